@@ -1,0 +1,32 @@
+//! `reachc inspect` on the 1000-state chain: load (parse, check, unroll), differentiate,
+//! bound every Jacobian entry, and print the JSON. Run with `cargo bench -p reachc`.
+
+use std::path::PathBuf;
+
+fn chain1000() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../specs/chain1000.sde")
+}
+
+fn main() {
+    divan::main();
+}
+
+/// Parse and check only.
+#[divan::bench(sample_count = 20)]
+fn load_chain1000() -> reachc::model::Model {
+    reachc::driver::load(&chain1000()).unwrap().model
+}
+
+/// Everything `reachc inspect --json` does after reading the file.
+#[divan::bench(sample_count = 20)]
+fn inspect_json_chain1000() -> usize {
+    let mut model = reachc::driver::load(&chain1000()).unwrap().model;
+    reachc::cli::inspect::json(&mut model).len()
+}
+
+/// The text report.
+#[divan::bench(sample_count = 20)]
+fn inspect_text_chain1000() -> usize {
+    let mut model = reachc::driver::load(&chain1000()).unwrap().model;
+    reachc::cli::inspect::text(&mut model).len()
+}

@@ -1,0 +1,110 @@
+//! The `reachc` command line. Exit codes: 0 ok, 1 spec errors, 2 usage or I/O errors.
+
+pub mod inspect;
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::diagnostics::render;
+use crate::driver::{load, LoadError, Loaded};
+
+/// reachc: a compiler for stochastic reachability (delta-probabilistic reachable sets).
+#[derive(Parser, Debug)]
+#[command(name = "reachc", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Parse and check a spec; print diagnostics.
+    Check {
+        /// The .sde spec.
+        spec: PathBuf,
+    },
+    /// Show the checked model: simplified drift and diffusion, Jacobians, atoms and bounds.
+    Inspect {
+        /// The .sde spec.
+        spec: PathBuf,
+        /// Print JSON (documented in docs/language.md) instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Exit code for spec errors.
+pub const EXIT_SPEC: u8 = 1;
+/// Exit code for usage and I/O errors.
+pub const EXIT_USAGE: u8 = 2;
+
+/// Runs the CLI on the process arguments.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            // clap uses 0 for --help/--version and 2 for usage errors, as we do.
+            return ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(EXIT_USAGE));
+        }
+    };
+    match run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(code) => ExitCode::from(code),
+    }
+}
+
+fn run(command: Command) -> Result<(), u8> {
+    match command {
+        Command::Check { spec } => {
+            let loaded = load_reporting(&spec)?;
+            println!(
+                "ok: model `{}` ({} states, {} inputs, {} noise channels, {} analyses)",
+                loaded.model.name,
+                loaded.model.states.len(),
+                loaded.model.inputs.len(),
+                loaded.model.noises.len(),
+                loaded.model.analyses.len()
+            );
+            Ok(())
+        }
+        Command::Inspect { spec, json } => {
+            let mut loaded = load_reporting(&spec)?;
+            let text = if json {
+                inspect::json(&mut loaded.model)
+            } else {
+                inspect::text(&mut loaded.model)
+            };
+            let mut out = std::io::stdout().lock();
+            // A closed pipe (`| head`) is not an error worth a panic.
+            let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+            Ok(())
+        }
+    }
+}
+
+/// Loads a spec, printing diagnostics (warnings too) to stderr; the exit code on failure.
+fn load_reporting(spec: &std::path::Path) -> Result<Loaded, u8> {
+    let color = std::io::stderr().is_terminal();
+    match load(spec) {
+        Ok(loaded) => {
+            if !loaded.warnings.is_empty() {
+                let path = loaded.path.display().to_string();
+                eprint!("{}", render(&loaded.warnings, &path, &loaded.source, color));
+            }
+            Ok(loaded)
+        }
+        Err(e) => {
+            eprint!("{}", e.report(color));
+            Err(match e {
+                LoadError::Io(_) => EXIT_USAGE,
+                LoadError::Spec { .. } => EXIT_SPEC,
+            })
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! Reading a spec from disk through parsing and checking: the front end as one call, shared by
+//! the CLI and by library users (build scripts, tests).
+
+use std::path::{Path, PathBuf};
+
+use crate::diagnostics::{has_errors, render, Diagnostic};
+use crate::model::{check, Model};
+use crate::syntax::parse;
+
+/// Why a spec could not be loaded.
+#[derive(Debug)]
+pub enum LoadError {
+    /// The file could not be read (exit code 2).
+    Io(String),
+    /// The spec has errors (exit code 1).
+    Spec {
+        /// Every diagnostic, errors and warnings.
+        diagnostics: Vec<Diagnostic>,
+        /// The spec's path as given (for the report).
+        path: String,
+        /// The spec's text (for the report).
+        source: String,
+    },
+}
+
+impl LoadError {
+    /// The report for a user: the I/O message, or the diagnostics rendered with ariadne.
+    pub fn report(&self, color: bool) -> String {
+        match self {
+            LoadError::Io(msg) => format!("error: {msg}\n"),
+            LoadError::Spec {
+                diagnostics,
+                path,
+                source,
+            } => render(diagnostics, path, source, color),
+        }
+    }
+}
+
+impl std::fmt::Display for LoadError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.report(false))
+    }
+}
+
+impl std::error::Error for LoadError {}
+
+/// A loaded spec: the model, its source, and any warnings.
+#[derive(Debug)]
+pub struct Loaded {
+    /// The checked model.
+    pub model: Model,
+    /// The spec's path as given.
+    pub path: PathBuf,
+    /// The spec's text.
+    pub source: String,
+    /// Warnings (the spec has no errors).
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// Parses and checks spec text; CSV paths are resolved against `dir`.
+/// Syntax errors stop before checking (a partial tree would give misleading follow-up errors).
+pub fn check_source(source: &str, dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
+    let (spec, diags) = parse(source);
+    if has_errors(&diags) {
+        return (None, diags);
+    }
+    let (model, mut more) = check(&spec, dir);
+    let mut all = diags;
+    all.append(&mut more);
+    (model, all)
+}
+
+/// Reads, parses and checks the spec at `path`.
+pub fn load(path: &Path) -> Result<Loaded, LoadError> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| LoadError::Io(format!("cannot read {}: {e}", path.display())))?;
+    let source = String::from_utf8(bytes).map_err(|e| {
+        LoadError::Io(format!(
+            "{} is not UTF-8 text (byte {})",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let (model, diagnostics) = check_source(&source, dir);
+    match model {
+        Some(model) => Ok(Loaded {
+            model,
+            path: path.to_path_buf(),
+            source,
+            warnings: diagnostics,
+        }),
+        None => Err(LoadError::Spec {
+            diagnostics,
+            path: path.display().to_string(),
+            source,
+        }),
+    }
+}

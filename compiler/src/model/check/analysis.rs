@@ -1,0 +1,282 @@
+//! `analysis NAME { key = value ... }` blocks.
+
+use super::matrix;
+use super::scope::did_you_mean;
+use super::sets::Fields;
+use super::Checker;
+use crate::diagnostics::{Diagnostic, Span};
+use crate::model::{Analysis, Inclusion, Integrator, Method, Metric, RadiusRule};
+use crate::syntax::ast::{Block, Expr, ExprKind, Ident};
+
+const KEYS: &[&str] = &[
+    "method",
+    "delta",
+    "horizon",
+    "step",
+    "metric",
+    "radius",
+    "inclusion",
+    "integrator",
+    "transform",
+    "outputs",
+];
+
+impl Checker<'_> {
+    pub(super) fn analysis(&mut self, name: &Ident, body: &Block, span: Span) {
+        if let Some(first) = self
+            .analyses
+            .iter()
+            .find(|a| a.name == name.name)
+            .map(|a| a.span.clone())
+        {
+            self.diags.push(
+                Diagnostic::error(
+                    format!("analysis `{}` is defined twice", name.name),
+                    name.span.clone(),
+                    "again",
+                )
+                .with_label(first, "first defined here"),
+            );
+            return;
+        }
+        let f = self.fields(body, KEYS, "an analysis");
+        let n = self.states.len();
+        let method = self.choice(
+            &f,
+            "method",
+            &[
+                ("contraction", Method::Contraction),
+                ("interval", Method::Interval),
+            ],
+            Method::Contraction,
+        );
+        let inclusion = self.choice(
+            &f,
+            "inclusion",
+            &[
+                ("natural", Inclusion::Natural),
+                ("jacobian", Inclusion::Jacobian),
+                ("mixed", Inclusion::Mixed),
+            ],
+            Inclusion::Jacobian,
+        );
+        let integrator = self.choice(
+            &f,
+            "integrator",
+            &[("rk4", Integrator::Rk4), ("euler", Integrator::Euler)],
+            Integrator::Rk4,
+        );
+        let delta = self.number(&f, "delta", 1e-3, |d| {
+            (d > 0.0 && d < 1.0)
+                .then_some(())
+                .ok_or("delta must be in (0, 1)")
+        });
+        let horizon = match f.get("horizon") {
+            Some(_) => self.number(&f, "horizon", 0.0, |h| {
+                (h > 0.0)
+                    .then_some(())
+                    .ok_or("the horizon must be positive")
+            }),
+            None => self.fail(
+                Diagnostic::error(
+                    format!("analysis `{}` has no horizon", name.name),
+                    name.span.clone(),
+                    "needs `horizon = ...`",
+                )
+                .with_help("add e.g. `horizon = 4` (the final time)"),
+            ),
+        };
+        let step = horizon.and_then(|h| {
+            self.number(&f, "step", h / 100.0, |s| {
+                if s <= 0.0 {
+                    Err("the step must be positive")
+                } else if s > h {
+                    Err("the step is larger than the horizon")
+                } else {
+                    Ok(())
+                }
+            })
+        });
+        let metric = match f.get("metric") {
+            None => Some(Metric::Identity),
+            Some((e, _)) => match &e.kind {
+                ExprKind::Name(id) if id.name == "identity" => Some(Metric::Identity),
+                ExprKind::Name(id) if id.name == "auto" => Some(Metric::Auto),
+                ExprKind::List(_) => self.square(e, n, "metric", true).map(Metric::Matrix),
+                _ => self.fail(Diagnostic::error(
+                    "unknown metric",
+                    e.span.clone(),
+                    "expected `identity`, `auto` or a matrix",
+                )),
+            },
+        };
+        let radius = match f.get("radius") {
+            None => Some(RadiusRule::Amgf),
+            Some((e, _)) => self.radius_rule(e),
+        };
+        let transform = match f.get("transform") {
+            None => Some(None),
+            Some((e, _)) => self.square(e, n, "transform", false).map(Some),
+        };
+        let outputs = match f.get("outputs") {
+            None => Some((0..n).collect()),
+            Some((e, _)) => self.state_list(e),
+        };
+        let (
+            Some(method),
+            Some(inclusion),
+            Some(integrator),
+            Some(delta),
+            Some(horizon),
+            Some(step),
+        ) = (method, inclusion, integrator, delta, horizon, step)
+        else {
+            return;
+        };
+        let (Some(metric), Some(radius), Some(transform), Some(outputs)) =
+            (metric, radius, transform, outputs)
+        else {
+            return;
+        };
+        self.analyses.push(Analysis {
+            name: name.name.clone(),
+            span,
+            method,
+            delta,
+            horizon,
+            step,
+            metric,
+            radius,
+            inclusion,
+            integrator,
+            transform,
+            outputs,
+        });
+    }
+
+    /// A keyword value from `options`, or `default` if the key is absent.
+    fn choice<T: Copy>(
+        &mut self,
+        f: &Fields,
+        key: &str,
+        options: &[(&str, T)],
+        default: T,
+    ) -> Option<T> {
+        let Some((e, _)) = f.get(key) else {
+            return Some(default);
+        };
+        let words: Vec<&str> = options.iter().map(|(w, _)| *w).collect();
+        if let ExprKind::Name(id) = &e.kind {
+            if let Some((_, v)) = options.iter().find(|(w, _)| *w == id.name) {
+                return Some(*v);
+            }
+            let mut d = Diagnostic::error(
+                format!("unknown {key} `{}`", id.name),
+                id.span.clone(),
+                format!("expected {}", words.join(", ")),
+            );
+            if let Some(s) = did_you_mean(&id.name, words.iter().copied()) {
+                d = d.with_help(format!("did you mean `{s}`?"));
+            }
+            return self.fail(d);
+        }
+        self.fail(Diagnostic::error(
+            format!("expected a {key}"),
+            e.span.clone(),
+            format!("expected {}", words.join(", ")),
+        ))
+    }
+
+    /// A constant field checked by `valid`, or `default` if absent.
+    fn number(
+        &mut self,
+        f: &Fields,
+        key: &str,
+        default: f64,
+        valid: impl Fn(f64) -> Result<(), &'static str>,
+    ) -> Option<f64> {
+        let Some((e, _)) = f.get(key) else {
+            return Some(default);
+        };
+        let v = self.constant(e, &[])?;
+        match valid(v) {
+            Ok(()) => Some(v),
+            Err(msg) => self.fail(Diagnostic::error(
+                format!("{msg}, but it is {v}"),
+                e.span.clone(),
+                "out of range",
+            )),
+        }
+    }
+
+    /// An n x n matrix, symmetric positive definite (`spd`) or non-singular.
+    fn square(&mut self, e: &Expr, n: usize, key: &str, spd: bool) -> Option<Vec<Vec<f64>>> {
+        let m = self.matrix(e)?;
+        let check = matrix::check_square(&m, n).and_then(|()| {
+            if spd {
+                matrix::check_spd(&m)
+            } else {
+                matrix::check_nonsingular(&m)
+            }
+        });
+        match check {
+            Ok(()) => Some(m),
+            Err(err) => {
+                let need = if spd {
+                    "symmetric positive definite"
+                } else {
+                    "square and invertible"
+                };
+                self.fail(
+                    Diagnostic::error(format!("bad {key}: {err}"), e.span.clone(), "here")
+                        .with_help(format!(
+                            "the {key} must be {need}, {n} x {n} (one row per state)"
+                        )),
+                )
+            }
+        }
+    }
+
+    /// `amgf`, `paper(eps = x)` or `paper(optimal)`.
+    fn radius_rule(&mut self, e: &Expr) -> Option<RadiusRule> {
+        let help = "write `amgf`, `paper(eps = 1/16)` or `paper(optimal)`";
+        match &e.kind {
+            ExprKind::Name(id) if id.name == "amgf" => Some(RadiusRule::Amgf),
+            ExprKind::Call { func, args } if func.name == "paper" => match args.as_slice() {
+                [a] if a.name.is_none()
+                    && matches!(&a.value.kind, ExprKind::Name(id) if id.name == "optimal") =>
+                {
+                    Some(RadiusRule::Paper(None))
+                }
+                [a] if a.name.as_ref().is_some_and(|n| n.name == "eps") => {
+                    let eps = self.constant(&a.value, &[])?;
+                    if eps > 0.0 && eps < 1.0 {
+                        Some(RadiusRule::Paper(Some(eps)))
+                    } else {
+                        self.fail(Diagnostic::error(
+                            format!("eps must be in (0, 1), but it is {eps}"),
+                            a.value.span.clone(),
+                            "out of range",
+                        ))
+                    }
+                }
+                _ => self.fail(
+                    Diagnostic::error(
+                        "bad arguments to `paper`",
+                        e.span.clone(),
+                        "expected `eps = NUMBER` or `optimal`",
+                    )
+                    .with_help(help),
+                ),
+            },
+            _ => self.fail(
+                Diagnostic::error(
+                    "unknown radius rule",
+                    e.span.clone(),
+                    "expected amgf or paper(...)",
+                )
+                .with_help(help),
+            ),
+        }
+    }
+}

@@ -1,0 +1,393 @@
+//! Initial balls, unsafe sets, and the `key = value` field blocks they share with analyses.
+
+use std::collections::HashMap;
+
+use super::lower::Allow;
+use super::matrix;
+use super::scope::{did_you_mean, VarKind};
+use super::Checker;
+use crate::diagnostics::{Diagnostic, Span};
+use crate::ir::Var;
+use crate::model::{Ball, Bounds, UnsafeSet, UnsafeShape};
+use crate::syntax::ast::{Block, CmpOp, Expr, ExprKind, Ident, Stmt, Target};
+
+/// The fields of a block, by key.
+pub(super) type Fields<'s> = HashMap<&'s str, (&'s Expr, Span)>;
+
+impl Checker<'_> {
+    /// Collects `key = value` fields, reporting unknown keys (with a suggestion), duplicates and
+    /// statements that are not fields.
+    pub(super) fn fields<'s>(&mut self, body: &'s Block, keys: &[&str], what: &str) -> Fields<'s> {
+        let mut out: Fields<'s> = HashMap::new();
+        for s in &body.stmts {
+            let Stmt::Field { key, value, span } = s else {
+                self.unexpected(
+                    s,
+                    &format!("in {what}"),
+                    &format!("{what} holds fields: {}", keys.join(", ")),
+                );
+                continue;
+            };
+            if !keys.contains(&key.name.as_str()) {
+                let mut d = Diagnostic::error(
+                    format!("unknown key `{}` in {what}", key.name),
+                    key.span.clone(),
+                    "unknown key",
+                );
+                d = match did_you_mean(&key.name, keys.iter().copied()) {
+                    Some(k) => d.with_help(format!("did you mean `{k}`?")),
+                    None => d.with_note(format!("the keys are: {}", keys.join(", "))),
+                };
+                self.diags.push(d);
+                continue;
+            }
+            if let Some((_, first)) = out.get(key.name.as_str()) {
+                let first = first.clone();
+                self.diags.push(
+                    Diagnostic::error(
+                        format!("`{}` is given twice in {what}", key.name),
+                        span.clone(),
+                        "given again",
+                    )
+                    .with_label(first, "first given here"),
+                );
+                continue;
+            }
+            out.insert(&key.name, (value, span.clone()));
+        }
+        out
+    }
+
+    /// A list of constants.
+    pub(super) fn vector(&mut self, e: &Expr) -> Option<Vec<f64>> {
+        let ExprKind::List(items) = &e.kind else {
+            return self.fail(
+                Diagnostic::error("expected a list of numbers", e.span.clone(), "not a list")
+                    .with_help("write `[a, b, ...]`"),
+            );
+        };
+        let vals: Vec<Option<f64>> = items.iter().map(|x| self.constant(x, &[])).collect();
+        vals.into_iter().collect()
+    }
+
+    /// A matrix: a list of lists of constants (squareness is checked by the caller).
+    pub(super) fn matrix(&mut self, e: &Expr) -> Option<Vec<Vec<f64>>> {
+        let ExprKind::List(rows) = &e.kind else {
+            return self.fail(
+                Diagnostic::error("expected a matrix", e.span.clone(), "not a matrix")
+                    .with_help("write rows as lists: `[[1, 0], [0, 1]]`"),
+            );
+        };
+        let rows: Vec<Option<Vec<f64>>> = rows.iter().map(|r| self.vector(r)).collect();
+        rows.into_iter().collect()
+    }
+
+    /// A list of state names (or family elements with constant indices).
+    pub(super) fn state_list(&mut self, e: &Expr) -> Option<Vec<usize>> {
+        let ExprKind::List(items) = &e.kind else {
+            return self.fail(
+                Diagnostic::error("expected a list of states", e.span.clone(), "not a list")
+                    .with_help("write `[x, y]`"),
+            );
+        };
+        let mut out = Vec::new();
+        for item in items {
+            let target = match &item.kind {
+                ExprKind::Name(name) => Target {
+                    name: name.clone(),
+                    index: None,
+                    span: item.span.clone(),
+                },
+                ExprKind::Index { base, index } => Target {
+                    name: base.clone(),
+                    index: Some(index.clone()),
+                    span: item.span.clone(),
+                },
+                _ => {
+                    return self.fail(Diagnostic::error(
+                        "expected a state name",
+                        item.span.clone(),
+                        "not a state",
+                    ))
+                }
+            };
+            let i = self.target(&target, VarKind::State, &[])?;
+            if out.contains(&i) {
+                return self.fail(Diagnostic::error(
+                    format!("state `{}` is listed twice", self.states[i].name),
+                    item.span.clone(),
+                    "repeated",
+                ));
+            }
+            out.push(i);
+        }
+        Some(out)
+    }
+
+    /// `over`, `center` and `radius` of a ball; `over` defaults to all states.
+    fn ball_fields(&mut self, f: &Fields, span: &Span) -> Option<(Vec<usize>, Vec<f64>, f64)> {
+        let states = match f.get("over") {
+            Some((e, _)) => self.state_list(e)?,
+            None => (0..self.states.len()).collect(),
+        };
+        let center = self.required(f, "center", span, "ball")?;
+        let center = self.vector(center)?;
+        let radius = self.required(f, "radius", span, "ball")?;
+        let radius_span = radius.span.clone();
+        let radius = self.constant(radius, &[])?;
+        if center.len() != states.len() {
+            let (e, _) = &f["center"];
+            return self.fail(Diagnostic::error(
+                format!(
+                    "the centre has {} entries but the ball is over {} states",
+                    center.len(),
+                    states.len()
+                ),
+                e.span.clone(),
+                "wrong length",
+            ));
+        }
+        if radius < 0.0 {
+            return self.fail(Diagnostic::error(
+                format!("the radius {radius} is negative"),
+                radius_span,
+                "must be >= 0",
+            ));
+        }
+        Some((states, center, radius))
+    }
+
+    /// A required field, or a diagnostic at the block.
+    pub(super) fn required<'s>(
+        &mut self,
+        f: &Fields<'s>,
+        key: &str,
+        span: &Span,
+        what: &str,
+    ) -> Option<&'s Expr> {
+        match f.get(key) {
+            Some((e, _)) => Some(e),
+            None => self.fail(Diagnostic::error(
+                format!("{what} needs `{key}`"),
+                span.clone(),
+                format!("no `{key} = ...`"),
+            )),
+        }
+    }
+
+    /// `initial ball { over = [..] center = [..] radius = r metric = [[..]] }`.
+    pub(super) fn initial_set(&mut self, kind: &Ident, body: &Block, span: Span) {
+        if kind.name != "ball" {
+            self.diags.push(
+                Diagnostic::error(
+                    format!("unknown initial set kind `{}`", kind.name),
+                    kind.span.clone(),
+                    "expected `ball`",
+                )
+                .with_help("boxes and points are written on the states: `state x in [LO, HI]`"),
+            );
+            return;
+        }
+        let f = self.fields(
+            body,
+            &["over", "center", "radius", "metric"],
+            "an initial ball",
+        );
+        let Some((states, center, radius)) = self.ball_fields(&f, &span) else {
+            return;
+        };
+        let metric = match f.get("metric") {
+            None => None,
+            Some((e, _)) => {
+                let Some(m) = self.matrix(e) else { return };
+                if let Err(err) =
+                    matrix::check_square(&m, states.len()).and_then(|()| matrix::check_spd(&m))
+                {
+                    self.diags.push(Diagnostic::error(format!("bad ball metric: {err}"), e.span.clone(), "here")
+                        .with_help("the metric must be symmetric positive definite, one row per state of the ball"));
+                    return;
+                }
+                Some(m)
+            }
+        };
+        for &s in &states {
+            let earlier = self
+                .initial
+                .balls
+                .iter()
+                .find(|b| b.states.contains(&s))
+                .map(|b| b.span.clone());
+            if self.states[s].bounds.is_some() || earlier.is_some() {
+                let mut d = Diagnostic::error(
+                    format!("state `{}` gets two initial sets", self.states[s].name),
+                    span.clone(),
+                    "this ball",
+                )
+                .with_label(self.states[s].span.clone(), "declared here");
+                if let Some(e) = earlier {
+                    d = d.with_label(e, "an earlier ball");
+                }
+                self.diags.push(d.with_help(
+                    "a state has a box or point in its declaration, or belongs to one ball",
+                ));
+                return;
+            }
+        }
+        self.initial.balls.push(Ball {
+            states,
+            center,
+            radius,
+            metric,
+            span,
+        });
+    }
+
+    /// `unsafe NAME box|ball|halfspace { ... }`.
+    pub(super) fn unsafe_set(&mut self, name: &Ident, kind: &Ident, body: &Block, span: Span) {
+        if let Some(first) = self
+            .unsafe_sets
+            .iter()
+            .find(|u| u.name == name.name)
+            .map(|u| u.span.clone())
+        {
+            self.diags.push(
+                Diagnostic::error(
+                    format!("unsafe set `{}` is defined twice", name.name),
+                    name.span.clone(),
+                    "again",
+                )
+                .with_label(first, "first defined here"),
+            );
+            return;
+        }
+        let shape = match kind.name.as_str() {
+            "box" => self.unsafe_box(body),
+            "ball" => {
+                let f = self.fields(body, &["over", "center", "radius"], "an unsafe ball");
+                self.ball_fields(&f, &span)
+                    .map(|(states, center, radius)| UnsafeShape::Ball {
+                        states,
+                        center,
+                        radius,
+                    })
+            }
+            "halfspace" => self.halfspace(body),
+            other => {
+                let mut d = Diagnostic::error(
+                    format!("unknown unsafe set kind `{other}`"),
+                    kind.span.clone(),
+                    "expected box, ball or halfspace",
+                );
+                if let Some(s) = did_you_mean(other, ["box", "ball", "halfspace"]) {
+                    d = d.with_help(format!("did you mean `{s}`?"));
+                }
+                self.fail(d)
+            }
+        };
+        if let Some(shape) = shape {
+            self.unsafe_sets.push(UnsafeSet {
+                name: name.name.clone(),
+                span,
+                shape,
+            });
+        }
+    }
+
+    fn unsafe_box(&mut self, body: &Block) -> Option<UnsafeShape> {
+        let mut sides: Vec<(usize, Bounds)> = Vec::new();
+        let mut ok = true;
+        for s in &body.stmts {
+            let Stmt::Member { target, set, .. } = s else {
+                self.unexpected(
+                    s,
+                    "in an unsafe box",
+                    "an unsafe box holds memberships like `px in [1, 2]`",
+                );
+                ok = false;
+                continue;
+            };
+            let (i, b) = (
+                self.target(target, VarKind::State, &[]),
+                self.interval(set, &[]),
+            );
+            let (Some(i), Some(b)) = (i, b) else {
+                ok = false;
+                continue;
+            };
+            if sides.iter().any(|(j, _)| *j == i) {
+                self.diags.push(Diagnostic::error(
+                    format!("state `{}` is bounded twice", self.states[i].name),
+                    target.span.clone(),
+                    "again",
+                ));
+                ok = false;
+                continue;
+            }
+            sides.push((i, b));
+        }
+        if ok && sides.is_empty() {
+            return self.fail(
+                Diagnostic::error(
+                    "an unsafe box needs at least one side",
+                    body.span.clone(),
+                    "empty",
+                )
+                .with_help("write `px in [1, 2]`"),
+            );
+        }
+        ok.then_some(UnsafeShape::Box(sides))
+    }
+
+    fn halfspace(&mut self, body: &Block) -> Option<UnsafeShape> {
+        let [Stmt::Constraint { lhs, op, rhs, span }] = body.stmts.as_slice() else {
+            return self.fail(
+                Diagnostic::error(
+                    "a half-space is one linear constraint",
+                    body.span.clone(),
+                    "expected one `EXPR >= EXPR`",
+                )
+                .with_help("write `halfspace { px + 2 * py >= 3 }`"),
+            );
+        };
+        let l = self.lower(lhs, Allow::Model, &[]);
+        let r = self.lower(rhs, Allow::Model, &[]);
+        let (l, r) = (l?, r?);
+        // Normalise to `g(x) >= 0`, then split g into normal . x - offset.
+        let g = match op {
+            CmpOp::Ge => self.pool.sub(l, r),
+            CmpOp::Le => self.pool.sub(r, l),
+        };
+        let not_linear = |c: &mut Self| {
+            c.fail(
+                Diagnostic::error(
+                    "a half-space must be linear in the states",
+                    span.clone(),
+                    "not linear",
+                )
+                .with_help("use only constants times states: `a * px + b * py >= c`"),
+            )
+        };
+        let mut normal = vec![0.0; self.states.len()];
+        for v in self.pool.vars_of(g) {
+            let Var::State(i) = v else {
+                return not_linear(self);
+            };
+            let d = self.pool.diff(g, v);
+            let Some(a) = self.pool.as_const(d) else {
+                return not_linear(self);
+            };
+            normal[i as usize] = a;
+        }
+        let zero = self.pool.num(0.0);
+        let at_zero = self.pool.substitute(g, &mut |_| Some(zero));
+        let offset = -self.pool.as_const(at_zero)?;
+        if normal.iter().all(|a| *a == 0.0) {
+            return self.fail(Diagnostic::error(
+                "the half-space does not depend on any state",
+                span.clone(),
+                "no state here",
+            ));
+        }
+        Some(UnsafeShape::HalfSpace { normal, offset })
+    }
+}

@@ -1,0 +1,145 @@
+//! The `reachc` binary: exit codes, diagnostics on stderr, and `inspect --json` values.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn reachc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_reachc"))
+        .args(args)
+        .output()
+        .expect("the reachc binary runs")
+}
+
+fn spec(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../specs")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn temp_spec(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("reachc-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn check_exit_codes() {
+    let ok = reachc(&["check", &spec("pendulum.sde")]);
+    assert_eq!(ok.status.code(), Some(0), "{}", stderr(&ok));
+    assert!(String::from_utf8_lossy(&ok.stdout).contains("model `pendulum` (2 states"));
+
+    let bad = temp_spec("bad.sde", "model m\nstate x in [0, 1]\ndrift { x' = -y }\n");
+    let out = reachc(&["check", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(err.contains("undefined name `y`"), "{err}");
+    assert!(
+        err.contains("bad.sde:3:"),
+        "diagnostic names file and line: {err}"
+    );
+
+    let missing = reachc(&["check", "/no/such/file.sde"]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(stderr(&missing).contains("cannot read /no/such/file.sde"));
+
+    assert_eq!(reachc(&["frobnicate"]).status.code(), Some(2));
+    assert_eq!(reachc(&["check"]).status.code(), Some(2));
+}
+
+#[test]
+fn hostile_input_gives_diagnostics_not_crashes() {
+    let deep = format!(
+        "model m\nstate x in [0, 1]\ndrift {{ x' = {}x{} }}\n",
+        "(".repeat(10_000),
+        ")".repeat(10_000)
+    );
+    let out = reachc(&["check", temp_spec("deep.sde", &deep).to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("nested too deeply"),
+        "{}",
+        stderr(&out)
+    );
+
+    let minus = format!(
+        "model m\nstate x in [0, 1]\ndrift {{ x' = {}x }}\n",
+        "-".repeat(10_000)
+    );
+    let out = reachc(&["check", temp_spec("minus.sde", &minus).to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+
+    let mut huge = String::from("model m\nstate x in [0, 1]\ndrift { x' = -x }\n");
+    while huge.len() < 10 << 20 {
+        huge.push_str("// padding padding padding padding padding padding padding padding\n");
+    }
+    let out = reachc(&["check", temp_spec("huge.sde", &huge).to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+
+    let binary = temp_spec("binary.sde", "");
+    std::fs::write(&binary, [0xff, 0xfe, 0x00, 0x41]).unwrap();
+    assert_eq!(
+        reachc(&["check", binary.to_str().unwrap()]).status.code(),
+        Some(2)
+    );
+}
+
+fn inspect_json(name: &str) -> serde_json::Value {
+    let out = reachc(&["inspect", "--json", &spec(name)]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).expect("inspect --json prints JSON")
+}
+
+#[test]
+fn pendulum_inspect_json_has_the_papers_vertex_matrices() {
+    let j = inspect_json("pendulum.sde");
+    assert_eq!(j["model"], "pendulum");
+    assert_eq!(j["jacobian_x"][0][0], "0");
+    assert_eq!(j["jacobian_x"][0][1], "1");
+    assert_eq!(j["jacobian_x"][1][1], "-20");
+    // d/dtheta (10 sin(theta) - 20 theta - 20 omega), within [-30, -10] for every theta.
+    let b = &j["bounds"]["jacobian_x"][1][0];
+    let (lo, hi) = (b[0].as_f64().unwrap(), b[1].as_f64().unwrap());
+    assert!((-30.0 - 1e-9..=-30.0).contains(&lo), "{lo}");
+    assert!((-10.0..-10.0 + 1e-9).contains(&hi), "{hi}");
+    // One atom, cos(theta) in [-1, 1] with coefficient 10: the paper's conv{A1, A2}.
+    let atoms = &j["atoms"]["jacobian_x"];
+    assert_eq!(
+        atoms["constant"],
+        serde_json::json!([[0.0, 1.0], [-20.0, -20.0]])
+    );
+    assert_eq!(atoms["atoms"].as_array().unwrap().len(), 1);
+    assert_eq!(atoms["atoms"][0]["expr"], "cos(theta)");
+    assert_eq!(
+        atoms["atoms"][0]["entries"],
+        serde_json::json!([[1, 0, 10.0]])
+    );
+    let r = &atoms["atoms"][0]["range"];
+    assert!(r[0].as_f64().unwrap() <= -1.0 && r[1].as_f64().unwrap() >= 1.0);
+    assert_eq!(j["diffusion"], serde_json::json!([["0"], ["0.1"]]));
+    assert_eq!(j["unbounded"], serde_json::json!([]));
+}
+
+#[test]
+fn unbounded_entries_are_reported() {
+    // Van der Pol's Jacobian is polynomial: bounded only because the spec gives a domain.
+    let vdp = inspect_json("vanderpol.sde");
+    assert_eq!(vdp["domain_given"], true);
+    assert_eq!(vdp["unbounded"], serde_json::json!([]));
+    // The unicycle's tracking controller differentiates atan2 of the position error.
+    let uni = inspect_json("unicycle.sde");
+    let unbounded = uni["unbounded"].as_array().unwrap();
+    assert!(
+        unbounded.iter().any(|u| u["matrix"] == "jacobian_x"),
+        "{unbounded:?}"
+    );
+    let text = reachc(&["inspect", &spec("unicycle.sde")]);
+    assert!(String::from_utf8_lossy(&text.stdout).contains("help: add a `domain"));
+}

@@ -1,0 +1,2 @@
+pub mod interval;
+pub use interval::Interval;
