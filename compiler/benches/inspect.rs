@@ -21,12 +21,16 @@ fn load_chain1000() -> reachc::model::Model {
 #[divan::bench(sample_count = 20)]
 fn inspect_json_chain1000() -> usize {
     let mut model = reachc::driver::load(&chain1000()).unwrap().model;
-    reachc::cli::inspect::json(&mut model).len()
+    let mut out = Vec::new();
+    reachc::cli::inspect::json(&mut model, &mut out).unwrap();
+    out.len()
 }
 
 /// The text report.
 #[divan::bench(sample_count = 20)]
 fn inspect_text_chain1000() -> usize {
     let mut model = reachc::driver::load(&chain1000()).unwrap().model;
-    reachc::cli::inspect::text(&mut model).len()
+    let mut out = Vec::new();
+    reachc::cli::inspect::text(&mut model, &mut out).unwrap();
+    out.len()
 }

@@ -1,7 +1,11 @@
-//! Property tests for the parser: it never panics, and every diagnostic span lies within the
-//! source on char boundaries, for random text, token soups and mutated valid specs.
+//! Property tests for the front end (parser and checker): it never panics, and every
+//! diagnostic span lies within the source on char boundaries, for random text, token soups
+//! and mutated valid specs.
 
 use proptest::prelude::*;
+use std::path::Path;
+
+use reachc::driver::check_source;
 use reachc::syntax::parse;
 
 /// A valid spec exercising every item kind (with a non-ASCII comment).
@@ -12,10 +16,12 @@ const K1 = -20
 state theta in [-pi/10, pi/10]
 state x[1..3] in [-1, 1]
 state c = 0.5
+state z
+state q
 input u in [-1, 1]
 noise w
 noise v[1..3]
-table ref = csv(\"ref.csv\")
+table ref = csv(\"unicycle_ref.csv\")
 let e = theta - ref.px
 for i in 1..3 { let y[i] = x[i] * 2 }
 drift {
@@ -23,10 +29,12 @@ drift {
   for i in 2..3 { x[i]' = x[i-1] - x[i] }
   x[1]' = -x[1]
   c' = min(c, 1, e) / (1 + c)
+  z' = -z + q
+  q' = -q * y[2]
 }
 diffusion { theta: 0.1 * w; x[1]: v[1] }
 domain { theta in [-1, 1] }
-initial ball { over = [x[1], c] center = [0, 0] radius = .5 metric = [[1, 0], [0, 2.]] }
+initial ball { over = [z, q] center = [0, 0] radius = .5 metric = [[1, 0], [0, 2.]] }
 unsafe wall halfspace { theta + 2 * c >= 3 }
 unsafe b box { theta in [1, 2] c in [3, 4] }
 unsafe s ball { over = [theta, c] center = [2, 3] radius = 1e-1 }
@@ -107,10 +115,16 @@ const VOCAB: &[&str] = &[
     "\\",
 ];
 
-/// Checks the parser's contract on `src`.
+/// Where the table of [`VALID`] lives.
+fn specs_dir() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../specs"))
+}
+
+/// Checks the front end's contract on `src`: parse, then (if it parsed) check.
 fn check(src: &str) -> Result<(), TestCaseError> {
-    let (_spec, diags) = parse(src);
-    for d in &diags {
+    let (_, checked) = check_source(src, specs_dir());
+    let (_spec, parsed) = parse(src);
+    for d in parsed.iter().chain(&checked) {
         prop_assert!(!d.labels.is_empty(), "diagnostic without a label: {d:?}");
         for l in &d.labels {
             let s = &l.span;
@@ -230,7 +244,12 @@ proptest! {
 fn valid_spec_is_clean() {
     let (spec, diags) = parse(VALID);
     assert!(diags.is_empty(), "{diags:#?}");
-    assert_eq!(spec.items.len(), 19);
+    assert_eq!(spec.items.len(), 21);
+    let (model, diags) = check_source(VALID, specs_dir());
+    assert!(diags.is_empty(), "{diags:#?}");
+    let model = model.unwrap();
+    assert_eq!(model.states.len(), 7);
+    assert_eq!(model.noises.len(), 4);
 }
 
 #[test]

@@ -35,7 +35,7 @@ pub fn split_atoms(pool: &Pool, matrix: &[Vec<ExprId>]) -> AtomSplit {
     let cols = matrix.first().map_or(0, Vec::len);
     let mut constant = vec![vec![0.0; cols]; matrix.len()];
     let mut atoms: Vec<Atom> = Vec::new();
-    let mut index: std::collections::HashMap<ExprId, usize> = std::collections::HashMap::new();
+    let mut index: rustc_hash::FxHashMap<ExprId, usize> = Default::default();
     let mut add = |expr: ExprId, i: usize, j: usize, c: f64| {
         let k = *index.entry(expr).or_insert_with(|| {
             atoms.push(Atom {

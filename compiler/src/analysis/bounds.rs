@@ -41,12 +41,20 @@ pub fn eval_box(model: &Model, roots: &[ExprId], time: Interval) -> Vec<Interval
     model.pool.eval(roots, &vars, &model.tables)
 }
 
-/// Encloses every entry of a matrix of expressions (see [`eval_box`]).
+/// Encloses every entry of a matrix of expressions (see [`eval_box`]). Each distinct
+/// expression is evaluated once (most entries of a large Jacobian are the same constant 0).
 pub fn bound_matrix(model: &Model, matrix: &[Vec<ExprId>], time: Interval) -> Vec<Vec<Interval>> {
-    let flat: Vec<ExprId> = matrix.iter().flatten().copied().collect();
-    let mut values = eval_box(model, &flat, time).into_iter();
+    let mut index: rustc_hash::FxHashMap<ExprId, usize> = Default::default();
+    let mut distinct = Vec::new();
+    for &e in matrix.iter().flatten() {
+        index.entry(e).or_insert_with(|| {
+            distinct.push(e);
+            distinct.len() - 1
+        });
+    }
+    let values = eval_box(model, &distinct, time);
     matrix
         .iter()
-        .map(|row| values.by_ref().take(row.len()).collect())
+        .map(|row| row.iter().map(|e| values[index[e]]).collect())
         .collect()
 }

@@ -3,15 +3,29 @@
 use crate::ir::{ExprId, Var};
 use crate::model::Model;
 
-/// The Jacobians of a model, as IR expressions (the constant 0 where an entry vanishes).
+/// One non-zero entry of `D_x G`: `d G[row][noise] / d x[state]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GradEntry {
+    /// The state `i` of the diffusion row.
+    pub row: usize,
+    /// The noise channel `k`.
+    pub noise: usize,
+    /// The state `j` differentiated against.
+    pub state: usize,
+    /// The derivative.
+    pub expr: ExprId,
+}
+
+/// The Jacobians of a model, as IR expressions.
 #[derive(Clone, Debug)]
 pub struct Derivatives {
-    /// `D_x f`: `[equation i][state j] = d f_i / d x_j`.
+    /// `D_x f`: `[equation i][state j] = d f_i / d x_j` (the constant 0 where it vanishes).
     pub jac_x: Vec<Vec<ExprId>>,
     /// `D_u f`: `[equation i][input j] = d f_i / d u_j`.
     pub jac_u: Vec<Vec<ExprId>>,
-    /// `D_x G`: `[state i][noise k][state j] = d G_ik / d x_j`.
-    pub jac_g: Vec<Vec<Vec<ExprId>>>,
+    /// `D_x G`: its non-zero entries, ordered by (row, noise, state). Sparse because the dense
+    /// tensor has n * m * n entries (10^9 for a 1000-state chain with a noise per state).
+    pub jac_g: Vec<GradEntry>,
 }
 
 impl Derivatives {
@@ -38,11 +52,24 @@ impl Derivatives {
         let input = |v| if let Var::Input(j) = v { Some(j) } else { None };
         let jac_x = model.drift.iter().map(|&f| gradient(f, n, state)).collect();
         let jac_u = model.drift.iter().map(|&f| gradient(f, p, input)).collect();
-        let jac_g = model
-            .diffusion
-            .iter()
-            .map(|row| row.iter().map(|&g| gradient(g, n, state)).collect())
-            .collect();
+        let mut jac_g = Vec::new();
+        for (row, g_row) in model.diffusion.iter().enumerate() {
+            for (noise, &g) in g_row.iter().enumerate() {
+                for v in pool.vars_of(g) {
+                    if let Some(j) = state(v) {
+                        let expr = pool.diff(g, v);
+                        if pool.as_const(expr) != Some(0.0) {
+                            jac_g.push(GradEntry {
+                                row,
+                                noise,
+                                state: j as usize,
+                                expr,
+                            });
+                        }
+                    }
+                }
+            }
+        }
         Derivatives {
             jac_x,
             jac_u,

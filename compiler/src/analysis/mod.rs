@@ -7,4 +7,4 @@ mod derivatives;
 
 pub use atoms::{split_atoms, Atom, AtomSplit};
 pub use bounds::{bound_matrix, eval_box, time_range};
-pub use derivatives::Derivatives;
+pub use derivatives::{Derivatives, GradEntry};

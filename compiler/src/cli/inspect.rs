@@ -1,15 +1,24 @@
 //! `reachc inspect`: the checked model, its Jacobians, atoms and bounds, as text or JSON.
+//!
+//! Both forms come from one [`Report`]. Expressions are printed once per distinct IR node (a
+//! 1000-state chain has a million Jacobian entries but few distinct ones), and the JSON is
+//! streamed from borrowed data rather than built as a tree.
 
-use std::fmt::Write;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::io::Write;
 
 use reachc_runtime::interval::Interval;
+use serde::Serialize;
 use serde_json::{json, Value};
 
-use crate::analysis::{bound_matrix, eval_box, split_atoms, time_range, AtomSplit, Derivatives};
+use crate::analysis::{
+    bound_matrix, eval_box, split_atoms, time_range, AtomSplit, Derivatives, GradEntry,
+};
 use crate::ir::{ExprId, Names};
-use crate::model::{Bounds, Model, UnsafeShape};
+use crate::model::{Bounds, Model, UnsafeShape, Variable};
 
-/// A matrix of expressions with its interval bounds, named as in the output.
+/// A dense matrix of expressions with its interval bounds.
 struct Matrix {
     key: &'static str,
     title: &'static str,
@@ -17,177 +26,276 @@ struct Matrix {
     bounds: Vec<Vec<Interval>>,
     row_names: Vec<String>,
     col_names: Vec<String>,
+    atoms: AtomSplit,
+    atom_ranges: Vec<Interval>,
 }
 
 /// Everything inspect shows, computed once.
 struct Report {
-    /// Diffusion, `D_x f`, `D_u f` and `D_x G` (rows `(state, noise)`), with bounds.
+    /// Diffusion `G`, `D_x f` and `D_u f`.
     matrices: Vec<Matrix>,
+    /// The non-zero entries of `D_x G` with their bounds.
+    jac_g: Vec<(GradEntry, Interval)>,
     /// The time range the bounds hold on.
     time: Interval,
+    /// Every expression shown, printed in `.sde` syntax.
+    printed: HashMap<ExprId, String>,
 }
 
-fn names(model: &Model) -> (Vec<String>, Vec<String>, Vec<String>) {
-    let n = |v: &[crate::model::Variable]| v.iter().map(|x| x.name.clone()).collect();
-    (n(&model.states), n(&model.inputs), n(&model.noises))
+fn names(v: &[Variable]) -> Vec<String> {
+    v.iter().map(|x| x.name.clone()).collect()
 }
 
 fn report(model: &mut Model) -> Report {
     let d = Derivatives::of(model);
+    let model = &*model;
     let time = time_range(model);
-    let (states, inputs, noises) = names(model);
-    let jac_g_rows: Vec<Vec<ExprId>> = d.jac_g.iter().flatten().cloned().collect();
-    let jac_g_names: Vec<String> = states
-        .iter()
-        .flat_map(|s| noises.iter().map(move |w| format!("G[{s}, {w}]")))
-        .collect();
+    let (states, inputs, noises) = (
+        names(&model.states),
+        names(&model.inputs),
+        names(&model.noises),
+    );
     let specs = [
         (
             "diffusion",
             "diffusion G (state x noise)",
             model.diffusion.clone(),
-            states.clone(),
-            noises.clone(),
+            &noises,
         ),
         (
             "jacobian_x",
             "Jacobian D_x f (equation x state)",
             d.jac_x,
-            states.clone(),
-            states.clone(),
+            &states,
         ),
         (
             "jacobian_u",
             "Jacobian D_u f (equation x input)",
             d.jac_u,
-            states.clone(),
-            inputs,
-        ),
-        (
-            "jacobian_g",
-            "Jacobian D_x G (entry x state)",
-            jac_g_rows,
-            jac_g_names,
-            states,
+            &inputs,
         ),
     ];
-    let matrices = specs
+    let matrices: Vec<Matrix> = specs
         .into_iter()
-        .map(|(key, title, rows, row_names, col_names)| Matrix {
-            key,
-            title,
-            bounds: bound_matrix(model, &rows, time),
-            rows,
-            row_names,
-            col_names,
+        .map(|(key, title, rows, cols)| {
+            let atoms = split_atoms(&model.pool, &rows);
+            let atom_exprs: Vec<ExprId> = atoms.atoms.iter().map(|a| a.expr).collect();
+            Matrix {
+                key,
+                title,
+                bounds: bound_matrix(model, &rows, time),
+                atom_ranges: eval_box(model, &atom_exprs, time),
+                atoms,
+                rows,
+                row_names: states.clone(),
+                col_names: cols.clone(),
+            }
         })
         .collect();
-    Report { matrices, time }
-}
-
-fn sde(model: &Model, e: ExprId) -> String {
-    let (states, inputs, noises) = names(model);
-    let names = Names {
+    let g_exprs: Vec<ExprId> = d.jac_g.iter().map(|g| g.expr).collect();
+    let jac_g = d
+        .jac_g
+        .iter()
+        .copied()
+        .zip(eval_box(model, &g_exprs, time))
+        .collect();
+    let mut all: Vec<ExprId> = model.drift.clone();
+    for m in &matrices {
+        all.extend(m.rows.iter().flatten());
+        all.extend(m.atoms.atoms.iter().map(|a| a.expr));
+    }
+    all.extend(g_exprs);
+    all.sort_unstable();
+    all.dedup();
+    let sde_names = Names {
         states: &states,
         inputs: &inputs,
         noises: &noises,
         tables: &model.tables,
     };
-    model.pool.to_sde(e, &names)
+    let printed = all
+        .into_iter()
+        .map(|e| (e, model.pool.to_sde(e, &sde_names)))
+        .collect();
+    Report {
+        matrices,
+        jac_g,
+        time,
+        printed,
+    }
 }
 
-/// JSON numbers for interval ends; infinite ends become `null`.
-fn ends(i: Interval) -> Value {
-    json!([i.lo(), i.hi()])
+impl Report {
+    fn sde(&self, e: ExprId) -> &str {
+        &self.printed[&e]
+    }
+}
+
+/// `[lo, hi]`; serde_json writes infinite ends as `null`.
+fn ends(i: Interval) -> [f64; 2] {
+    [i.lo(), i.hi()]
+}
+
+#[derive(Serialize)]
+struct AtomDoc<'a> {
+    expr: &'a str,
+    range: [f64; 2],
+    entries: &'a [(usize, usize, f64)],
+}
+
+#[derive(Serialize)]
+struct SplitDoc<'a> {
+    constant: &'a [Vec<f64>],
+    atoms: Vec<AtomDoc<'a>>,
+}
+
+#[derive(Serialize)]
+struct GradDoc<'a> {
+    row: usize,
+    noise: usize,
+    column: usize,
+    expr: &'a str,
+    range: [f64; 2],
+}
+
+#[derive(Serialize)]
+struct UnboundedDoc<'a> {
+    matrix: &'a str,
+    row: usize,
+    column: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    noise: Option<usize>,
+    expr: &'a str,
+    range: [f64; 2],
+}
+
+#[derive(Serialize)]
+struct Doc<'a> {
+    model: &'a str,
+    doc: Option<&'a str>,
+    constants: Vec<Value>,
+    states: Vec<Value>,
+    inputs: Vec<Value>,
+    noise: Vec<&'a str>,
+    initial_balls: Vec<Value>,
+    domain_given: bool,
+    time_range: [f64; 2],
+    drift: Vec<&'a str>,
+    diffusion: Vec<Vec<&'a str>>,
+    jacobian_x: Vec<Vec<&'a str>>,
+    jacobian_u: Vec<Vec<&'a str>>,
+    jacobian_g: Vec<GradDoc<'a>>,
+    bounds: HashMap<&'a str, Vec<Vec<[f64; 2]>>>,
+    atoms: HashMap<&'a str, SplitDoc<'a>>,
+    unbounded: Vec<UnboundedDoc<'a>>,
+    #[serde(rename = "unsafe")]
+    unsafe_sets: Vec<Value>,
+    analyses: Vec<Value>,
 }
 
 fn bounds_json(b: Option<Bounds>) -> Value {
     b.map_or(Value::Null, |b| json!([b.lo, b.hi]))
 }
 
-fn atoms_json(model: &Model, split: &AtomSplit, time: Interval) -> Value {
-    let exprs: Vec<ExprId> = split.atoms.iter().map(|a| a.expr).collect();
-    let ranges = eval_box(model, &exprs, time);
-    let atoms: Vec<Value> = split
-        .atoms
-        .iter()
-        .zip(&ranges)
-        .map(
-            |(a, r)| json!({ "expr": sde(model, a.expr), "range": ends(*r), "entries": a.entries }),
-        )
-        .collect();
-    json!({ "constant": split.constant, "atoms": atoms })
-}
-
-/// The `inspect --json` document (schema in docs/language.md).
-pub fn json(model: &mut Model) -> String {
+/// Writes the `inspect --json` document (schema in docs/language.md).
+pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     let r = report(model);
     let model = &*model;
-    let mut doc = json!({
-        "model": model.name,
-        "doc": model.doc,
-        "constants": model.constants.iter().map(|(n, v)| json!({"name": n, "value": v})).collect::<Vec<_>>(),
-        "states": model.states.iter().zip(&model.domain).map(|(s, d)| json!({
-            "name": s.name, "initial": bounds_json(s.bounds), "domain": [d.lo, d.hi],
-        })).collect::<Vec<_>>(),
-        "inputs": model.inputs.iter().map(|u| json!({"name": u.name, "range": bounds_json(u.bounds)})).collect::<Vec<_>>(),
-        "noise": model.noises.iter().map(|w| w.name.clone()).collect::<Vec<_>>(),
-        "initial_balls": model.initial.balls.iter().map(|b| json!({
-            "over": b.states.iter().map(|&i| model.states[i].name.clone()).collect::<Vec<_>>(),
-            "center": b.center, "radius": b.radius, "metric": b.metric,
-        })).collect::<Vec<_>>(),
-        "domain_given": model.has_domain,
-        "time_range": ends(r.time),
-        "drift": model.drift.iter().map(|&e| sde(model, e)).collect::<Vec<_>>(),
-        "unsafe": model.unsafe_sets.iter().map(|u| unsafe_json(model, u)).collect::<Vec<_>>(),
-        "analyses": model.analyses.iter().map(|a| json!({
-            "name": a.name, "method": format!("{:?}", a.method).to_lowercase(), "delta": a.delta,
-            "horizon": a.horizon, "step": a.step,
-        })).collect::<Vec<_>>(),
-    });
-    let mut bounds = serde_json::Map::new();
-    let mut atoms = serde_json::Map::new();
+    let grid = |rows: &[Vec<ExprId>]| -> Vec<Vec<&str>> {
+        rows.iter()
+            .map(|row| row.iter().map(|&e| r.sde(e)).collect())
+            .collect()
+    };
     let mut unbounded = Vec::new();
     for m in &r.matrices {
-        let exprs: Vec<Vec<String>> = m
-            .rows
-            .iter()
-            .map(|row| row.iter().map(|&e| sde(model, e)).collect())
-            .collect();
-        doc[m.key] = json!(exprs);
-        bounds.insert(
-            m.key.into(),
-            json!(m
-                .bounds
-                .iter()
-                .map(|row| row.iter().map(|i| ends(*i)).collect::<Vec<_>>())
-                .collect::<Vec<_>>()),
-        );
-        if m.key != "jacobian_g" {
-            atoms.insert(
-                m.key.into(),
-                atoms_json(model, &split_atoms(&model.pool, &m.rows), r.time),
-            );
-        }
         for (i, row) in m.bounds.iter().enumerate() {
             for (j, b) in row.iter().enumerate().filter(|(_, b)| !b.is_bounded()) {
-                unbounded.push(json!({
-                    "matrix": m.key, "row": i, "column": j, "row_name": m.row_names[i],
-                    "column_name": m.col_names[j], "expr": exprs[i][j], "range": ends(*b),
-                }));
+                unbounded.push(UnboundedDoc {
+                    matrix: m.key,
+                    row: i,
+                    column: j,
+                    noise: None,
+                    expr: r.sde(m.rows[i][j]),
+                    range: ends(*b),
+                });
             }
         }
     }
-    doc["jacobian_g"] = json!(doc["jacobian_g"].as_array().map(|rows| rows
-        .chunks(model.noises.len().max(1))
-        .map(|c| json!(c))
-        .collect::<Vec<_>>()));
-    doc["bounds"] = Value::Object(bounds);
-    doc["atoms"] = Value::Object(atoms);
-    doc["unbounded"] = json!(unbounded);
-    let mut s = serde_json::to_string_pretty(&doc).expect("JSON values always serialise");
-    s.push('\n');
-    s
+    for (g, b) in r.jac_g.iter().filter(|(_, b)| !b.is_bounded()) {
+        unbounded.push(UnboundedDoc {
+            matrix: "jacobian_g",
+            row: g.row,
+            column: g.state,
+            noise: Some(g.noise),
+            expr: r.sde(g.expr),
+            range: ends(*b),
+        });
+    }
+    let doc = Doc {
+        model: &model.name,
+        doc: model.doc.as_deref(),
+        constants: model.constants.iter().map(|(n, v)| json!({"name": n, "value": v})).collect(),
+        states: model
+            .states
+            .iter()
+            .zip(&model.domain)
+            .map(|(s, d)| json!({"name": s.name, "initial": bounds_json(s.bounds), "domain": [d.lo, d.hi]}))
+            .collect(),
+        inputs: model.inputs.iter().map(|u| json!({"name": u.name, "range": bounds_json(u.bounds)})).collect(),
+        noise: model.noises.iter().map(|w| w.name.as_str()).collect(),
+        initial_balls: model
+            .initial
+            .balls
+            .iter()
+            .map(|b| {
+                let over: Vec<&str> = b.states.iter().map(|&i| model.states[i].name.as_str()).collect();
+                json!({"over": over, "center": b.center, "radius": b.radius, "metric": b.metric})
+            })
+            .collect(),
+        domain_given: model.has_domain,
+        time_range: ends(r.time),
+        drift: model.drift.iter().map(|&e| r.sde(e)).collect(),
+        diffusion: grid(&r.matrices[0].rows),
+        jacobian_x: grid(&r.matrices[1].rows),
+        jacobian_u: grid(&r.matrices[2].rows),
+        jacobian_g: r
+            .jac_g
+            .iter()
+            .map(|(g, b)| GradDoc { row: g.row, noise: g.noise, column: g.state, expr: r.sde(g.expr), range: ends(*b) })
+            .collect(),
+        bounds: r
+            .matrices
+            .iter()
+            .map(|m| (m.key, m.bounds.iter().map(|row| row.iter().map(|b| ends(*b)).collect()).collect()))
+            .collect(),
+        atoms: r
+            .matrices
+            .iter()
+            .map(|m| {
+                let atoms = m
+                    .atoms
+                    .atoms
+                    .iter()
+                    .zip(&m.atom_ranges)
+                    .map(|(a, range)| AtomDoc { expr: r.sde(a.expr), range: ends(*range), entries: &a.entries })
+                    .collect();
+                (m.key, SplitDoc { constant: &m.atoms.constant, atoms })
+            })
+            .collect(),
+        unbounded,
+        unsafe_sets: model.unsafe_sets.iter().map(|u| unsafe_json(model, u)).collect(),
+        analyses: model
+            .analyses
+            .iter()
+            .map(|a| {
+                json!({"name": a.name, "method": format!("{:?}", a.method).to_lowercase(),
+                       "delta": a.delta, "horizon": a.horizon, "step": a.step})
+            })
+            .collect(),
+    };
+    // Compact: dense Jacobians of large models are millions of entries (pipe through `jq` to read).
+    serde_json::to_writer(&mut *out, &doc)?;
+    writeln!(out)
 }
 
 fn unsafe_json(model: &Model, u: &crate::model::UnsafeSet) -> Value {
@@ -211,8 +319,8 @@ fn fmt_bounds(b: Bounds) -> String {
     format!("[{}, {}]", b.lo, b.hi)
 }
 
-/// The human-readable report.
-pub fn text(model: &mut Model) -> String {
+/// Writes the human-readable report.
+pub fn text(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     let r = report(model);
     let model = &*model;
     let mut o = String::new();
@@ -224,10 +332,8 @@ pub fn text(model: &mut Model) -> String {
         model.inputs.len(),
         model.noises.len()
     );
-    if let Some(doc) = &model.doc {
-        for line in doc.lines() {
-            let _ = writeln!(o, "  /// {line}");
-        }
+    for line in model.doc.iter().flat_map(|d| d.lines()) {
+        let _ = writeln!(o, "  /// {line}");
     }
     let _ = writeln!(o, "\nstates (initial set; domain):");
     for (s, d) in model.states.iter().zip(&model.domain) {
@@ -242,17 +348,17 @@ pub fn text(model: &mut Model) -> String {
             .iter()
             .map(|&i| model.states[i].name.as_str())
             .collect();
+        let metric = if b.metric.is_some() {
+            ", with metric"
+        } else {
+            ""
+        };
         let _ = writeln!(
             o,
-            "  ball over [{}]: center {:?}, radius {}{}",
+            "  ball over [{}]: center {:?}, radius {}{metric}",
             over.join(", "),
             b.center,
-            b.radius,
-            if b.metric.is_some() {
-                ", with metric"
-            } else {
-                ""
-            }
+            b.radius
         );
     }
     if !model.inputs.is_empty() {
@@ -267,12 +373,12 @@ pub fn text(model: &mut Model) -> String {
         }
     }
     if !model.noises.is_empty() {
-        let names: Vec<&str> = model.noises.iter().map(|w| w.name.as_str()).collect();
-        let _ = writeln!(o, "\nnoise: {}", names.join(", "));
+        let ws: Vec<&str> = model.noises.iter().map(|w| w.name.as_str()).collect();
+        let _ = writeln!(o, "\nnoise: {}", ws.join(", "));
     }
     let _ = writeln!(o, "\ndrift (simplified):");
     for (s, &f) in model.states.iter().zip(&model.drift) {
-        let _ = writeln!(o, "  {}' = {}", s.name, sde(model, f));
+        let _ = writeln!(o, "  {}' = {}", s.name, r.sde(f));
     }
     let _ = writeln!(
         o,
@@ -285,58 +391,63 @@ pub fn text(model: &mut Model) -> String {
         let _ = writeln!(o, "\n{} (non-zero entries):", m.title);
         let mut any = false;
         for (i, row) in m.rows.iter().enumerate() {
-            for (j, &e) in row.iter().enumerate() {
-                if model.pool.as_const(e) == Some(0.0) {
-                    continue;
-                }
+            for (j, &e) in row
+                .iter()
+                .enumerate()
+                .filter(|(_, &e)| model.pool.as_const(e) != Some(0.0))
+            {
                 any = true;
                 let b = m.bounds[i][j];
-                let _ = writeln!(
-                    o,
-                    "  [{}, {}] = {}    in {}",
-                    m.row_names[i],
-                    m.col_names[j],
-                    sde(model, e),
-                    b
-                );
+                let entry = format!("[{}, {}] = {}", m.row_names[i], m.col_names[j], r.sde(e));
+                let _ = writeln!(o, "  {entry}    in {b}");
                 if !b.is_bounded() {
-                    unbounded.push(format!(
-                        "{} [{}, {}] = {}",
-                        m.key,
-                        m.row_names[i],
-                        m.col_names[j],
-                        sde(model, e)
-                    ));
+                    unbounded.push(format!("{} {entry}", m.key));
                 }
             }
         }
         if !any {
             let _ = writeln!(o, "  (all zero)");
+            continue;
         }
-        if m.key != "jacobian_g" && any {
-            let split = split_atoms(&model.pool, &m.rows);
-            let exprs: Vec<ExprId> = split.atoms.iter().map(|a| a.expr).collect();
-            let ranges = eval_box(model, &exprs, r.time);
+        let _ = writeln!(
+            o,
+            "  atoms: {} (matrix = constant part + sum of atom * coefficient)",
+            m.atoms.atoms.len()
+        );
+        for (k, (a, range)) in m.atoms.atoms.iter().zip(&m.atom_ranges).enumerate() {
+            let at: Vec<String> = a
+                .entries
+                .iter()
+                .map(|(i, j, c)| format!("[{}, {}]*{c}", m.row_names[*i], m.col_names[*j]))
+                .collect();
             let _ = writeln!(
                 o,
-                "  atoms: {} (constant part plus atom x coefficient matrix)",
-                split.atoms.len()
+                "    a{} = {}    in {}    at {}",
+                k + 1,
+                r.sde(a.expr),
+                range,
+                at.join(", ")
             );
-            for (k, (a, range)) in split.atoms.iter().zip(&ranges).enumerate() {
-                let entries: Vec<String> = a
-                    .entries
-                    .iter()
-                    .map(|(i, j, c)| format!("[{}, {}]*{c}", m.row_names[*i], m.col_names[*j]))
-                    .collect();
-                let _ = writeln!(
-                    o,
-                    "    a{} = {}    in {}    at {}",
-                    k + 1,
-                    sde(model, a.expr),
-                    range,
-                    entries.join(", ")
-                );
-            }
+        }
+    }
+    let _ = writeln!(
+        o,
+        "\nJacobian D_x G (non-zero entries d G[state, noise] / d state):"
+    );
+    if r.jac_g.is_empty() {
+        let _ = writeln!(o, "  (all zero: additive noise)");
+    }
+    for (g, b) in &r.jac_g {
+        let entry = format!(
+            "d G[{}, {}] / d {} = {}",
+            model.states[g.row].name,
+            model.noises[g.noise].name,
+            model.states[g.state].name,
+            r.sde(g.expr)
+        );
+        let _ = writeln!(o, "  {entry}    in {b}");
+        if !b.is_bounded() {
+            unbounded.push(format!("jacobian_g {entry}"));
         }
     }
     let _ = writeln!(o);
@@ -353,5 +464,5 @@ pub fn text(model: &mut Model) -> String {
         }
         let _ = writeln!(o, "help: add a `domain {{ x in [LO, HI] }}` block to bound the states these entries depend on");
     }
-    o
+    out.write_all(o.as_bytes())
 }

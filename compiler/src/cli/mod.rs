@@ -75,15 +75,20 @@ fn run(command: Command) -> Result<(), u8> {
         }
         Command::Inspect { spec, json } => {
             let mut loaded = load_reporting(&spec)?;
-            let text = if json {
-                inspect::json(&mut loaded.model)
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            let written = if json {
+                inspect::json(&mut loaded.model, &mut out)
             } else {
-                inspect::text(&mut loaded.model)
+                inspect::text(&mut loaded.model, &mut out)
             };
-            let mut out = std::io::stdout().lock();
-            // A closed pipe (`| head`) is not an error worth a panic.
-            let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
-            Ok(())
+            // A closed pipe (`| head`) is not worth a panic or an error message.
+            match written.and_then(|()| out.flush()) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                    eprintln!("error: writing the report: {e}");
+                    Err(EXIT_USAGE)
+                }
+                _ => Ok(()),
+            }
         }
     }
 }

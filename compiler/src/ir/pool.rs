@@ -1,7 +1,9 @@
 //! The hash-consed expression pool. Its constructors simplify, so every stored node is in the
 //! canonical form documented on [`Node`].
 
-use std::collections::{HashMap, HashSet};
+// Fx hashing: ids and nodes are small keys hashed millions of times on large models, and
+// hash-flooding is no concern for a compiler's own data.
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use super::eval::Arith;
 use super::node::{ExprId, Func1, Func2, Node, Var, F64};
@@ -425,7 +427,7 @@ impl Pool {
     /// Ids of the nodes reachable from `roots` for which `skip` is false (not descending into
     /// skipped nodes), in increasing order. Iterative: DAG depth is not bounded by the parser.
     pub(super) fn collect(&self, roots: &[ExprId], skip: impl Fn(ExprId) -> bool) -> Vec<ExprId> {
-        let mut seen: HashSet<ExprId> = HashSet::new();
+        let mut seen: HashSet<ExprId> = HashSet::default();
         let mut stack: Vec<ExprId> = Vec::new();
         for &r in roots {
             if !skip(r) && seen.insert(r) {
@@ -457,6 +459,12 @@ impl Pool {
 
     /// The variables `e` depends on, sorted and deduplicated.
     pub fn vars_of(&self, e: ExprId) -> Vec<Var> {
+        // Leaves are most entries of large sparse Jacobians and diffusion matrices.
+        match self.node(e) {
+            Node::Const(_) => return Vec::new(),
+            Node::Var(v) => return vec![*v],
+            _ => {}
+        }
         let mut vars: Vec<Var> = self
             .reachable(&[e])
             .into_iter()
@@ -479,7 +487,7 @@ impl Pool {
         if vid > e {
             return false; // children have smaller ids
         }
-        let mut seen: HashSet<ExprId> = HashSet::new();
+        let mut seen: HashSet<ExprId> = HashSet::default();
         let mut stack = vec![e];
         while let Some(id) = stack.pop() {
             if id == vid {
@@ -499,7 +507,8 @@ impl Pool {
     /// sub-expressions keep their ids.
     pub fn substitute(&mut self, e: ExprId, f: &mut dyn FnMut(Var) -> Option<ExprId>) -> ExprId {
         let order = self.reachable(&[e]);
-        let mut map: HashMap<ExprId, ExprId> = HashMap::with_capacity(order.len());
+        let mut map: HashMap<ExprId, ExprId> =
+            HashMap::with_capacity_and_hasher(order.len(), Default::default());
         for id in order {
             let node = self.node(id).clone();
             let m = |c: ExprId| map[&c];

@@ -157,7 +157,6 @@ impl Checker<'_> {
         }
         match id.name.as_str() {
             "pi" => return Some(self.pool.num(std::f64::consts::PI)),
-            "e" => return Some(self.pool.num(std::f64::consts::E)),
             "t" => {
                 return if allow == Allow::Constants {
                     self.not_constant(id, "time")
@@ -168,6 +167,10 @@ impl Checker<'_> {
             _ => {}
         }
         let Some((sym, def)) = self.scope.get(&id.name).cloned() else {
+            // Euler's number, unless the spec defines its own `e` (a common name for an error).
+            if id.name == "e" {
+                return Some(self.pool.num(std::f64::consts::E));
+            }
             return self.undefined(id);
         };
         match sym {

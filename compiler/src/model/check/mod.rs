@@ -135,7 +135,7 @@ impl Checker<'_> {
                     name.span.clone(),
                     "choose another name",
                 )
-                .with_note("built-in names: t (time), pi, e, and the function names"),
+                .with_note("built-in names: t (time), pi, and the function names"),
             );
             // Defined anyway, so its uses do not cascade into "undefined" errors.
         }

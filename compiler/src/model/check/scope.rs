@@ -71,8 +71,9 @@ pub(super) struct Scope {
     pub(super) symbols: HashMap<String, (Symbol, Span)>,
 }
 
-/// Names every spec has.
-pub(super) const BUILTIN_NAMES: &[&str] = &["t", "pi", "e"];
+/// Names every spec has and cannot redefine. (`e` is built in too, but a spec may define its
+/// own `e`, which then hides Euler's number.)
+pub(super) const BUILTIN_NAMES: &[&str] = &["t", "pi"];
 
 impl Scope {
     pub(super) fn get(&self, name: &str) -> Option<&(Symbol, Span)> {
