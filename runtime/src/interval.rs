@@ -104,35 +104,11 @@ const SINC_TAIL_MAX: f64 = 0.2228;
 // Rounding primitives
 // ---------------------------------------------------------------------------
 
-/// The least f64 greater than `x` (same semantics as `f64::next_up`, which is
-/// newer than this crate's MSRV).
-#[inline]
-fn next_up(x: f64) -> f64 {
-    if x.is_nan() || x == f64::INFINITY {
-        return x;
-    }
-    if x == 0.0 {
-        return f64::from_bits(1);
-    }
-    let bits = x.to_bits();
-    if x > 0.0 {
-        f64::from_bits(bits + 1)
-    } else {
-        f64::from_bits(bits - 1)
-    }
-}
-
-/// The greatest f64 less than `x` (same semantics as `f64::next_down`).
-#[inline]
-fn next_down(x: f64) -> f64 {
-    -next_up(-x)
-}
-
 /// `n` steps of `next_up`.
 #[inline]
 fn up_n(mut x: f64, n: u32) -> f64 {
     for _ in 0..n {
-        x = next_up(x);
+        x = f64::next_up(x);
     }
     x
 }
@@ -141,7 +117,7 @@ fn up_n(mut x: f64, n: u32) -> f64 {
 #[inline]
 fn down_n(mut x: f64, n: u32) -> f64 {
     for _ in 0..n {
-        x = next_down(x);
+        x = f64::next_down(x);
     }
     x
 }
@@ -185,7 +161,7 @@ fn add_rd(a: f64, b: f64) -> f64 {
     let bb = s - a;
     let e = (a - (s - bb)) + (b - bb);
     if e < 0.0 || !e.is_finite() {
-        next_down(s)
+        f64::next_down(s)
     } else {
         s
     }
@@ -228,12 +204,12 @@ fn mul_rd(a: f64, b: f64) -> f64 {
         // Exact residual a*b - p (representable since no underflow).
         let e = a.mul_add(b, -p);
         if e < 0.0 {
-            next_down(p)
+            f64::next_down(p)
         } else {
             p
         }
     } else {
-        next_down(p)
+        f64::next_down(p)
     }
 }
 
@@ -267,12 +243,12 @@ fn div_rd(a: f64, b: f64) -> f64 {
         let r = (-q).mul_add(b, a);
         let dir = if b > 0.0 { r } else { -r };
         if dir < 0.0 {
-            next_down(q)
+            f64::next_down(q)
         } else {
             q
         }
     } else {
-        next_down(q)
+        f64::next_down(q)
     }
 }
 
@@ -291,12 +267,12 @@ fn sqrt_rd(x: f64) -> f64 {
     if x >= RESIDUAL_SAFE_MIN {
         let r = (-q).mul_add(q, x);
         if r < 0.0 {
-            next_down(q)
+            f64::next_down(q)
         } else {
             q
         }
     } else {
-        next_down(q).max(0.0)
+        f64::next_down(q).max(0.0)
     }
 }
 
@@ -309,12 +285,12 @@ fn sqrt_ru(x: f64) -> f64 {
     if x >= RESIDUAL_SAFE_MIN {
         let r = (-q).mul_add(q, x);
         if r > 0.0 {
-            next_up(q)
+            f64::next_up(q)
         } else {
             q
         }
     } else {
-        next_up(q)
+        f64::next_up(q)
     }
 }
 
@@ -374,8 +350,8 @@ fn quarter_range(a: f64, b: f64) -> (i64, i64) {
     let half_pi = std::f64::consts::FRAC_PI_2;
     let ta = a / half_pi;
     let tb = b / half_pi;
-    let lower = next_down(ta - ta.abs() * REDUCTION_MARGIN);
-    let upper = next_up(tb + tb.abs() * REDUCTION_MARGIN);
+    let lower = f64::next_down(ta - ta.abs() * REDUCTION_MARGIN);
+    let upper = f64::next_up(tb + tb.abs() * REDUCTION_MARGIN);
     (lower.ceil() as i64, upper.floor() as i64)
 }
 
@@ -406,7 +382,7 @@ impl Interval {
     pub const ONE: Interval = Interval { lo: 1.0, hi: 1.0 };
     /// `[-1, 1]`, the range of `sin` and `cos`.
     const UNIT: Interval = Interval { lo: -1.0, hi: 1.0 };
-    /// A tight enclosure of pi: `[PI, next_up(PI)]` (the f64 constant `PI`
+    /// A tight enclosure of pi: `[PI, f64::next_up(PI)]` (the f64 constant `PI`
     /// is below the real pi).
     pub const PI: Interval = Interval {
         lo: std::f64::consts::PI,

@@ -215,19 +215,6 @@ impl Arith for f64 {
     }
 }
 
-/// Smallest f64 above `x` (for rounding bounds up; `f64::next_up` needs Rust 1.86).
-fn next_up(x: f64) -> f64 {
-    if x.is_nan() || x == f64::INFINITY {
-        x
-    } else if x == 0.0 {
-        f64::from_bits(1)
-    } else if x > 0.0 {
-        f64::from_bits(x.to_bits() + 1)
-    } else {
-        f64::from_bits(x.to_bits() - 1)
-    }
-}
-
 /// `max |sinc'|` over R is 0.436181817... (at x ~ 2.0816), rounded up.
 const DSINC_MAX: f64 = 0.4362;
 /// `sinc' <= 0` on `[0, 4.4934...]` (the first positive zero, where `tan x = x`), rounded down.
@@ -239,10 +226,10 @@ const DSINC_NEG_END: f64 = 4.49;
 /// interval evaluation of `(x cos x - sin x)/x^2`.
 fn dsinc_interval(x: Interval) -> Interval {
     let (mig, mag) = (x.mig(), x.mag());
-    let mut b = DSINC_MAX.min(next_up(mag / 3.0));
+    let mut b = DSINC_MAX.min(f64::next_up(mag / 3.0));
     if mig > 0.0 {
-        let r = next_up(1.0 / mig);
-        b = b.min(next_up(r + next_up(r * r)));
+        let r = f64::next_up(1.0 / mig);
+        b = b.min(f64::next_up(r + f64::next_up(r * r)));
     }
     let (mut lo, mut hi) = (-b, b);
     if x.lo() >= 0.0 && x.hi() <= DSINC_NEG_END {

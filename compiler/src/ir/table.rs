@@ -16,23 +16,6 @@ pub struct Table {
     pub values: Vec<Vec<f64>>,
 }
 
-/// Bits of `f64` arithmetic: smallest f64 above / below (`f64::next_up` needs Rust 1.86).
-fn next_up(x: f64) -> f64 {
-    if x.is_nan() || x == f64::INFINITY {
-        x
-    } else if x == 0.0 {
-        f64::from_bits(1)
-    } else if x > 0.0 {
-        f64::from_bits(x.to_bits() + 1)
-    } else {
-        f64::from_bits(x.to_bits() - 1)
-    }
-}
-
-fn next_down(x: f64) -> f64 {
-    -next_up(-x)
-}
-
 impl Table {
     /// The index of the column called `name`.
     pub fn column_index(&self, name: &str) -> Option<usize> {
@@ -97,8 +80,8 @@ impl Table {
         let (v0, v1) = (vs[i], vs[i + 1]);
         let c = self.interp(column, i, t);
         let err = 8.0 * f64::EPSILON * (v0.abs() + v1.abs()) + 1e-300;
-        let lo = next_down(c - err).max(v0.min(v1));
-        let hi = next_up(c + err).min(v0.max(v1));
+        let lo = f64::next_down(c - err).max(v0.min(v1));
+        let hi = f64::next_up(c + err).min(v0.max(v1));
         (lo, hi)
     }
 
