@@ -6,9 +6,12 @@
 //! See `ARCHITECTURE.md` at the repository root for the map.
 
 pub mod analysis;
+pub mod backend;
 pub mod cli;
+pub mod config;
 pub mod diagnostics;
 pub mod driver;
 pub mod ir;
 pub mod model;
 pub mod syntax;
+pub use config::Config;

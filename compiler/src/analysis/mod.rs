@@ -3,8 +3,15 @@
 
 mod atoms;
 mod bounds;
+mod contraction;
 mod derivatives;
+mod metric;
+mod psd;
+#[cfg(feature = "sdp")]
+pub mod sdp;
 
 pub use atoms::{split_atoms, Atom, AtomSplit};
 pub use bounds::{bound_matrix, eval_box, time_range};
+pub use contraction::{constants, ConstantsError, MAX_SIGN_INPUTS, MAX_VERTEX_ATOMS};
 pub use derivatives::{Derivatives, GradEntry};
+pub use metric::{synthesize_metric, FULL_METRIC_MAX_DIM};

@@ -1,6 +1,8 @@
 //! The `reachc` command line. Exit codes: 0 ok, 1 spec errors, 2 usage or I/O errors.
 
+mod build;
 pub mod inspect;
+mod run;
 
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -36,6 +38,34 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Generate a Rust crate for a spec and compile it with cargo.
+    Build {
+        /// The .sde spec.
+        spec: PathBuf,
+        /// The crate's directory (default: ./<crate name>); replaced if it holds an older one.
+        #[arg(short, long)]
+        out: Option<PathBuf>,
+        /// Only write the crate; do not run cargo.
+        #[arg(long)]
+        no_compile: bool,
+        /// Compile with optimisations (cargo build --release).
+        #[arg(long)]
+        release: bool,
+    },
+    /// Compute the spec's delta-PRS analyses: print summaries, write JSON and CSV results.
+    Run {
+        /// The .sde spec.
+        spec: PathBuf,
+        /// Run only this analysis (default: all).
+        #[arg(long)]
+        analysis: Option<String>,
+        /// Generated and compiled code, or the IR interpreter (no cargo needed).
+        #[arg(long, value_enum, default_value = "compiled")]
+        backend: run::Backend,
+        /// Directory for <analysis>.json and <analysis>.csv (default: reachc-out).
+        #[arg(short, long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// Exit code for spec errors.
@@ -61,6 +91,18 @@ pub fn main() -> ExitCode {
 
 fn run(command: Command) -> Result<(), u8> {
     match command {
+        Command::Build {
+            spec,
+            out,
+            no_compile,
+            release,
+        } => build::run_build(&spec, out, no_compile, release),
+        Command::Run {
+            spec,
+            analysis,
+            backend,
+            out,
+        } => run::run_spec(&spec, analysis, backend, out),
         Command::Check { spec } => {
             let loaded = load_reporting(&spec)?;
             println!(

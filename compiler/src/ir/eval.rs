@@ -1,6 +1,7 @@
 //! Evaluation of expressions in any [`Arith`]: `f64` for point values, [`Interval`] for sound
 //! enclosures.
 
+use reachc_runtime::func;
 use reachc_runtime::interval::Interval;
 
 use super::node::{ExprId, Func1, Func2, Node, Var};
@@ -126,39 +127,6 @@ impl Pool {
     }
 }
 
-/// `sin(x)/x`, 1 at 0.
-pub(crate) fn sinc_f64(x: f64) -> f64 {
-    if x == 0.0 {
-        1.0
-    } else {
-        x.sin() / x
-    }
-}
-
-/// `sinc'(x) = (x cos x - sin x)/x^2`, 0 at 0. A Taylor series near 0, where the quotient
-/// cancels catastrophically.
-pub(crate) fn dsinc_f64(x: f64) -> f64 {
-    if x.abs() < 0.1 {
-        // -x/3 + x^3/30 - x^5/840 + x^7/45360 - x^9/3991680; next term < 1e-19 relative.
-        let x2 = x * x;
-        x * (-1.0 / 3.0
-            + x2 * (1.0 / 30.0 + x2 * (-1.0 / 840.0 + x2 * (1.0 / 45360.0 - x2 / 3991680.0))))
-    } else {
-        (x * x.cos() - x.sin()) / (x * x)
-    }
-}
-
-/// -1, 0 or 1 (NaN stays NaN); unlike `f64::signum`, `sign(0) = 0`.
-pub(crate) fn sign_f64(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        x * 0.0 // 0 for +-0, NaN for NaN
-    }
-}
-
 impl Arith for f64 {
     fn constant(v: f64) -> Self {
         v
@@ -197,9 +165,9 @@ impl Arith for f64 {
             Func1::Sinh => self.sinh(),
             Func1::Cosh => self.cosh(),
             Func1::Tanh => self.tanh(),
-            Func1::Sinc => sinc_f64(self),
-            Func1::Sign => sign_f64(self),
-            Func1::DSinc => dsinc_f64(self),
+            Func1::Sinc => func::sinc(self),
+            Func1::Sign => func::sign(self),
+            Func1::DSinc => func::dsinc(self),
         }
     }
     fn call2(self, f: Func2, o: Self) -> Self {
@@ -213,37 +181,6 @@ impl Arith for f64 {
     fn table(table: &Table, column: usize, at: Self) -> Self {
         table.eval_f64(column, at)
     }
-}
-
-/// `max |sinc'|` over R is 0.436181817... (at x ~ 2.0816), rounded up.
-const DSINC_MAX: f64 = 0.4362;
-/// `sinc' <= 0` on `[0, 4.4934...]` (the first positive zero, where `tan x = x`), rounded down.
-const DSINC_NEG_END: f64 = 4.49;
-
-/// Encloses `sinc'` over `x`. Envelope: `|sinc'(x)| <= min(|x|/3, 0.4362, 1/|x| + 1/x^2)` (from
-/// `|sin x - x cos x| <= |x|^3/3`, whose derivative is `x sin x`, and `<= 1 + |x|`), signed
-/// on `[-4.49, 4.49]` (`sinc'` is odd, `<= 0` on `[0, 4.49]`); away from 0 intersected with the
-/// interval evaluation of `(x cos x - sin x)/x^2`.
-fn dsinc_interval(x: Interval) -> Interval {
-    let (mig, mag) = (x.mig(), x.mag());
-    let mut b = DSINC_MAX.min(f64::next_up(mag / 3.0));
-    if mig > 0.0 {
-        let r = f64::next_up(1.0 / mig);
-        b = b.min(f64::next_up(r + f64::next_up(r * r)));
-    }
-    let (mut lo, mut hi) = (-b, b);
-    if x.lo() >= 0.0 && x.hi() <= DSINC_NEG_END {
-        hi = 0.0;
-    }
-    if x.hi() <= 0.0 && x.lo() >= -DSINC_NEG_END {
-        lo = 0.0;
-    }
-    let envelope = Interval::new(lo, hi);
-    if x.contains_zero() {
-        return envelope;
-    }
-    let q = (x * x.cos() - x.sin()) / x.sqr();
-    q.intersect(envelope).unwrap_or(envelope)
 }
 
 impl Arith for Interval {
@@ -286,7 +223,7 @@ impl Arith for Interval {
             Func1::Tanh => self.tanh(),
             Func1::Sinc => self.sinc(),
             Func1::Sign => self.sign(),
-            Func1::DSinc => dsinc_interval(self),
+            Func1::DSinc => func::dsinc_interval(self),
         }
     }
     fn call2(self, f: Func2, o: Self) -> Self {
@@ -472,27 +409,5 @@ mod tests {
                 }
             }
         }
-    }
-
-    #[test]
-    fn dsinc_enclosure() {
-        let mut rng = Rng(99);
-        for _ in 0..2000 {
-            let c = rng.range(-12.0, 12.0);
-            let r = rng.range(0.0, 3.0) * rng.next_f64();
-            let x = Interval::new(c - r, c + r);
-            let enc = dsinc_interval(x);
-            for k in 0..=20 {
-                let v = c - r + 2.0 * r * (k as f64) / 20.0;
-                assert!(
-                    enc.contains(dsinc_f64(v)),
-                    "{v} in {x}: {} not in {enc}",
-                    dsinc_f64(v)
-                );
-            }
-        }
-        assert!(dsinc_interval(Interval::ENTIRE).contains(0.43));
-        assert!(dsinc_interval(Interval::new(-1e-3, 1e-3)).hi() < 4e-4);
-        assert_eq!(dsinc_interval(Interval::ZERO), Interval::ZERO);
     }
 }

@@ -1,0 +1,212 @@
+//! What every backend needs: the Jacobians and the runtime's [`ModelInfo`], with the constants
+//! of Assumption 1 derived (and certified) for each analysis.
+
+use reachc_runtime::system::{self as rt, ModelInfo};
+
+use crate::analysis::{constants, synthesize_metric, ConstantsError, Derivatives};
+use crate::diagnostics::Diagnostic;
+use crate::ir::Names;
+use crate::model::{self, Bounds, Model};
+
+/// A model ready for code generation or interpretation.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// The Jacobians (their expressions live in the model's pool).
+    pub derivatives: Derivatives,
+    /// Sets, analyses and derived constants, as the runtime consumes them.
+    pub info: ModelInfo,
+    /// Warnings, e.g. an analysis whose constants are unbounded (it cannot run; the model can
+    /// still be built).
+    pub warnings: Vec<Diagnostic>,
+}
+
+fn range(b: Bounds) -> rt::Range {
+    (b.lo, b.hi)
+}
+
+/// Differentiates the model and derives each analysis' constants.
+///
+/// An analysis whose constants cannot be bounded (an unbounded Jacobian entry over the domain)
+/// gets `constants: None` with the reason, and a warning naming the entry; running it is then
+/// an error, but the rest of the model is still usable.
+pub fn prepare(model: &mut Model) -> Prepared {
+    let derivatives = Derivatives::of(model);
+    let n = model.states.len();
+    let mut warnings = Vec::new();
+    let mut analyses = Vec::new();
+    for a in &model.analyses {
+        let metric = match &a.metric {
+            model::Metric::Identity => Ok(identity(n)),
+            model::Metric::Matrix(m) => Ok(m.iter().flatten().copied().collect()),
+            model::Metric::Auto => synthesize_metric(model, &derivatives),
+        };
+        let derived = metric.and_then(|p| constants(model, &derivatives, &p));
+        let (constants, constants_error) = match derived {
+            Ok(c) => (Some(c), None),
+            Err(e) => {
+                let (message, help) = explain(model, &derivatives, &e);
+                warnings.push(
+                    Diagnostic::warning(
+                        format!("analysis `{}` cannot run: {message}", a.name),
+                        a.span.clone(),
+                        "its constants are unbounded",
+                    )
+                    .with_help(help),
+                );
+                (None, Some(message))
+            }
+        };
+        analyses.push(rt::Analysis {
+            name: a.name.clone(),
+            method: match a.method {
+                model::Method::Contraction => rt::Method::Contraction,
+                model::Method::Interval => rt::Method::Interval,
+            },
+            delta: a.delta,
+            horizon: a.horizon,
+            step: a.step,
+            radius: match a.radius {
+                model::RadiusRule::Amgf => rt::RadiusRule::Amgf,
+                model::RadiusRule::Paper(Some(eps)) => rt::RadiusRule::Paper(eps),
+                model::RadiusRule::Paper(None) => rt::RadiusRule::PaperOptimal,
+            },
+            integrator: match a.integrator {
+                model::Integrator::Rk4 => rt::Integrator::Rk4,
+                model::Integrator::Euler => rt::Integrator::Euler,
+            },
+            outputs: a.outputs.clone(),
+            constants,
+            constants_error,
+        });
+    }
+    let info = ModelInfo {
+        name: model.name.clone(),
+        states: model.states.iter().map(|s| s.name.clone()).collect(),
+        inputs: model.inputs.iter().map(|u| u.name.clone()).collect(),
+        noises: model.noises.iter().map(|w| w.name.clone()).collect(),
+        input_box: model
+            .inputs
+            .iter()
+            .map(|u| range(u.bounds.unwrap_or(Bounds::ENTIRE)))
+            .collect(),
+        initial: rt::InitialSet {
+            boxes: model.states.iter().map(|s| s.bounds.map(range)).collect(),
+            balls: model
+                .initial
+                .balls
+                .iter()
+                .map(|b| rt::InitialBall {
+                    states: b.states.clone(),
+                    center: b.center.clone(),
+                    radius: b.radius,
+                    metric: b
+                        .metric
+                        .as_ref()
+                        .map(|m| m.iter().flatten().copied().collect()),
+                })
+                .collect(),
+        },
+        domain: model.domain.iter().map(|&b| range(b)).collect(),
+        has_domain: model.has_domain,
+        unsafe_sets: model
+            .unsafe_sets
+            .iter()
+            .map(|u| rt::UnsafeSet {
+                name: u.name.clone(),
+                shape: match &u.shape {
+                    model::UnsafeShape::Box(sides) => {
+                        rt::UnsafeShape::Box(sides.iter().map(|&(i, b)| (i, range(b))).collect())
+                    }
+                    model::UnsafeShape::Ball {
+                        states,
+                        center,
+                        radius,
+                    } => rt::UnsafeShape::Ball {
+                        states: states.clone(),
+                        center: center.clone(),
+                        radius: *radius,
+                    },
+                    model::UnsafeShape::HalfSpace { normal, offset } => {
+                        rt::UnsafeShape::HalfSpace {
+                            normal: normal.clone(),
+                            offset: *offset,
+                        }
+                    }
+                },
+            })
+            .collect(),
+        analyses,
+    };
+    Prepared {
+        derivatives,
+        info,
+        warnings,
+    }
+}
+
+fn identity(n: usize) -> Vec<f64> {
+    (0..n * n)
+        .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
+        .collect()
+}
+
+/// The message and help for a constants error, naming the offending entry.
+fn explain(model: &Model, d: &Derivatives, e: &ConstantsError) -> (String, String) {
+    let ConstantsError::Unbounded {
+        matrix,
+        row,
+        column,
+    } = *e
+    else {
+        return (e.to_string(), "check the analysis' metric".to_string());
+    };
+    let names = |v: &[model::Variable]| v.iter().map(|x| x.name.clone()).collect::<Vec<_>>();
+    let (states, inputs, noises) = (
+        names(&model.states),
+        names(&model.inputs),
+        names(&model.noises),
+    );
+    let sde = Names {
+        states: &states,
+        inputs: &inputs,
+        noises: &noises,
+        tables: &model.tables,
+    };
+    let (what, expr) = match matrix {
+        "D_u f" => (
+            format!("d f[{}] / d {}", states[row], inputs[column]),
+            d.jac_u[row][column],
+        ),
+        "G" => (
+            format!("the diffusion entry G[{}, {}]", states[row], noises[column]),
+            model.diffusion[row][column],
+        ),
+        _ => (
+            format!("d f[{}] / d {}", states[row], states[column]),
+            d.jac_x[row][column],
+        ),
+    };
+    let message = format!(
+        "{what} = {} is unbounded over the domain",
+        model.pool.to_sde(expr, &sde)
+    );
+    let vars: Vec<String> = model
+        .pool
+        .vars_of(expr)
+        .into_iter()
+        .filter_map(|v| match v {
+            crate::ir::Var::State(i) => Some(states[i as usize].clone()),
+            _ => None,
+        })
+        .collect();
+    let help = if vars.is_empty() {
+        "the entry is unbounded in time or in the inputs; bound them".to_string()
+    } else {
+        let example: Vec<String> = vars.iter().map(|v| format!("{v} in [LO, HI]")).collect();
+        format!(
+            "add a domain box for the states it depends on: `domain {{ {} }}`",
+            example.join("  ")
+        )
+    };
+    (message, help)
+}

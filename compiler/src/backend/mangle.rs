@@ -1,0 +1,264 @@
+//! Turning a model name into the Rust identifiers and the Cargo package name of its generated
+//! crate.
+//!
+//! The model's struct is the only spec name that becomes a Rust identifier; everything else
+//! (state, input, table names, doc comments) only appears inside string literals and doc
+//! comments. The results here are always valid: ASCII letters, digits, `_` / `-` only, never
+//! empty, never starting with a digit, never a Rust keyword or a name the generated code (or
+//! Cargo) relies on.
+
+/// Rust keywords (strict, reserved and weak ones that are keywords in some position), lowercase.
+const KEYWORDS: &[&str] = &[
+    "abstract", "as", "async", "await", "become", "box", "break", "const", "continue", "crate",
+    "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if", "impl",
+    "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub", "ref",
+    "return", "self", "static", "struct", "super", "trait", "true", "try", "type", "typeof",
+    "union", "unsafe", "unsized", "use", "virtual", "where", "while", "yield",
+];
+
+/// Type names the generated code refers to unqualified, or that would shadow the prelude: a
+/// model struct with one of these names gets the suffix `Model`.
+const RESERVED_TYPES: &[&str] = &[
+    "Self",
+    "Interval",
+    "System",
+    "ModelInfo",
+    "Option",
+    "Some",
+    "None",
+    "Result",
+    "Ok",
+    "Err",
+    "String",
+    "Vec",
+    "Box",
+    "ToString",
+    "ToOwned",
+    "Clone",
+    "Copy",
+    "Send",
+    "Sync",
+    "Sized",
+    "Unpin",
+    "Drop",
+    "Fn",
+    "FnMut",
+    "FnOnce",
+    "AsyncFn",
+    "AsyncFnMut",
+    "AsyncFnOnce",
+    "Default",
+    "Debug",
+    "Hash",
+    "Iterator",
+    "IntoIterator",
+    "DoubleEndedIterator",
+    "ExactSizeIterator",
+    "Extend",
+    "FromIterator",
+    "AsRef",
+    "AsMut",
+    "Into",
+    "From",
+    "TryFrom",
+    "TryInto",
+    "PartialEq",
+    "Eq",
+    "PartialOrd",
+    "Ord",
+];
+
+/// Package names Cargo rejects (or warns about) besides keywords: its own directory names,
+/// the standard crates and Windows device names.
+const RESERVED_CRATES: &[&str] = &[
+    "build",
+    "deps",
+    "examples",
+    "incremental",
+    "std",
+    "core",
+    "alloc",
+    "proc-macro",
+    "proc_macro",
+    "test",
+    "con",
+    "prn",
+    "aux",
+    "nul",
+    "com1",
+    "com2",
+    "com3",
+    "com4",
+    "com5",
+    "com6",
+    "com7",
+    "com8",
+    "com9",
+    "lpt1",
+    "lpt2",
+    "lpt3",
+    "lpt4",
+    "lpt5",
+    "lpt6",
+    "lpt7",
+    "lpt8",
+    "lpt9",
+    "reachc",
+    "reachc-runtime",
+];
+
+/// Splits a name into ASCII alphanumeric words: at every other character (`_`, `-`, spaces,
+/// non-ASCII, punctuation) and at lower-to-upper case changes (`vanDerPol` -> van, Der, Pol).
+fn words(name: &str) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    let mut cur = String::new();
+    let mut prev_lower_or_digit = false;
+    for ch in name.chars() {
+        if !ch.is_ascii_alphanumeric() {
+            if !cur.is_empty() {
+                out.push(std::mem::take(&mut cur));
+            }
+            prev_lower_or_digit = false;
+            continue;
+        }
+        if ch.is_ascii_uppercase() && prev_lower_or_digit && !cur.is_empty() {
+            out.push(std::mem::take(&mut cur));
+        }
+        prev_lower_or_digit = ch.is_ascii_lowercase() || ch.is_ascii_digit();
+        cur.push(ch);
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+/// The Rust type name of a model's struct: the name in UpperCamelCase (`van_der_pol` ->
+/// `VanDerPol`, `chain10` -> `Chain10`), keeping only ASCII letters and digits. A name that
+/// is empty, starts with a digit, or clashes with a keyword or a prelude / runtime type name
+/// gets `Model` added (`3d` -> `Model3d`, `self` -> `SelfModel`, `some` -> `SomeModel`).
+pub fn type_name(model_name: &str) -> String {
+    let mut name: String = words(model_name)
+        .iter()
+        .map(|w| {
+            let mut cs = w.chars();
+            let first = cs.next().map(|c| c.to_ascii_uppercase());
+            first.into_iter().chain(cs).collect::<String>()
+        })
+        .collect();
+    if name.is_empty() || name.starts_with(|c: char| c.is_ascii_digit()) {
+        name.insert_str(0, "Model");
+    }
+    if RESERVED_TYPES.contains(&name.as_str()) || KEYWORDS.contains(&name.as_str()) {
+        name.push_str("Model");
+    }
+    name
+}
+
+/// The Cargo package name of a model's generated crate: lowercase words joined by `-`
+/// (`van_der_pol` -> `van-der-pol`, `VanDerPol` -> `van-der-pol`). A name that is empty,
+/// starts with a digit, or is a Rust keyword or a name Cargo reserves gets the prefix
+/// `model-` (`3d` -> `model-3d`, `fn` -> `model-fn`).
+pub fn crate_name(model_name: &str) -> String {
+    let name = words(model_name)
+        .iter()
+        .map(|w| w.to_ascii_lowercase())
+        .collect::<Vec<_>>()
+        .join("-");
+    let needs_prefix = name.is_empty()
+        || name.starts_with(|c: char| c.is_ascii_digit())
+        || KEYWORDS.contains(&name.replace('-', "_").as_str())
+        || RESERVED_CRATES.contains(&name.as_str());
+    if needs_prefix {
+        if name.is_empty() {
+            "model".to_string()
+        } else {
+            format!("model-{name}")
+        }
+    } else {
+        name
+    }
+}
+
+/// The Rust identifier of a crate called `crate_name` (`-` becomes `_`), as written in
+/// `use` paths.
+pub fn crate_ident(crate_name: &str) -> String {
+    crate_name.replace('-', "_")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn is_ident(s: &str) -> bool {
+        syn::parse_str::<syn::Ident>(s).is_ok()
+    }
+
+    #[test]
+    fn type_names() {
+        assert_eq!(type_name("pendulum"), "Pendulum");
+        assert_eq!(type_name("van_der_pol"), "VanDerPol");
+        assert_eq!(type_name("vanDerPol"), "VanDerPol");
+        assert_eq!(type_name("chain10"), "Chain10");
+        assert_eq!(type_name("linear_n"), "LinearN");
+        assert_eq!(type_name("3d"), "Model3d");
+        assert_eq!(type_name(""), "Model");
+        assert_eq!(type_name("_"), "Model");
+        assert_eq!(type_name("self"), "SelfModel");
+        assert_eq!(type_name("Self"), "SelfModel");
+        assert_eq!(type_name("some"), "SomeModel");
+        assert_eq!(type_name("string"), "StringModel");
+        assert_eq!(type_name("interval"), "IntervalModel");
+        assert_eq!(type_name("fn"), "Fn".to_string() + "Model");
+        assert_eq!(type_name("} fn evil() {"), "FnEvil");
+        assert_eq!(type_name("pénd ulum"), "PNdUlum");
+    }
+
+    #[test]
+    fn crate_names() {
+        assert_eq!(crate_name("pendulum"), "pendulum");
+        assert_eq!(crate_name("van_der_pol"), "van-der-pol");
+        assert_eq!(crate_name("VanDerPol"), "van-der-pol");
+        assert_eq!(crate_name("chain1000"), "chain1000");
+        assert_eq!(crate_name("3d"), "model-3d");
+        assert_eq!(crate_name("fn"), "model-fn");
+        assert_eq!(crate_name("type"), "model-type");
+        assert_eq!(crate_name("test"), "model-test");
+        assert_eq!(crate_name("build"), "model-build");
+        assert_eq!(crate_name(""), "model");
+        assert_eq!(crate_name("**"), "model");
+        assert_eq!(crate_ident("van-der-pol"), "van_der_pol");
+    }
+
+    #[test]
+    fn always_valid_identifiers() {
+        let names = [
+            "",
+            "_",
+            "self",
+            "Self",
+            "crate",
+            "super",
+            "fn",
+            "type",
+            "r#x",
+            "} fn evil() {",
+            "0",
+            "9lives",
+            "a-b",
+            "__x__",
+            "ÄÖÜ",
+            "x y z",
+            "unsafe",
+            "union",
+            "async",
+        ];
+        for n in names {
+            let t = type_name(n);
+            assert!(is_ident(&t), "type_name({n:?}) = {t:?}");
+            let c = crate_ident(&crate_name(n));
+            assert!(is_ident(&c), "crate_name({n:?}) = {c:?}");
+            assert!(!t.is_empty() && !c.is_empty());
+        }
+    }
+}

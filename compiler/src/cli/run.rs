@@ -1,0 +1,95 @@
+//! `reachc run`: compute the spec's analyses with the compiled backend (a generated crate, built
+//! with cargo and cached) or the IR interpreter (no cargo), print summaries, write JSON and CSV.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use clap::ValueEnum;
+
+use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
+use crate::backend::crate_writer::{compile_crate, shared_target_dir, write_crate, CrateOptions};
+use crate::backend::interp::Interpreter;
+use crate::backend::{mangle, prepare};
+use crate::diagnostics::render;
+
+/// Which backend computes the sets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Backend {
+    /// Generate a Rust crate, compile it (cached) and run its binary.
+    Compiled,
+    /// Evaluate the IR directly: no cargo, results at once.
+    Interp,
+}
+
+/// Runs `reachc run`. Exit codes: 0 ok, 1 spec errors or an analysis that cannot run, 2 usage,
+/// I/O or cargo failures.
+pub fn run_spec(
+    spec: &Path,
+    analysis: Option<String>,
+    backend: Backend,
+    out: Option<PathBuf>,
+) -> Result<(), u8> {
+    let color = std::io::stderr().is_terminal();
+    let mut loaded = load_reporting(spec)?;
+    let mut args = Vec::new();
+    if let Some(name) = analysis {
+        args.extend(["--analysis".to_string(), name]);
+    }
+    if let Some(dir) = out {
+        args.extend(["-o".to_string(), dir.display().to_string()]);
+    }
+    let code = match backend {
+        Backend::Interp => {
+            let prepared = prepare(&mut loaded.model);
+            if !prepared.warnings.is_empty() {
+                let path = loaded.path.display().to_string();
+                eprint!(
+                    "{}",
+                    render(&prepared.warnings, &path, &loaded.source, color)
+                );
+            }
+            let interp = Interpreter::new(loaded.model, &prepared.derivatives);
+            reachc_runtime::app::run_cli(
+                &interp,
+                &prepared.info,
+                &args,
+                &mut std::io::stdout().lock(),
+                &mut std::io::stderr().lock(),
+            )
+        }
+        Backend::Compiled => {
+            let crates = shared_target_dir()
+                .and_then(|t| t.parent().map(|p| p.join("crates")))
+                .unwrap_or_else(|| PathBuf::from("target/reachc-crates"));
+            std::fs::create_dir_all(&crates).map_err(|e| {
+                eprintln!("error: cannot create {}: {e}", crates.display());
+                EXIT_USAGE
+            })?;
+            let dir = crates.join(mangle::crate_name(&loaded.model.name));
+            let written =
+                write_crate(&mut loaded, &dir, &CrateOptions::default()).map_err(|e| {
+                    eprint!("{}", e.report(color));
+                    e.exit_code()
+                })?;
+            let binary = compile_crate(&written.dir, true).map_err(|e| {
+                eprint!("{}", e.report(color));
+                EXIT_USAGE
+            })?;
+            let status = std::process::Command::new(&binary)
+                .args(&args)
+                .status()
+                .map_err(|e| {
+                    eprintln!("error: cannot run {}: {e}", binary.display());
+                    EXIT_USAGE
+                })?;
+            status
+                .code()
+                .map_or(EXIT_USAGE, |c| u8::try_from(c).unwrap_or(EXIT_USAGE))
+        }
+    };
+    match code {
+        0 => Ok(()),
+        1 => Err(EXIT_SPEC),
+        c => Err(c),
+    }
+}

@@ -1,0 +1,9 @@
+//! The pendulum of `specs/pendulum.sde`, compiled by `build.rs` with `reachc::Config` and
+//! included here: [`Pendulum`] implements `reachc_runtime::System`, [`info`] describes the spec's
+//! sets and analyses.
+
+mod pendulum {
+    reachc_runtime::include_sde!("pendulum");
+}
+
+pub use pendulum::*;

@@ -1,0 +1,248 @@
+//! Small dense linear algebra with rigorous bounds, for the metric `P` and the initial-set
+//! metrics `M` (n is small: a few to a few dozen states).
+//!
+//! Everything that feeds a safety verdict or a radius is computed in [`Interval`] arithmetic on
+//! top of the exact `f64` inputs, so the bounds hold for the exact real matrices:
+//!
+//! * quadratic forms `v' A^-1 v` and diagonals of `A^-1` go through an interval Cholesky
+//!   factorisation `A = L L'` (each entry of `L` is an enclosure of the exact factor's entry,
+//!   because every formula is evaluated with inclusion functions) followed by interval forward
+//!   substitution, so `|L^-1 v|^2` encloses `v' A^-1 v`;
+//! * `lambda_max` of a symmetric interval matrix is estimated in `f64` (Jacobi) and then
+//!   *verified*: `mu` is an upper bound as soon as the interval Cholesky factorisation of
+//!   `mu I - A` succeeds with certainly positive pivots (then every symmetric matrix in the
+//!   enclosure satisfies `mu I - A > 0`). Gershgorin's bound is the fallback and is also used to
+//!   cap the result.
+
+use crate::interval::Interval;
+
+/// Interval Cholesky factor `L` (lower triangular, row-major `n x n`) of the symmetric matrix
+/// whose lower triangle is enclosed by `a`. `None` when a pivot is not certainly positive
+/// (the matrix may not be positive definite, or the enclosure is too wide to tell).
+pub(crate) fn cholesky(a: &[Interval], n: usize) -> Option<Vec<Interval>> {
+    debug_assert_eq!(a.len(), n * n);
+    let mut l = vec![Interval::ZERO; n * n];
+    for j in 0..n {
+        let mut d = a[j * n + j];
+        for k in 0..j {
+            d -= l[j * n + k].sqr();
+        }
+        // (Interval ends are never NaN.)
+        if d.lo() <= 0.0 || !d.is_bounded() {
+            return None;
+        }
+        let ljj = d.sqrt();
+        l[j * n + j] = ljj;
+        for i in j + 1..n {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= l[i * n + k] * l[j * n + k];
+            }
+            l[i * n + j] = s / ljj;
+        }
+    }
+    Some(l)
+}
+
+/// Enclosure of `L^-1 v` by interval forward substitution (`L` from [`cholesky`], so its
+/// diagonal is certainly positive).
+pub(crate) fn forward_solve(l: &[Interval], n: usize, v: &[Interval]) -> Vec<Interval> {
+    let mut w = vec![Interval::ZERO; n];
+    for i in 0..n {
+        let mut s = v[i];
+        for k in 0..i {
+            s -= l[i * n + k] * w[k];
+        }
+        w[i] = s / l[i * n + i];
+    }
+    w
+}
+
+/// Point matrix as intervals.
+pub(crate) fn to_intervals(a: &[f64]) -> Vec<Interval> {
+    a.iter().map(|&x| Interval::point(x)).collect()
+}
+
+/// Enclosure of `v' A^-1 v` given the interval Cholesky factor of `A`.
+pub(crate) fn inv_quad_form(l: &[Interval], n: usize, v: &[f64]) -> Interval {
+    let w = forward_solve(l, n, &to_intervals(v));
+    w.iter().fold(Interval::ZERO, |acc, wi| acc + wi.sqr())
+}
+
+/// Enclosure of the whole inverse `A^-1 = L^-T L^-1` (row-major), given the interval Cholesky
+/// factor of `A`.
+pub(crate) fn inverse(l: &[Interval], n: usize) -> Vec<Interval> {
+    // Column j of L^-1 is L^-1 e_j; store them as rows of `cols`.
+    let cols: Vec<Vec<Interval>> = (0..n)
+        .map(|j| {
+            let mut e = vec![Interval::ZERO; n];
+            e[j] = Interval::ONE;
+            forward_solve(l, n, &e)
+        })
+        .collect();
+    let mut out = vec![Interval::ZERO; n * n];
+    for i in 0..n {
+        for j in 0..=i {
+            // (A^-1)_ij = sum_k (L^-1)_ki (L^-1)_kj; use sqr on the diagonal (tighter).
+            let s = cols[i]
+                .iter()
+                .zip(&cols[j])
+                .fold(Interval::ZERO, |acc, (&a, &b)| {
+                    acc + if i == j { a.sqr() } else { a * b }
+                });
+            out[i * n + j] = s;
+            out[j * n + i] = s;
+        }
+    }
+    out
+}
+
+/// Eigenvalues of a symmetric `f64` matrix by the cyclic Jacobi method (an estimate only; the
+/// callers verify what they use).
+pub(crate) fn jacobi_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
+    let mut m = a.to_vec();
+    for _sweep in 0..100 {
+        let mut off = 0.0;
+        let mut diag = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                if i == j {
+                    diag += m[i * n + i] * m[i * n + i];
+                } else {
+                    off += m[i * n + j] * m[i * n + j];
+                }
+            }
+        }
+        if off <= 1e-30 * diag || off == 0.0 {
+            break;
+        }
+        for p in 0..n {
+            for q in p + 1..n {
+                let apq = m[p * n + q];
+                if apq == 0.0 {
+                    continue;
+                }
+                let theta = (m[q * n + q] - m[p * n + p]) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                // Rotate rows/columns p and q.
+                for k in 0..n {
+                    let mkp = m[k * n + p];
+                    let mkq = m[k * n + q];
+                    m[k * n + p] = c * mkp - s * mkq;
+                    m[k * n + q] = s * mkp + c * mkq;
+                }
+                for k in 0..n {
+                    let mpk = m[p * n + k];
+                    let mqk = m[q * n + k];
+                    m[p * n + k] = c * mpk - s * mqk;
+                    m[q * n + k] = s * mpk + c * mqk;
+                }
+            }
+        }
+    }
+    (0..n).map(|i| m[i * n + i]).collect()
+}
+
+/// Gershgorin upper bound of `lambda_max` over every symmetric matrix in the enclosure `a`
+/// (rounded up).
+pub(crate) fn gershgorin_upper(a: &[Interval], n: usize) -> f64 {
+    (0..n)
+        .map(|i| {
+            let mut s = Interval::point(a[i * n + i].hi());
+            for j in 0..n {
+                if j != i {
+                    s += a[i * n + j].mag();
+                }
+            }
+            s.hi()
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// A rigorous upper bound of `lambda_max` over every symmetric matrix whose lower triangle lies
+/// in the enclosure `a` (`k x k`). See the module documentation for the method.
+pub(crate) fn lambda_max_upper(a: &[Interval], k: usize) -> f64 {
+    if k == 0 {
+        return 0.0;
+    }
+    if k == 1 {
+        return a[0].hi();
+    }
+    let gersh = gershgorin_upper(a, k);
+    let mid: Vec<f64> = a.iter().map(|x| x.mid()).collect();
+    let est = jacobi_eigenvalues(&mid, k)
+        .into_iter()
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !est.is_finite() {
+        return gersh;
+    }
+    // Scale of the matrix, to make the trial margins relative.
+    let scale = a
+        .iter()
+        .map(|x| x.mag())
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let mut margin = scale * 1e-13;
+    for _ in 0..12 {
+        let mu = est + margin;
+        if mu >= gersh {
+            break;
+        }
+        let shifted: Vec<Interval> = (0..k * k)
+            .map(|idx| {
+                let (i, j) = (idx / k, idx % k);
+                let diag = if i == j {
+                    Interval::point(mu)
+                } else {
+                    Interval::ZERO
+                };
+                diag - a[idx]
+            })
+            .collect();
+        if cholesky(&shifted, k).is_some() {
+            return mu;
+        }
+        margin *= 10.0;
+    }
+    gersh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_of_pendulum_metric_encloses_exact() {
+        let p = [35.68, 2.21, 2.21, 1.27];
+        let l = cholesky(&to_intervals(&p), 2).unwrap();
+        let inv = inverse(&l, 2);
+        let det = 35.68 * 1.27 - 2.21 * 2.21;
+        let exact = [1.27 / det, -2.21 / det, -2.21 / det, 35.68 / det];
+        for (e, i) in exact.iter().zip(&inv) {
+            assert!((i.lo() - e).abs() < 1e-13 && (i.hi() - e).abs() < 1e-13);
+        }
+        let q = inv_quad_form(&l, 2, &[1.0, 1.0]);
+        let qe = exact.iter().sum::<f64>();
+        assert!(q.lo() <= qe + 1e-14 && qe - 1e-14 <= q.hi());
+    }
+
+    #[test]
+    fn lambda_max_bound_is_tight_and_above() {
+        let a = [2.0, 1.0, 1.0, 2.0];
+        let ub = lambda_max_upper(&to_intervals(&a), 2);
+        assert!((3.0..3.0 + 1e-10).contains(&ub), "{ub}");
+        let a3 = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 1.0];
+        let ev = jacobi_eigenvalues(&a3, 3);
+        let m = ev.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let ub = lambda_max_upper(&to_intervals(&a3), 3);
+        assert!(ub >= m && ub <= m + 1e-9, "{ub} {m}");
+    }
+
+    #[test]
+    fn cholesky_rejects_indefinite() {
+        assert!(cholesky(&to_intervals(&[1.0, 2.0, 2.0, 1.0]), 2).is_none());
+    }
+}

@@ -1,0 +1,88 @@
+//! The nominal trajectory `x*_t` of the deterministic system `x' = f(x, u_c, t)` (centre input),
+//! integrated numerically. Not validated: the report says so.
+
+use crate::system::{Integrator, System};
+
+/// The report times `0 = t_0 < t_1 < ... < t_N = horizon`, spaced by `step`; the last step is
+/// shortened so the grid ends exactly on the horizon.
+///
+/// A ratio `horizon / step` that is an integer up to rounding (e.g. `4 / 0.01`) does not
+/// produce an extra sliver step.
+pub(crate) fn time_grid(horizon: f64, step: f64) -> Vec<f64> {
+    let ratio = horizon / step;
+    let n = ((ratio * (1.0 - 1e-12)).ceil() as usize).max(if horizon > 0.0 { 1 } else { 0 });
+    let mut ts: Vec<f64> = (0..n).map(|k| k as f64 * step).collect();
+    ts.push(horizon);
+    ts
+}
+
+/// Integrates `x' = f(x, u, t)` over the grid with the integrator; `None` if a state became
+/// non-finite (returns the index of the first bad time in `Err`).
+pub(crate) fn integrate(
+    sys: &dyn System,
+    x0: &[f64],
+    u: &[f64],
+    grid: &[f64],
+    integrator: Integrator,
+) -> Result<Vec<Vec<f64>>, usize> {
+    let n = x0.len();
+    let mut out = Vec::with_capacity(grid.len());
+    out.push(x0.to_vec());
+    let mut x = x0.to_vec();
+    let mut k1 = vec![0.0; n];
+    let mut k2 = vec![0.0; n];
+    let mut k3 = vec![0.0; n];
+    let mut k4 = vec![0.0; n];
+    let mut tmp = vec![0.0; n];
+    for (idx, w) in grid.windows(2).enumerate() {
+        let (t, h) = (w[0], w[1] - w[0]);
+        match integrator {
+            Integrator::Euler => {
+                sys.drift(&x, u, t, &mut k1);
+                for i in 0..n {
+                    x[i] += h * k1[i];
+                }
+            }
+            Integrator::Rk4 => {
+                sys.drift(&x, u, t, &mut k1);
+                for i in 0..n {
+                    tmp[i] = x[i] + 0.5 * h * k1[i];
+                }
+                sys.drift(&tmp, u, t + 0.5 * h, &mut k2);
+                for i in 0..n {
+                    tmp[i] = x[i] + 0.5 * h * k2[i];
+                }
+                sys.drift(&tmp, u, t + 0.5 * h, &mut k3);
+                for i in 0..n {
+                    tmp[i] = x[i] + h * k3[i];
+                }
+                sys.drift(&tmp, u, t + h, &mut k4);
+                for i in 0..n {
+                    x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+                }
+            }
+        }
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(idx + 1);
+        }
+        out.push(x.clone());
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_lands_on_horizon() {
+        let g = time_grid(4.0, 0.01);
+        assert_eq!(g.len(), 401);
+        assert_eq!(*g.last().unwrap(), 4.0);
+        let g = time_grid(1.05, 0.1);
+        assert_eq!(g.len(), 12);
+        assert!((g[10] - 1.0).abs() < 1e-12);
+        assert_eq!(g[11], 1.05);
+        assert_eq!(time_grid(0.0, 0.1), vec![0.0]);
+    }
+}

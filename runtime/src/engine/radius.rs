@@ -1,0 +1,276 @@
+//! The rigorous scalar parts of the contraction PRS: the initial radius `r1`, the
+//! deterministic radius `R_t` (Proposition 3) and `Psi_t` (eq. Psi), all in [`Interval`]
+//! arithmetic with the upper ends kept.
+
+use super::linalg;
+use crate::interval::{Interval, ELEM_ULPS};
+use crate::system::InitialSet;
+
+/// Number of box coordinates (with non-zero width) up to which `r1` is the exact maximum over
+/// the box's vertices; above it the cheaper bound `sum_ij |P_ij| h_i h_j` is used.
+pub const MAX_VERTEX_COORDS: usize = 16;
+
+/// Interval enclosure of `expm1(x) = e^x - 1`, increasing, from `f64::exp_m1` at the ends
+/// widened by [`ELEM_ULPS`] ulps (the same accuracy assumption as the interval module makes for
+/// `exp`: the usual libms document `expm1` within 1 ulp). Using `expm1` rather than `exp - 1`
+/// keeps the relative accuracy for small `|x|` (short steps, small `|c|`).
+pub(crate) fn expm1(x: Interval) -> Interval {
+    let widen = |mut v: f64, up: bool| {
+        for _ in 0..ELEM_ULPS {
+            v = if up { v.next_up() } else { v.next_down() };
+        }
+        v
+    };
+    let mut lo = if x.lo() == f64::NEG_INFINITY {
+        -1.0
+    } else {
+        widen(x.lo().exp_m1(), false).max(-1.0)
+    };
+    let mut hi = if x.hi() == f64::INFINITY {
+        f64::INFINITY
+    } else {
+        widen(x.hi().exp_m1(), true)
+    };
+    // expm1 has the sign of its argument.
+    if x.lo() >= 0.0 {
+        lo = lo.max(0.0);
+    }
+    if x.hi() <= 0.0 {
+        hi = hi.min(0.0);
+    }
+    Interval::try_new(lo, hi).unwrap_or(Interval::ENTIRE)
+}
+
+/// `expm1(a h) / a`, the integral of `e^(a s)` over `[0, h]`; `h` itself at `a = 0`.
+fn expm1_over(a: f64, h: Interval) -> Interval {
+    if a == 0.0 {
+        h
+    } else {
+        let a = Interval::point(a);
+        expm1(a * h) / a
+    }
+}
+
+/// One exact step of `Psi' = 2 c Psi + sigma^2` over a step of length `h` on which `c` and
+/// `sigma` are constant: `Psi(t+h) = Psi(t) e^(2ch) + sigma^2 expm1(2ch) / (2c)`.
+///
+/// Written per step (rather than with the closed form) so that piecewise-constant `c_t`,
+/// `sigma_t` only need a different `(c, sigma)` per step. `Psi(t+h)` is increasing in `Psi(t)`,
+/// so feeding an enclosure of `Psi(t)` gives an enclosure of `Psi(t+h)`.
+#[cfg_attr(not(test), allow(dead_code))]
+pub(crate) fn psi_step(psi: Interval, c: f64, sigma: f64, h: Interval) -> Interval {
+    PsiStep::new(c, sigma, h).apply(psi)
+}
+
+/// The affine map `Psi -> Psi decay + gain` of one step, kept so that equal consecutive steps
+/// (the usual case: constant rates, uniform grid) reuse it instead of recomputing `exp` and
+/// `expm1` in interval arithmetic.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PsiStep {
+    key: (u64, u64, u64, u64),
+    decay: Interval,
+    gain: Interval,
+}
+
+impl PsiStep {
+    /// The step map for rates `(c, sigma)` and step-length enclosure `h`.
+    pub(crate) fn new(c: f64, sigma: f64, h: Interval) -> PsiStep {
+        let sigma2 = Interval::point(sigma).sqr();
+        // 2c is exact (doubling), so expm1_over(2c, h) encloses the integral of e^(2c s).
+        PsiStep {
+            key: Self::key(c, sigma, h),
+            decay: (Interval::point(2.0 * c) * h).exp(),
+            gain: sigma2 * expm1_over(2.0 * c, h),
+        }
+    }
+
+    fn key(c: f64, sigma: f64, h: Interval) -> (u64, u64, u64, u64) {
+        (
+            c.to_bits(),
+            sigma.to_bits(),
+            h.lo().to_bits(),
+            h.hi().to_bits(),
+        )
+    }
+
+    /// Whether this map is the one for `(c, sigma, h)` (bitwise equal inputs).
+    pub(crate) fn matches(&self, c: f64, sigma: f64, h: Interval) -> bool {
+        self.key == Self::key(c, sigma, h)
+    }
+
+    /// `Psi(t + h)` from an enclosure of `Psi(t)`.
+    pub(crate) fn apply(&self, psi: Interval) -> Interval {
+        psi * self.decay + self.gain
+    }
+}
+
+/// Upper bound of the deterministic radius of Proposition 3,
+/// `R_t = e^(ct) r1 + rho/c (e^(ct) - 1) r2` (`r1 + rho t r2` at `c = 0`).
+pub(crate) fn det_radius(c: f64, rho: f64, r1: f64, r2: f64, t: f64) -> f64 {
+    let t = Interval::point(t);
+    let growth = (Interval::point(c) * t).exp() * Interval::point(r1);
+    let input = if rho == 0.0 || r2 == 0.0 {
+        Interval::ZERO
+    } else {
+        Interval::point(rho) * expm1_over(c, t) * Interval::point(r2)
+    };
+    (growth + input).hi()
+}
+
+/// The centre of the initial set (box midpoints, ball centres) and, per state, a half-width
+/// `h_i` with `|x_i - centre_i| <= h_i` for every `x` in the set (rounded up).
+///
+/// Ball parts `(x_S - c)' M (x_S - c) <= r^2` are replaced by their bounding box
+/// `|x_i - c_i| <= r sqrt((M^-1)_ii)`: conservative (the box's corners are outside the ball),
+/// but it keeps `r1` a single, simple formula. `(M^-1)_ii` is enclosed rigorously by an
+/// interval Cholesky factorisation of `M`.
+pub(crate) fn initial_center_and_halfwidths(
+    init: &InitialSet,
+    n: usize,
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    if init.boxes.len() != n {
+        return Err(format!(
+            "the initial set has {} per-state entries, the model has {n} states",
+            init.boxes.len()
+        ));
+    }
+    let mut center = vec![f64::NAN; n];
+    let mut half = vec![f64::NAN; n];
+    for (i, b) in init.boxes.iter().enumerate() {
+        if let Some((lo, hi)) = *b {
+            let iv = Interval::try_new(lo, hi)
+                .filter(|iv| iv.is_bounded())
+                .ok_or_else(|| {
+                    format!("initial box of state {i} is [{lo}, {hi}] (must be bounded)")
+                })?;
+            center[i] = iv.mid();
+            half[i] = iv.rad();
+        }
+    }
+    for (bi, ball) in init.balls.iter().enumerate() {
+        let k = ball.states.len();
+        if ball.center.len() != k || !ball.radius.is_finite() || ball.radius < 0.0 {
+            return Err(format!("initial ball #{bi} is malformed"));
+        }
+        let diag_inv: Vec<Interval> = match &ball.metric {
+            None => vec![Interval::ONE; k],
+            Some(m) => {
+                if m.len() != k * k {
+                    return Err(format!("initial ball #{bi}: metric is not {k} x {k}"));
+                }
+                let l = linalg::cholesky(&linalg::to_intervals(m), k).ok_or_else(|| {
+                    format!("initial ball #{bi}: metric is not (certifiably) positive definite")
+                })?;
+                let inv = linalg::inverse(&l, k);
+                (0..k).map(|i| inv[i * k + i]).collect()
+            }
+        };
+        for (j, &s) in ball.states.iter().enumerate() {
+            if s >= n {
+                return Err(format!("initial ball #{bi} refers to state {s} (n = {n})"));
+            }
+            center[s] = ball.center[j];
+            half[s] = (Interval::point(ball.radius) * diag_inv[j].sqrt()).hi();
+        }
+    }
+    if let Some(i) = (0..n).find(|&i| center[i].is_nan()) {
+        return Err(format!(
+            "state {i} is in neither an initial box nor an initial ball"
+        ));
+    }
+    Ok((center, half))
+}
+
+/// Upper bound of `max |d|_P` over the box `|d_i| <= h_i` (P row-major `n x n`).
+///
+/// `d' P d` is convex in `d`, so its maximum over the box is attained at a vertex. With at most
+/// [`MAX_VERTEX_COORDS`] coordinates of non-zero width every vertex is evaluated (in interval
+/// arithmetic); otherwise `d' P d <= sum_ij |P_ij| h_i h_j` is used. The square root is
+/// rounded up.
+pub(crate) fn r1_bound(p: &[f64], half: &[f64]) -> f64 {
+    let n = half.len();
+    let active: Vec<usize> = (0..n).filter(|&i| half[i] > 0.0).collect();
+    if active.is_empty() {
+        return 0.0;
+    }
+    let k = active.len();
+    // q_ab = P_ij h_i h_j over the active coordinates.
+    let mut q = vec![Interval::ZERO; k * k];
+    for (a, &i) in active.iter().enumerate() {
+        for (b, &j) in active.iter().enumerate() {
+            q[a * k + b] =
+                Interval::point(p[i * n + j]) * Interval::point(half[i]) * Interval::point(half[j]);
+        }
+    }
+    let max_sq = if k <= MAX_VERTEX_COORDS {
+        // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the same
+        // value, so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
+        let mut best = f64::NEG_INFINITY;
+        for bits in 0u32..(1u32 << (k - 1)) {
+            let sign = |a: usize| a == 0 || (bits >> (a - 1)) & 1 == 0;
+            let mut s = Interval::ZERO;
+            for a in 0..k {
+                s += q[a * k + a];
+                for b in a + 1..k {
+                    let term = q[a * k + b] + q[b * k + a];
+                    if sign(a) == sign(b) {
+                        s += term;
+                    } else {
+                        s -= term;
+                    }
+                }
+            }
+            best = best.max(s.hi());
+        }
+        best
+    } else {
+        q.iter()
+            .fold(Interval::ZERO, |acc, x| acc + Interval::point(x.mag()))
+            .hi()
+    };
+    Interval::point(max_sq.max(0.0)).sqrt().hi()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn psi_steps_match_closed_form() {
+        let (c, sigma) = (-0.4, 2f64.sqrt());
+        let mut psi = Interval::ZERO;
+        let h = 0.01;
+        for k in 1..=400 {
+            psi = psi_step(psi, c, sigma, Interval::point(h));
+            let t = k as f64 * h;
+            let exact = sigma * sigma * (2.0 * c * t).exp_m1() / (2.0 * c);
+            assert!(psi.lo() <= exact * (1.0 + 1e-15) && exact * (1.0 - 1e-15) <= psi.hi());
+            assert!((psi.hi() - exact).abs() <= 1e-12 * exact);
+        }
+    }
+
+    #[test]
+    fn psi_at_zero_rate_is_linear() {
+        let psi = psi_step(Interval::ZERO, 0.0, 3.0, Interval::point(0.5));
+        assert!(psi.contains(4.5));
+    }
+
+    #[test]
+    fn r1_vertices_vs_sum_bound() {
+        // P = [[2, 1], [1, 2]], h = (1, 1): vertex max at (1, 1): 6.
+        let r = r1_bound(&[2.0, 1.0, 1.0, 2.0], &[1.0, 1.0]);
+        assert!(r >= 6f64.sqrt() && r <= 6f64.sqrt() * (1.0 + 1e-14));
+        // Negative coupling: max at (1, -1): 2 + 2 + 2 = 6 as well.
+        let r = r1_bound(&[2.0, -1.0, -1.0, 2.0], &[1.0, 1.0]);
+        assert!(r >= 6f64.sqrt() && r <= 6f64.sqrt() * (1.0 + 1e-14));
+    }
+
+    #[test]
+    fn expm1_encloses() {
+        for x in [-3.0, -1e-9, 0.0, 1e-12, 0.7] {
+            let e = expm1(Interval::point(x));
+            assert!(e.contains(x.exp_m1()));
+            assert!(e.width() <= 1e-14 * x.exp_m1().abs().max(1e-300) + 1e-300);
+        }
+    }
+}

@@ -1,0 +1,316 @@
+//! The result of an analysis and its renderings (JSON, CSV, text summary).
+
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::io::{self, Write};
+
+/// Everything an analysis computed, ready to be serialised.
+///
+/// Non-finite numbers (e.g. an infinite margin) appear as `null` in the JSON.
+#[derive(Clone, Debug, Serialize)]
+pub struct AnalysisResult {
+    /// `model NAME`.
+    pub model: String,
+    /// The analysis' name.
+    pub analysis: String,
+    /// Deterministic-set method (`"contraction"`).
+    pub method: String,
+    /// Probability level: each PRS holds `X_t` with probability `>= 1 - delta`.
+    pub delta: f64,
+    /// Final time.
+    pub horizon: f64,
+    /// Nominal report step (the last step may be shorter).
+    pub step: f64,
+    /// Integrator of the nominal trajectory (`"rk4"` or `"euler"`).
+    pub integrator: String,
+    /// All state names (the order of `nominal` and `center`).
+    pub states: Vec<String>,
+    /// Indices of the states the CSV and the summary report.
+    pub outputs: Vec<usize>,
+    /// The constants of Assumption 1 used.
+    pub constants: ConstantsReport,
+    /// The stochastic radius rule.
+    pub radius_rule: RadiusRuleReport,
+    /// `kappa(n, delta)` of the rule: `r_t = sqrt(Psi_t kappa)`.
+    pub kappa: f64,
+    /// Upper bound of `|x0 - x*_0|_P` over the initial set.
+    pub r1: f64,
+    /// Radius of the input box in the input norm (1; 0 without inputs).
+    pub r2: f64,
+    /// How `r1` was bounded.
+    pub r1_how: String,
+    /// Centre of the initial set (the nominal's start).
+    pub initial_center: Vec<f64>,
+    /// Centre of the input box (the nominal's input).
+    pub input_center: Vec<f64>,
+    /// One record per report time.
+    pub steps: Vec<StepRecord>,
+    /// Per unsafe set, its verdict over the whole horizon.
+    pub unsafe_sets: Vec<UnsafeReport>,
+    /// The overall verdict.
+    pub verdict: Verdict,
+    /// Which parts are rigorous and which are not.
+    pub validated: Validation,
+}
+
+/// The constants of Assumption 1, as used.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConstantsReport {
+    /// Contraction rate.
+    pub c: f64,
+    /// Noise level.
+    pub sigma: f64,
+    /// Input gain (0 without inputs).
+    pub rho: f64,
+    /// How the compiler obtained them.
+    pub how: String,
+    /// The metric `P`, by rows.
+    pub metric: Vec<Vec<f64>>,
+}
+
+/// The stochastic radius rule used.
+#[derive(Clone, Debug, Serialize)]
+pub struct RadiusRuleReport {
+    /// `"amgf"`, `"paper"` or `"paper_optimal"`.
+    pub rule: String,
+    /// `eps` of Theorem 1 (the given one, or the minimiser), for the paper rules.
+    pub eps: Option<f64>,
+}
+
+/// The sets at one report time.
+#[derive(Clone, Debug, Serialize)]
+pub struct StepRecord {
+    /// Time.
+    pub t: f64,
+    /// Nominal state `x*_t` (all states).
+    pub nominal: Vec<f64>,
+    /// Deterministic reachable set `Rbar_t`.
+    pub det_set: DetSet,
+    /// Stochastic radius `r_t` (in `|.|_P`).
+    pub r_t: f64,
+    /// `Psi_t` (upper bound).
+    pub psi: f64,
+    /// Contraction rate on the step ending here.
+    pub c: f64,
+    /// Noise level on the step ending here.
+    pub sigma: f64,
+    /// Radius of the PRS `B_P(x*_t, R_t + r_t)`.
+    pub prs_radius: f64,
+    /// Safety margin per unsafe set (same order as `unsafe_sets`; `> 0` means shown safe).
+    pub margins: Vec<f64>,
+}
+
+/// A deterministic reachable set.
+#[derive(Clone, Debug, Serialize)]
+pub struct DetSet {
+    /// `"p_ball"`: `{x : |x - center|_P <= radius}`.
+    pub shape: &'static str,
+    /// Centre.
+    pub center: Vec<f64>,
+    /// Radius `R_t` (upper bound).
+    pub radius: f64,
+    /// Where the metric is: `"constants.metric"`.
+    pub metric: &'static str,
+}
+
+/// One unsafe set's verdict.
+#[derive(Clone, Debug, Serialize)]
+pub struct UnsafeReport {
+    /// Its name.
+    pub name: String,
+    /// `"half_space"`, `"box"` or `"ball"`.
+    pub kind: String,
+    /// Shown safe at every report time.
+    pub safe: bool,
+    /// Smallest margin over the report times.
+    pub min_margin: f64,
+    /// Time of the smallest margin.
+    pub min_margin_t: f64,
+    /// First report time at which safety was not shown.
+    pub first_not_safe_t: Option<f64>,
+    /// What the margin measures.
+    pub margin_unit: String,
+}
+
+/// The overall verdict. A PRS touching an unsafe set does not prove a violation, hence "not
+/// shown safe" rather than "unsafe".
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum Verdict {
+    /// Every PRS is disjoint from every unsafe set.
+    Safe,
+    /// The spec has no unsafe sets.
+    NoUnsafeSets,
+    /// The first report time and set for which safety was not shown.
+    NotShownSafe {
+        /// Time.
+        t: f64,
+        /// Step index.
+        step: usize,
+        /// The unsafe set's name.
+        set: String,
+    },
+}
+
+/// Which parts of the result are rigorous.
+#[derive(Clone, Debug, Serialize)]
+pub struct Validation {
+    /// Rigorous parts (outward-rounded, or certified by the compiler).
+    pub rigorous: Vec<String>,
+    /// Parts that are not validated.
+    pub not_validated: Vec<String>,
+    /// The result holds only while the state stays in the spec's domain.
+    pub conditional_on_domain: bool,
+}
+
+impl AnalysisResult {
+    /// Pretty-printed JSON.
+    pub fn to_json(&self) -> String {
+        // Serialising plain data with string keys cannot fail.
+        serde_json::to_string_pretty(self).expect("AnalysisResult serialises")
+    }
+
+    /// State indices the CSV and the summary show: `outputs`, or all states if it is empty.
+    fn shown_states(&self) -> Vec<usize> {
+        if self.outputs.is_empty() {
+            (0..self.states.len()).collect()
+        } else {
+            self.outputs.clone()
+        }
+    }
+
+    /// CSV with header `t,<output state names...>,det_radius,r_t,psi,c,sigma,prs_radius` and one
+    /// row per report time (the nominal state in the state columns).
+    pub fn write_csv(&self, w: &mut dyn Write) -> io::Result<()> {
+        let shown = self.shown_states();
+        let mut header = String::from("t");
+        for &i in &shown {
+            header.push(',');
+            header.push_str(&csv_field(&self.states[i]));
+        }
+        header.push_str(",det_radius,r_t,psi,c,sigma,prs_radius");
+        writeln!(w, "{header}")?;
+        for s in &self.steps {
+            let mut row = format!("{}", s.t);
+            for &i in &shown {
+                let _ = write!(row, ",{}", s.nominal[i]);
+            }
+            let _ = write!(
+                row,
+                ",{},{},{},{},{},{}",
+                s.det_set.radius, s.r_t, s.psi, s.c, s.sigma, s.prs_radius
+            );
+            writeln!(w, "{row}")?;
+        }
+        Ok(())
+    }
+
+    /// A readable text summary: constants, radius rule and kappa, a table at about ten evenly
+    /// spaced times plus the final time, and the safety verdicts with margins.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "analysis `{}` of model `{}` ({} method, delta = {})",
+            self.analysis, self.model, self.method, self.delta
+        );
+        let k = &self.constants;
+        let _ = writeln!(
+            s,
+            "  constants: c = {:.6}, sigma = {:.6}, rho = {:.6} ({})",
+            k.c, k.sigma, k.rho, k.how
+        );
+        let rows: Vec<String> = k
+            .metric
+            .iter()
+            .map(|r| {
+                let cells: Vec<String> = r.iter().map(|v| format!("{v:.6}")).collect();
+                format!("[{}]", cells.join(", "))
+            })
+            .collect();
+        let _ = writeln!(s, "  metric P = [{}]", rows.join(", "));
+        let rule = match self.radius_rule.eps {
+            Some(eps) => format!("{} (eps = {eps:.6})", self.radius_rule.rule),
+            None => self.radius_rule.rule.clone(),
+        };
+        let _ = writeln!(
+            s,
+            "  radius rule: {rule}, kappa(n = {}, delta = {}) = {:.6}",
+            self.states.len(),
+            self.delta,
+            self.kappa
+        );
+        let _ = writeln!(
+            s,
+            "  r1 = {:.6} ({}), r2 = {}",
+            self.r1, self.r1_how, self.r2
+        );
+        let _ = writeln!(
+            s,
+            "  {:>10}  {:>12}  {:>12}  {:>12}",
+            "t", "R_t", "r_t", "PRS radius"
+        );
+        for i in summary_indices(self.steps.len()) {
+            let st = &self.steps[i];
+            let _ = writeln!(
+                s,
+                "  {:>10.4}  {:>12.6}  {:>12.6}  {:>12.6}",
+                st.t, st.det_set.radius, st.r_t, st.prs_radius
+            );
+        }
+        if self.unsafe_sets.is_empty() {
+            let _ = writeln!(s, "  safety: no unsafe sets");
+        } else {
+            for u in &self.unsafe_sets {
+                let status = if u.safe {
+                    "safe".to_string()
+                } else {
+                    format!(
+                        "NOT SHOWN SAFE (first at t = {:.4})",
+                        u.first_not_safe_t.unwrap_or(f64::NAN)
+                    )
+                };
+                let _ = writeln!(
+                    s,
+                    "  unsafe set `{}` ({}): {status}; min margin {:.6} at t = {:.4} ({})",
+                    u.name, u.kind, u.min_margin, u.min_margin_t, u.margin_unit
+                );
+            }
+        }
+        let verdict = match &self.verdict {
+            Verdict::Safe => "safe (every PRS misses every unsafe set)".to_string(),
+            Verdict::NoUnsafeSets => "no unsafe sets to check".to_string(),
+            Verdict::NotShownSafe { t, set, .. } => format!(
+                "not shown safe: the PRS at t = {t:.4} meets `{set}` (this does not prove a violation)"
+            ),
+        };
+        let _ = writeln!(s, "  verdict: {verdict}");
+        let _ = writeln!(
+            s,
+            "  not validated: {}",
+            self.validated.not_validated.join("; ")
+        );
+        s
+    }
+}
+
+/// About ten evenly spaced step indices, always including the first and the last.
+fn summary_indices(len: usize) -> Vec<usize> {
+    if len == 0 {
+        return Vec::new();
+    }
+    let last = len - 1;
+    let mut idx: Vec<usize> = (0..10).map(|k| k * last / 10).collect();
+    idx.push(last);
+    idx.dedup();
+    idx
+}
+
+/// Quotes a CSV field when it needs it (state names are identifiers, possibly `x[3]`).
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}

@@ -1,0 +1,189 @@
+//! The interface between a model and the engines: what generated code (and the compiler's IR
+//! interpreter) implements, and the plain data describing the spec's sets and analyses.
+//!
+//! Matrices are flat row-major slices: entry `(i, j)` of an `r x c` matrix is `[i * c + j]`.
+
+use crate::interval::Interval;
+
+/// A stochastic system `dX = f(X, u, t) dt + G(X, t) dW` with its derivatives.
+///
+/// Implementations must be pure functions of their arguments. The interval versions must be
+/// inclusion functions: for every point in the argument boxes, the point result lies in the
+/// interval result (outward rounding).
+pub trait System {
+    /// Number of states `n`.
+    fn n(&self) -> usize;
+    /// Number of inputs `p`.
+    fn p(&self) -> usize;
+    /// Number of noise channels `m`.
+    fn m(&self) -> usize;
+    /// `out[i] = f_i(x, u, t)`; `out.len() == n`.
+    fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]);
+    /// Natural inclusion function of the drift.
+    fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]);
+    /// `D_x f`, n x n row-major.
+    fn jac_x(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]);
+    /// Interval enclosure of `D_x f` over the boxes.
+    fn jac_x_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]);
+    /// `D_u f`, n x p row-major.
+    fn jac_u(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]);
+    /// Interval enclosure of `D_u f`.
+    fn jac_u_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]);
+    /// `G(x, t)`, n x m row-major.
+    fn diffusion(&self, x: &[f64], t: f64, out: &mut [f64]);
+    /// Interval enclosure of `G`.
+    fn diffusion_interval(&self, x: &[Interval], t: Interval, out: &mut [Interval]);
+}
+
+/// A closed interval of reals given by its ends (`-inf`/`inf` allowed), as plain data.
+pub type Range = (f64, f64);
+
+/// Everything about a model that is not code: names, sets and analyses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelInfo {
+    /// `model NAME`.
+    pub name: String,
+    /// State names (family elements as `x[3]`).
+    pub states: Vec<String>,
+    /// Input names.
+    pub inputs: Vec<String>,
+    /// Noise channel names.
+    pub noises: Vec<String>,
+    /// The input box, one range per input.
+    pub input_box: Vec<Range>,
+    /// The initial set.
+    pub initial: InitialSet,
+    /// Per state, the box where the constants were derived (`(-inf, inf)` when unbounded).
+    pub domain: Vec<Range>,
+    /// Whether the spec gave a domain (results then hold while the state stays in it).
+    pub has_domain: bool,
+    /// Unsafe sets.
+    pub unsafe_sets: Vec<UnsafeSet>,
+    /// The analyses, with their derived constants.
+    pub analyses: Vec<Analysis>,
+}
+
+/// The initial set: per-state boxes (points are degenerate boxes) times balls over groups.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialSet {
+    /// Per state: its box, or `None` if the state belongs to a ball.
+    pub boxes: Vec<Option<Range>>,
+    /// Balls `{x_S : (x_S - c)' M (x_S - c) <= r^2}`.
+    pub balls: Vec<InitialBall>,
+}
+
+/// One ball of the initial set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialBall {
+    /// State indices.
+    pub states: Vec<usize>,
+    /// Centre, one entry per state in `states`.
+    pub center: Vec<f64>,
+    /// Radius.
+    pub radius: f64,
+    /// Metric `M`, k x k row-major (`k = states.len()`); identity when `None`.
+    pub metric: Option<Vec<f64>>,
+}
+
+/// A named unsafe set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnsafeSet {
+    /// Its name.
+    pub name: String,
+    /// Its shape.
+    pub shape: UnsafeShape,
+}
+
+/// Shapes of unsafe sets.
+#[derive(Clone, Debug, PartialEq)]
+pub enum UnsafeShape {
+    /// A box over some states (others unconstrained).
+    Box(Vec<(usize, Range)>),
+    /// A Euclidean ball over some states.
+    Ball {
+        /// State indices.
+        states: Vec<usize>,
+        /// Centre.
+        center: Vec<f64>,
+        /// Radius.
+        radius: f64,
+    },
+    /// `{x : normal . x >= offset}`.
+    HalfSpace {
+        /// One entry per state.
+        normal: Vec<f64>,
+        /// Offset.
+        offset: f64,
+    },
+}
+
+/// How the deterministic reachable set is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Proposition 3: a P-ball around the nominal trajectory.
+    Contraction,
+    /// Proposition 4: an embedding system on boxes.
+    Interval,
+}
+
+/// The stochastic radius rule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RadiusRule {
+    /// The averaged-MGF bound (default).
+    Amgf,
+    /// Theorem 1 with a given eps in (0, 1).
+    Paper(f64),
+    /// Theorem 1 with eps minimising the radius.
+    PaperOptimal,
+}
+
+/// Time integrator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Classical Runge-Kutta of order 4.
+    Rk4,
+    /// Forward Euler.
+    Euler,
+}
+
+/// Constants of Assumption 1 for one metric, derived by the compiler.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Constants {
+    /// The metric `P`, n x n row-major, symmetric positive definite.
+    pub metric: Vec<f64>,
+    /// Contraction rate: `mu_P(D_x f) <= c` on the domain, for all inputs and times.
+    pub c: f64,
+    /// Noise level: `P^(1/2) G G' P^(1/2) <= sigma^2 I`.
+    pub sigma: f64,
+    /// Input gain: `|D_u f v|_P <= rho |v|_U`, where `|v|_U = max_j |v_j| / h_j` for the input
+    /// box half-widths `h_j` (so the input box is the U-ball of radius 1 around its centre).
+    pub rho: f64,
+    /// How they were obtained (for the report), e.g. "max over 2 atom vertices, certified".
+    pub how: String,
+}
+
+/// One analysis of the spec, with everything the engine needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analysis {
+    /// Its name.
+    pub name: String,
+    /// Contraction or interval.
+    pub method: Method,
+    /// Probability level: the PRS holds the state with probability >= 1 - delta.
+    pub delta: f64,
+    /// Final time.
+    pub horizon: f64,
+    /// Time step of the nominal trajectory and of the report.
+    pub step: f64,
+    /// Radius rule.
+    pub radius: RadiusRule,
+    /// Integrator.
+    pub integrator: Integrator,
+    /// States to report (indices).
+    pub outputs: Vec<usize>,
+    /// Derived constants (`None` if they could not be bounded; the engine refuses to run then).
+    pub constants: Option<Constants>,
+    /// Why `constants` is `None` (e.g. "d f[omega]/d theta is unbounded over the domain"),
+    /// shown when the analysis is asked to run.
+    pub constants_error: Option<String>,
+}

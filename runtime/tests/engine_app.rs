@@ -1,0 +1,165 @@
+//! The generated binaries' `main`: argument parsing, exit codes, skipped analyses, output files.
+
+use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
+use reachc_runtime::interval::Interval;
+use reachc_runtime::system::{
+    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule,
+};
+use reachc_runtime::System;
+
+/// `dx = -x dt + 0.5 dW` in one dimension.
+struct Decay;
+
+impl System for Decay {
+    fn n(&self) -> usize {
+        1
+    }
+    fn p(&self) -> usize {
+        0
+    }
+    fn m(&self) -> usize {
+        1
+    }
+    fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+        out[0] = -x[0];
+    }
+    fn drift_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
+        out[0] = -x[0];
+    }
+    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+        out[0] = -1.0;
+    }
+    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
+        out[0] = Interval::point(-1.0);
+    }
+    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
+    fn jac_u_interval(
+        &self,
+        _x: &[Interval],
+        _u: &[Interval],
+        _t: Interval,
+        _out: &mut [Interval],
+    ) {
+    }
+    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
+        out[0] = 0.5;
+    }
+    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
+        out[0] = Interval::point(0.5);
+    }
+}
+
+fn analysis(name: &str, method: Method, constants: bool) -> Analysis {
+    Analysis {
+        name: name.into(),
+        method,
+        delta: 0.01,
+        horizon: 1.0,
+        step: 0.1,
+        radius: RadiusRule::Amgf,
+        integrator: Integrator::Rk4,
+        outputs: vec![],
+        constants: constants.then(|| Constants {
+            metric: vec![1.0],
+            c: -1.0,
+            sigma: 0.5,
+            rho: 0.0,
+            how: "by hand".into(),
+        }),
+        constants_error: (!constants).then(|| "not bounded".to_string()),
+    }
+}
+
+fn model(analyses: Vec<Analysis>) -> ModelInfo {
+    ModelInfo {
+        name: "decay".into(),
+        states: vec!["x".into()],
+        inputs: vec![],
+        noises: vec!["w".into()],
+        input_box: vec![],
+        initial: InitialSet {
+            boxes: vec![Some((0.9, 1.1))],
+            balls: vec![],
+        },
+        domain: vec![(f64::NEG_INFINITY, f64::INFINITY)],
+        has_domain: false,
+        unsafe_sets: vec![],
+        analyses,
+    }
+}
+
+fn tmp_dir(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("reachc-engine-app-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn cli(info: &ModelInfo, args: &[&str]) -> (u8, String, String) {
+    let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = run_cli(&Decay, info, &args, &mut out, &mut err);
+    (
+        code,
+        String::from_utf8(out).unwrap(),
+        String::from_utf8(err).unwrap(),
+    )
+}
+
+#[test]
+fn runs_writes_and_skips_interval() {
+    let info = model(vec![
+        analysis("main", Method::Contraction, true),
+        analysis("boxes", Method::Interval, true),
+    ]);
+    let dir = tmp_dir("ok");
+    let (code, out, err) = cli(&info, &["-o", dir.to_str().unwrap()]);
+    assert_eq!(code, EXIT_OK, "{err}");
+    assert!(out.contains("analysis `main`"), "{out}");
+    assert!(
+        err.contains("skipped analysis `boxes`") && err.contains("interval"),
+        "{err}"
+    );
+    let json = std::fs::read_to_string(dir.join("main.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["analysis"], "main");
+    let csv = std::fs::read_to_string(dir.join("main.csv")).unwrap();
+    assert!(csv.starts_with("t,x,det_radius,r_t,psi,c,sigma,prs_radius\n"));
+    assert_eq!(csv.lines().count(), 12);
+    assert!(!dir.join("boxes.json").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn quiet_and_named_analysis() {
+    let info = model(vec![
+        analysis("a", Method::Contraction, true),
+        analysis("b", Method::Contraction, true),
+    ]);
+    let dir = tmp_dir("named");
+    let (code, out, _) = cli(
+        &info,
+        &["--analysis=b", "--quiet", "--out", dir.to_str().unwrap()],
+    );
+    assert_eq!(code, EXIT_OK);
+    assert!(out.is_empty());
+    assert!(dir.join("b.json").exists() && !dir.join("a.json").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn exit_codes() {
+    let info = model(vec![analysis("nocon", Method::Contraction, false)]);
+    let dir = tmp_dir("fail");
+    let (code, _, err) = cli(&info, &["-o", dir.to_str().unwrap()]);
+    assert_eq!(code, EXIT_FAILED);
+    assert!(err.contains("not bounded"), "{err}");
+    let (code, _, err) = cli(&info, &["--analysis", "missing"]);
+    assert_eq!(code, EXIT_USAGE);
+    assert!(err.contains("available: nocon"), "{err}");
+    assert_eq!(cli(&info, &["--bogus"]).0, EXIT_USAGE);
+    assert_eq!(cli(&info, &["-o"]).0, EXIT_USAGE);
+    let (code, out, _) = cli(&info, &["--help"]);
+    assert_eq!(code, EXIT_OK);
+    assert!(out.contains("usage"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,453 @@
+//! Generated crates (`reachc build`): deterministic bytes for every shipped spec; for small
+//! specs, the crate compiles clippy-clean with cargo and its binary runs; and the generated
+//! code computes what the IR interpreter computes.
+//!
+//! Every crate compiles in one shared target directory, `<workspace>/target/reachc-crates`, so
+//! the runtime is compiled once (per profile) for all of them.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use reachc::backend::crate_writer::{compile_crate_in, write_crate, CrateOptions, WrittenCrate};
+use reachc::backend::interp::Interpreter;
+use reachc::backend::prepare;
+use reachc::driver::load;
+use reachc::model::Model;
+use reachc_e2e::{relative, shipped_specs, workspace};
+use reachc_runtime::{Interval, System};
+
+/// The shared target directory of the generated crates.
+fn target_dir() -> PathBuf {
+    workspace().join("target").join("reachc-crates")
+}
+
+/// A fresh scratch directory for one test (removed by [`Scratch`]'s drop).
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new(name: &str) -> Scratch {
+        let dir = std::env::temp_dir().join(format!("reachc-e2e-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Scratch(dir)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn spec(name: &str) -> PathBuf {
+    workspace().join("specs").join(name)
+}
+
+/// Loads `spec` and writes its crate to `out`.
+fn write(spec: &Path, out: &Path) -> WrittenCrate {
+    let mut loaded = load(spec).unwrap_or_else(|e| panic!("{}:\n{e}", relative(spec)));
+    let options = CrateOptions {
+        spec_label: Some(format!("`{}`", relative(spec))),
+        ..CrateOptions::default()
+    };
+    write_crate(&mut loaded, out, &options)
+        .unwrap_or_else(|e| panic!("{}: writing the crate:\n{e}", relative(spec)))
+}
+
+/// Every file under `dir`, relative, sorted, with its bytes.
+fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<(String, Vec<u8>)>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                let rel = path
+                    .strip_prefix(root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .into_owned();
+                out.push((rel, std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+#[test]
+fn every_shipped_spec_generates_the_same_bytes_twice() {
+    let scratch = Scratch::new("bytes");
+    for spec in shipped_specs() {
+        let name = spec.file_stem().unwrap().to_string_lossy().into_owned();
+        let a = scratch.0.join(format!("{name}-a"));
+        let b = scratch.0.join(format!("{name}-b"));
+        let written = write(&spec, &a);
+        write(&spec, &b);
+        let (ta, tb) = (tree(&a), tree(&b));
+        let names: Vec<&str> = ta.iter().map(|(p, _)| p.as_str()).collect();
+        assert_eq!(
+            names,
+            ["Cargo.toml", "README.md", "src/lib.rs", "src/main.rs"],
+            "{}",
+            relative(&spec)
+        );
+        for ((pa, ba), (pb, bb)) in ta.iter().zip(&tb) {
+            assert_eq!(pa, pb);
+            assert!(
+                ba == bb,
+                "{}: {pa} differs between two runs",
+                relative(&spec)
+            );
+        }
+        // The manifest names the package, the binary and the runtime by absolute path.
+        let manifest = String::from_utf8(ta[0].1.clone()).unwrap();
+        assert!(manifest.contains(&format!("name = \"{}\"", written.crate_name)));
+        assert!(manifest.contains("[[bin]]") && manifest.contains("\n[workspace]\n"));
+        let runtime = workspace().join("runtime").canonicalize().unwrap();
+        assert!(
+            manifest.contains(&format!("path = \"{}\"", runtime.display())),
+            "{manifest}"
+        );
+        // Writing again over the first crate replaces it in place.
+        write(&spec, &a);
+        assert_eq!(tree(&a), ta);
+    }
+}
+
+/// Runs `cargo SUBCOMMAND --manifest-path MANIFEST ARGS` (the cargo running the tests) in the
+/// shared target directory.
+fn cargo(subcommand: &str, manifest: &Path, args: &[&str]) -> std::process::Output {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    Command::new(cargo)
+        .arg(subcommand)
+        .arg("--manifest-path")
+        .arg(manifest)
+        .arg("--quiet")
+        .args(args)
+        .env("CARGO_TARGET_DIR", target_dir())
+        .stdin(Stdio::null())
+        .output()
+        .expect("cargo runs")
+}
+
+#[test]
+fn small_crates_compile_clippy_clean_and_run() {
+    let scratch = Scratch::new("compile");
+    for name in ["pendulum", "linear"] {
+        let dir = scratch.0.join(name);
+        let written = write(&spec(&format!("{name}.sde")), &dir);
+        let binary = compile_crate_in(&dir, false, &target_dir())
+            .unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
+        assert!(binary.is_file(), "{}", binary.display());
+        assert!(binary
+            .file_stem()
+            .is_some_and(|s| s.to_string_lossy() == written.crate_name));
+
+        let clippy = cargo(
+            "clippy",
+            &dir.join("Cargo.toml"),
+            &["--all-targets", "--", "-D", "warnings"],
+        );
+        assert!(
+            clippy.status.success(),
+            "{name}: cargo clippy -- -D warnings:\n{}",
+            String::from_utf8_lossy(&clippy.stderr)
+        );
+
+        let results = scratch.0.join(format!("{name}-out"));
+        let run = Command::new(&binary)
+            .arg("-o")
+            .arg(&results)
+            .arg("--quiet")
+            .stdin(Stdio::null())
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{name}: {} exited with {}:\n{}",
+            binary.display(),
+            run.status,
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let mut json: Vec<PathBuf> = std::fs::read_dir(&results)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "json"))
+            .collect();
+        json.sort();
+        assert!(!json.is_empty(), "{name}: no JSON in {}", results.display());
+        for file in json {
+            let text = std::fs::read_to_string(&file).unwrap();
+            serde_json::from_str::<serde_json::Value>(&text)
+                .unwrap_or_else(|e| panic!("{}: not JSON: {e}", file.display()));
+        }
+    }
+}
+
+/// The program replacing a generated crate's `src/main.rs`: for each line of stdin (a point
+/// `x, u, t` then a box `(lo, hi)` per state, input and time, as f64 bit patterns in hex), it
+/// prints drift, `D_x f`, `D_u f`, `G` at the point, then their interval versions on the box
+/// (`lo hi` per entry), all as hex bit patterns on one line.
+fn probe_main(crate_ident: &str, type_name: &str) -> String {
+    format!(
+        r#"use std::io::{{BufRead, Write}};
+
+use reachc_runtime::{{Interval, System}};
+
+fn parse(s: &str) -> f64 {{
+    f64::from_bits(u64::from_str_radix(s, 16).expect("hex"))
+}}
+
+fn main() {{
+    let sys = {crate_ident}::{type_name};
+    let (n, p, m) = (sys.n(), sys.p(), sys.m());
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    for line in std::io::stdin().lock().lines() {{
+        let v: Vec<f64> = line.expect("stdin").split_whitespace().map(parse).collect();
+        let (x, u, t) = (&v[..n], &v[n..n + p], v[n + p]);
+        let b = &v[n + p + 1..];
+        let iv = |k: usize| Interval::new(b[2 * k], b[2 * k + 1]);
+        let xi: Vec<Interval> = (0..n).map(iv).collect();
+        let ui: Vec<Interval> = (n..n + p).map(iv).collect();
+        let ti = iv(n + p);
+        let mut f = vec![0.0; n];
+        let mut jx = vec![0.0; n * n];
+        let mut ju = vec![0.0; n * p];
+        let mut g = vec![0.0; n * m];
+        sys.drift(x, u, t, &mut f);
+        sys.jac_x(x, u, t, &mut jx);
+        sys.jac_u(x, u, t, &mut ju);
+        sys.diffusion(x, t, &mut g);
+        let mut fi = vec![Interval::ZERO; n];
+        let mut jxi = vec![Interval::ZERO; n * n];
+        let mut jui = vec![Interval::ZERO; n * p];
+        let mut gi = vec![Interval::ZERO; n * m];
+        sys.drift_interval(&xi, &ui, ti, &mut fi);
+        sys.jac_x_interval(&xi, &ui, ti, &mut jxi);
+        sys.jac_u_interval(&xi, &ui, ti, &mut jui);
+        sys.diffusion_interval(&xi, ti, &mut gi);
+        let mut words: Vec<String> = Vec::new();
+        for v in f.iter().chain(&jx).chain(&ju).chain(&g) {{
+            words.push(format!("{{:016x}}", v.to_bits()));
+        }}
+        for v in fi.iter().chain(&jxi).chain(&jui).chain(&gi) {{
+            words.push(format!("{{:016x}}", v.lo().to_bits()));
+            words.push(format!("{{:016x}}", v.hi().to_bits()));
+        }}
+        writeln!(out, "{{}}", words.join(" ")).expect("stdout");
+    }}
+}}
+"#
+    )
+}
+
+/// A small deterministic generator (xorshift64*), so failures reproduce.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+}
+
+/// A point and a box around it: states near their initial set, inputs in their box, time in
+/// [0, 6] (past the end of the unicycle's table).
+struct Sample {
+    x: Vec<f64>,
+    u: Vec<f64>,
+    t: f64,
+    xi: Vec<Interval>,
+    ui: Vec<Interval>,
+    ti: Interval,
+}
+
+fn sample(model: &Model, rng: &mut Rng) -> Sample {
+    // A box of width up to 1e-2 holding `v` (min/max: rounding cannot push `v` out).
+    let around = |v: f64, rng: &mut Rng| {
+        let r = rng.uniform(0.0, 1e-2);
+        let lo = v - r * rng.next();
+        Interval::new(lo.min(v), (lo + r).max(v))
+    };
+    let x: Vec<f64> = model
+        .states
+        .iter()
+        .map(|s| {
+            let (lo, hi) = s.bounds.map_or((-2.0, 2.0), |b| (b.lo - 2.0, b.hi + 2.0));
+            rng.uniform(lo, hi)
+        })
+        .collect();
+    let u: Vec<f64> = model
+        .inputs
+        .iter()
+        .map(|i| i.bounds.map_or(0.0, |b| rng.uniform(b.lo, b.hi)))
+        .collect();
+    let t = rng.uniform(0.0, 6.0);
+    Sample {
+        xi: x.iter().map(|&v| around(v, rng)).collect(),
+        ui: u.iter().map(|&v| around(v, rng)).collect(),
+        ti: around(t, rng),
+        x,
+        u,
+        t,
+    }
+}
+
+fn hex(v: f64) -> String {
+    format!("{:016x}", v.to_bits())
+}
+
+/// `a` and `b` agree to 1e-14 relative (NaNs agree with NaNs, infinities must be equal).
+fn close(a: f64, b: f64) -> bool {
+    a == b || (a.is_nan() && b.is_nan()) || (a - b).abs() <= 1e-14 * a.abs().max(b.abs())
+}
+
+/// The distance in ulps between two finite floats of the same sign (u64::MAX otherwise).
+fn ulps(a: f64, b: f64) -> u64 {
+    if a == b {
+        return 0;
+    }
+    if !a.is_finite() || !b.is_finite() {
+        return u64::MAX;
+    }
+    // Map floats to a monotone integer line.
+    let key = |v: f64| {
+        let bits = v.to_bits() as i64;
+        if bits < 0 {
+            i64::MIN - bits
+        } else {
+            bits
+        }
+    };
+    key(a).abs_diff(key(b))
+}
+
+/// Interval results agree within a few ulps (both ends), or both are entire/NaN alike.
+fn near(a: Interval, b: Interval) -> bool {
+    const ULPS: u64 = 8;
+    let end = |x: f64, y: f64| x == y || (x.is_nan() && y.is_nan()) || ulps(x, y) <= ULPS;
+    end(a.lo(), b.lo()) && end(a.hi(), b.hi())
+}
+
+#[test]
+fn generated_code_agrees_with_the_interpreter() {
+    let scratch = Scratch::new("interp");
+    for name in ["pendulum", "unicycle"] {
+        let path = spec(&format!("{name}.sde"));
+        let dir = scratch.0.join(name);
+        let written = write(&path, &dir);
+        let ident = written.crate_name.replace('-', "_");
+        std::fs::write(
+            dir.join("src/main.rs"),
+            probe_main(&ident, &written.type_name),
+        )
+        .unwrap();
+        let binary = compile_crate_in(&dir, false, &target_dir())
+            .unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
+
+        let mut model = load(&path).unwrap().model;
+        let prepared = prepare(&mut model);
+        let interp = Interpreter::new(model.clone(), &prepared.derivatives);
+        let (n, p, m) = (interp.n(), interp.p(), interp.m());
+
+        let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ name.len() as u64);
+        let samples: Vec<Sample> = (0..50).map(|_| sample(&model, &mut rng)).collect();
+        let mut input = String::new();
+        for s in &samples {
+            let mut words: Vec<String> = Vec::new();
+            words.extend(s.x.iter().chain(&s.u).map(|&v| hex(v)));
+            words.push(hex(s.t));
+            for iv in s.xi.iter().chain(&s.ui).chain(std::iter::once(&s.ti)) {
+                words.push(hex(iv.lo()));
+                words.push(hex(iv.hi()));
+            }
+            input.push_str(&words.join(" "));
+            input.push('\n');
+        }
+        let mut child = Command::new(&binary)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(input.as_bytes())
+            .unwrap();
+        let output = child.wait_with_output().unwrap();
+        assert!(
+            output.status.success(),
+            "{name}: probe failed:\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let stdout = String::from_utf8(output.stdout).unwrap();
+        let lines: Vec<&str> = stdout.lines().collect();
+        assert_eq!(lines.len(), samples.len());
+
+        let sizes = [n, n * n, n * p, n * m];
+        let what = ["drift", "jac_x", "jac_u", "diffusion"];
+        for (k, (s, line)) in samples.iter().zip(&lines).enumerate() {
+            let words: Vec<f64> = line
+                .split_whitespace()
+                .map(|w| f64::from_bits(u64::from_str_radix(w, 16).unwrap()))
+                .collect();
+            let total: usize = sizes.iter().sum();
+            assert_eq!(words.len(), 3 * total, "{name}: sample {k}");
+            // The interpreter, in the same order.
+            let mut points: Vec<Vec<f64>> = sizes.iter().map(|&len| vec![0.0; len]).collect();
+            interp.drift(&s.x, &s.u, s.t, &mut points[0]);
+            interp.jac_x(&s.x, &s.u, s.t, &mut points[1]);
+            interp.jac_u(&s.x, &s.u, s.t, &mut points[2]);
+            interp.diffusion(&s.x, s.t, &mut points[3]);
+            let mut boxes: Vec<Vec<Interval>> =
+                sizes.iter().map(|&len| vec![Interval::ZERO; len]).collect();
+            interp.drift_interval(&s.xi, &s.ui, s.ti, &mut boxes[0]);
+            interp.jac_x_interval(&s.xi, &s.ui, s.ti, &mut boxes[1]);
+            interp.jac_u_interval(&s.xi, &s.ui, s.ti, &mut boxes[2]);
+            interp.diffusion_interval(&s.xi, s.ti, &mut boxes[3]);
+
+            let (gen_points, gen_boxes) = words.split_at(total);
+            let mut at = 0;
+            for (part, len) in sizes.iter().enumerate() {
+                for e in 0..*len {
+                    let (g, i) = (gen_points[at + e], points[part][e]);
+                    assert!(
+                        close(g, i),
+                        "{name}: sample {k}: {}[{e}]: generated {g:e}, interpreter {i:e}",
+                        what[part]
+                    );
+                    let gi = Interval::new(gen_boxes[2 * (at + e)], gen_boxes[2 * (at + e) + 1]);
+                    let ii = boxes[part][e];
+                    assert!(
+                        near(gi, ii),
+                        "{name}: sample {k}: {}_interval[{e}]: generated {gi:?}, interpreter \
+                         {ii:?}",
+                        what[part]
+                    );
+                }
+                at += len;
+            }
+            // Enclosure: the point lies in the box, so the box results hold the point results.
+            for (e, &v) in gen_points.iter().enumerate() {
+                let gi = Interval::new(gen_boxes[2 * e], gen_boxes[2 * e + 1]);
+                assert!(
+                    v.is_nan() || gi.contains(v),
+                    "{name}: sample {k}: interval entry {e} = {gi:?} misses {v:e}"
+                );
+            }
+        }
+    }
+}
