@@ -143,3 +143,44 @@ fn unbounded_entries_are_reported() {
     let text = reachc(&["inspect", &spec("unicycle.sde")]);
     assert!(String::from_utf8_lossy(&text.stdout).contains("help: add a `domain"));
 }
+
+#[test]
+fn run_with_the_interpreter_writes_results_and_reports_failures() {
+    let out = std::env::temp_dir().join(format!("reachc-run-{}", std::process::id()));
+    let dir = out.to_str().unwrap();
+    let ok = reachc(&["run", "--backend", "interp", &spec("linear.sde"), "-o", dir]);
+    assert_eq!(ok.status.code(), Some(0), "{}", stderr(&ok));
+    let summary = String::from_utf8_lossy(&ok.stdout);
+    assert!(summary.contains("c = -0.400000"), "{summary}");
+    for name in ["paper_rule", "amgf_rule"] {
+        let json = std::fs::read_to_string(out.join(format!("{name}.json"))).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+        assert_eq!(v["constants"]["c"], -0.4);
+        assert!(out.join(format!("{name}.csv")).is_file());
+    }
+    // The unicycle's atan2 controller has no global contraction rate: a diagnostic, exit 1.
+    let uni = reachc(&[
+        "run",
+        "--backend",
+        "interp",
+        &spec("unicycle.sde"),
+        "-o",
+        dir,
+    ]);
+    assert_eq!(uni.status.code(), Some(1));
+    let err = stderr(&uni);
+    assert!(
+        err.contains("is unbounded over the domain") && err.contains("domain {"),
+        "{err}"
+    );
+    let bad = reachc(&[
+        "run",
+        "--backend",
+        "interp",
+        &spec("linear.sde"),
+        "--analysis",
+        "nope",
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    std::fs::remove_dir_all(&out).unwrap();
+}

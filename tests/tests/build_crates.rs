@@ -14,8 +14,19 @@ use reachc::backend::interp::Interpreter;
 use reachc::backend::prepare;
 use reachc::driver::load;
 use reachc::model::Model;
-use reachc_e2e::{relative, shipped_specs, workspace};
+use reachc_e2e::{relative, shipped_specs, workspace, Rng};
 use reachc_runtime::{Interval, System};
+
+/// Held by each test that runs cargo: the tests share one target directory, and crates of the
+/// same spec (the probe and the real binary of `pendulum`) would overwrite each other's binary.
+static CARGO: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Takes the [`CARGO`] lock (a test that failed while holding it does not poison the others).
+fn cargo_lock() -> std::sync::MutexGuard<'static, ()> {
+    CARGO
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
 
 /// The shared target directory of the generated crates.
 fn target_dir() -> PathBuf {
@@ -136,6 +147,7 @@ fn cargo(subcommand: &str, manifest: &Path, args: &[&str]) -> std::process::Outp
 
 #[test]
 fn small_crates_compile_clippy_clean_and_run() {
+    let _cargo = cargo_lock();
     let scratch = Scratch::new("compile");
     for name in ["pendulum", "linear"] {
         let dir = scratch.0.join(name);
@@ -246,22 +258,6 @@ fn main() {{
     )
 }
 
-/// A small deterministic generator (xorshift64*), so failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 /// A point and a box around it: states near their initial set, inputs in their box, time in
 /// [0, 6] (past the end of the unicycle's table).
 struct Sample {
@@ -315,6 +311,7 @@ fn same(a: f64, b: f64) -> bool {
 
 #[test]
 fn generated_code_agrees_with_the_interpreter() {
+    let _cargo = cargo_lock();
     let scratch = Scratch::new("interp");
     // Every shipped spec but chain1000 (chain10 has the same equations; the big crate alone
     // takes minutes to compile).

@@ -3,7 +3,7 @@
 
 use reachc::backend::{interp::Interpreter, prepare};
 use reachc::driver::load;
-use reachc_e2e::workspace;
+use reachc_e2e::{workspace, Rng};
 use reachc_runtime::engine::{self, AnalysisResult};
 use reachc_runtime::System;
 
@@ -81,23 +81,6 @@ fn linear_constants_psi_and_radius_match_closed_forms_and_reference() {
     }
 }
 
-/// A small deterministic generator (xorshift64*) and Box-Muller normals.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn normal(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
-
 /// Euler-Maruyama paths of the pendulum from random initial states in X0 stay inside the
 /// contraction-based PRS (delta = 1e-3) at t = 1, 2 and 4, and the PRS is not vacuous.
 #[test]
@@ -119,7 +102,7 @@ fn pendulum_prs_covers_monte_carlo_paths() {
             .iter()
             .map(|b| {
                 let (lo, hi) = b.unwrap();
-                lo + (hi - lo) * rng.uniform()
+                rng.uniform(lo, hi)
             })
             .collect();
         let mut t = 0.0;

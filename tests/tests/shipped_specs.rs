@@ -7,23 +7,7 @@ use reachc::analysis::Derivatives;
 use reachc::driver::{check_source, load};
 use reachc::ir::{ExprId, Names, VarValues};
 use reachc::model::Model;
-use reachc_e2e::{relative, shipped_specs};
-
-/// A small deterministic generator (xorshift64*), so failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
+use reachc_e2e::{relative, shipped_specs, Rng};
 
 /// A random point: states in the domain (or within 3 of the initial set where unbounded),
 /// inputs in their box, time in [0, 5].

@@ -58,22 +58,12 @@ pub fn prepare(model: &mut Model) -> Prepared {
         };
         analyses.push(rt::Analysis {
             name: a.name.clone(),
-            method: match a.method {
-                model::Method::Contraction => rt::Method::Contraction,
-                model::Method::Interval => rt::Method::Interval,
-            },
+            method: a.method,
             delta: a.delta,
             horizon: a.horizon,
             step: a.step,
-            radius: match a.radius {
-                model::RadiusRule::Amgf => rt::RadiusRule::Amgf,
-                model::RadiusRule::Paper(Some(eps)) => rt::RadiusRule::Paper(eps),
-                model::RadiusRule::Paper(None) => rt::RadiusRule::PaperOptimal,
-            },
-            integrator: match a.integrator {
-                model::Integrator::Rk4 => rt::Integrator::Rk4,
-                model::Integrator::Euler => rt::Integrator::Euler,
-            },
+            radius: a.radius,
+            integrator: a.integrator,
             outputs: a.outputs.clone(),
             constants,
             constants_error,

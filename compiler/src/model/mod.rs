@@ -8,6 +8,9 @@ pub use check::check;
 use crate::diagnostics::Span;
 use crate::ir::{ExprId, Pool, Table};
 
+// The analysis settings are the runtime's own types: the compiler hands them on unchanged.
+pub use reachc_runtime::system::{Integrator, Method, RadiusRule};
+
 /// A checked spec, ready for analysis and code generation.
 #[derive(Clone, Debug)]
 pub struct Model {
@@ -128,15 +131,6 @@ pub enum UnsafeShape {
     },
 }
 
-/// How the deterministic reachable set is over-approximated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// Contraction-based (Proposition 3): a ball around the nominal trajectory.
-    Contraction,
-    /// Interval-based (Proposition 4): an embedding system on boxes.
-    Interval,
-}
-
 /// The metric `P` for the contraction method.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Metric {
@@ -148,15 +142,6 @@ pub enum Metric {
     Auto,
 }
 
-/// The rule turning `Psi_t` into the stochastic radius.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum RadiusRule {
-    /// The averaged-MGF bound (default; method.md section 5).
-    Amgf,
-    /// The paper's Theorem 1 with a given `eps`, or minimised over `eps` if `None`.
-    Paper(Option<f64>),
-}
-
 /// The inclusion function for interval analysis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Inclusion {
@@ -166,15 +151,6 @@ pub enum Inclusion {
     Jacobian,
     /// Mixed Jacobian, one column at a time.
     Mixed,
-}
-
-/// Time integrator for the nominal trajectory and the embedding system.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Integrator {
-    /// Classical fourth-order Runge-Kutta.
-    Rk4,
-    /// Forward Euler.
-    Euler,
 }
 
 /// An `analysis NAME { ... }` block, with defaults filled in.

@@ -246,12 +246,12 @@ impl Checker<'_> {
                 [a] if a.name.is_none()
                     && matches!(&a.value.kind, ExprKind::Name(id) if id.name == "optimal") =>
                 {
-                    Some(RadiusRule::Paper(None))
+                    Some(RadiusRule::PaperOptimal)
                 }
                 [a] if a.name.as_ref().is_some_and(|n| n.name == "eps") => {
                     let eps = self.constant(&a.value, &[])?;
                     if eps > 0.0 && eps < 1.0 {
-                        Some(RadiusRule::Paper(Some(eps)))
+                        Some(RadiusRule::Paper(eps))
                     } else {
                         self.fail(Diagnostic::error(
                             format!("eps must be in (0, 1), but it is {eps}"),
