@@ -315,7 +315,8 @@ fn generated_code_agrees_with_the_interpreter() {
     let scratch = Scratch::new("interp");
     // Every shipped spec but chain1000 (chain10 has the same equations; the big crate alone
     // takes minutes to compile).
-    for name in [
+    // Plus a spec whose names are Rust keywords (`fn`, `type`, `impl`, `self`, ...).
+    let shipped = [
         "chain10",
         "duffing",
         "linear",
@@ -323,8 +324,15 @@ fn generated_code_agrees_with_the_interpreter() {
         "pendulum",
         "unicycle",
         "vanderpol",
-    ] {
-        let path = spec(&format!("{name}.sde"));
+    ];
+    let keywords = workspace().join("tests/good/rust_keywords.sde");
+    for path in shipped
+        .iter()
+        .map(|n| spec(&format!("{n}.sde")))
+        .chain([keywords])
+    {
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let name = stem.as_str();
         let dir = scratch.0.join(name);
         let written = write(&path, &dir);
         let ident = written.crate_name.replace('-', "_");
