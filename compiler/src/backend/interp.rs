@@ -9,22 +9,47 @@ use crate::analysis::Derivatives;
 use crate::ir::{Arith, ExprId, VarValues};
 use crate::model::Model;
 
+/// The outputs of one `System` method and the nodes they need, in evaluation order (computed
+/// once: the engines call each method at every step).
+#[derive(Debug)]
+struct Plan {
+    roots: Vec<ExprId>,
+    order: Vec<ExprId>,
+}
+
+impl Plan {
+    fn new(model: &Model, roots: Vec<ExprId>) -> Plan {
+        Plan {
+            order: model.pool.reachable(&roots),
+            roots,
+        }
+    }
+}
+
 /// A model evaluated by walking its IR.
 #[derive(Debug)]
 pub struct Interpreter {
     model: Model,
-    jac_x: Vec<ExprId>,
-    jac_u: Vec<ExprId>,
-    diffusion: Vec<ExprId>,
+    drift: Plan,
+    jac_x: Plan,
+    jac_u: Plan,
+    diffusion: Plan,
 }
 
 impl Interpreter {
     /// Wraps a model and its derivatives (from the same pool).
     pub fn new(model: Model, derivatives: &Derivatives) -> Self {
         Interpreter {
-            jac_x: derivatives.jac_x.iter().flatten().copied().collect(),
-            jac_u: derivatives.jac_u.iter().flatten().copied().collect(),
-            diffusion: model.diffusion.iter().flatten().copied().collect(),
+            drift: Plan::new(&model, model.drift.clone()),
+            jac_x: Plan::new(
+                &model,
+                derivatives.jac_x.iter().flatten().copied().collect(),
+            ),
+            jac_u: Plan::new(
+                &model,
+                derivatives.jac_u.iter().flatten().copied().collect(),
+            ),
+            diffusion: Plan::new(&model, model.diffusion.iter().flatten().copied().collect()),
             model,
         }
     }
@@ -34,7 +59,7 @@ impl Interpreter {
         &self.model
     }
 
-    fn eval_into<T: Arith>(&self, roots: &[ExprId], x: &[T], u: &[T], t: T, out: &mut [T]) {
+    fn eval_into<T: Arith>(&self, plan: &Plan, x: &[T], u: &[T], t: T, out: &mut [T]) {
         let vars = VarValues {
             states: x,
             inputs: u,
@@ -43,7 +68,11 @@ impl Interpreter {
             noises: &[],
             time: t,
         };
-        out.copy_from_slice(&self.model.pool.eval(roots, &vars, &self.model.tables));
+        let values =
+            self.model
+                .pool
+                .eval_ordered(&plan.order, &plan.roots, &vars, &self.model.tables);
+        out.copy_from_slice(&values);
     }
 }
 
@@ -61,11 +90,11 @@ impl System for Interpreter {
     }
 
     fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
-        self.eval_into(&self.model.drift, x, u, t, out);
+        self.eval_into(&self.drift, x, u, t, out);
     }
 
     fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]) {
-        self.eval_into(&self.model.drift, x, u, t, out);
+        self.eval_into(&self.drift, x, u, t, out);
     }
 
     fn jac_x(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {

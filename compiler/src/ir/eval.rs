@@ -62,12 +62,27 @@ impl Pool {
         vars: &VarValues<'_, T>,
         tables: &[Table],
     ) -> Vec<T> {
-        let order = self.reachable(roots);
+        self.eval_ordered(&self.reachable(roots), roots, vars, tables)
+    }
+
+    /// [`Pool::eval`] with `order = self.reachable(roots)` supplied by the caller, who evaluates
+    /// the same roots many times (the interpreter backend, once per integration step).
+    pub fn eval_ordered<T: Arith>(
+        &self,
+        order: &[ExprId],
+        roots: &[ExprId],
+        vars: &VarValues<'_, T>,
+        tables: &[Table],
+    ) -> Vec<T> {
+        debug_assert!(
+            order.windows(2).all(|w| w[0] < w[1]),
+            "order must be sorted"
+        );
         // `order` is sorted: a child's value is found by binary search (no per-call allocation
         // proportional to the whole pool).
         let at = |vals: &[T], id: ExprId| vals[order.binary_search(&id).expect("child evaluated")];
         let mut vals: Vec<T> = Vec::with_capacity(order.len());
-        for &id in &order {
+        for &id in order {
             let v = match self.node(id) {
                 Node::Const(c) => T::constant(c.get()),
                 Node::Var(v) => match *v {
