@@ -183,7 +183,7 @@ pub struct Analysis {
     pub outputs: Vec<usize>,
     /// Derived constants (`None` if they could not be bounded; the engine refuses to run then).
     pub constants: Option<Constants>,
-    /// Why `constants` is `None` (e.g. "d f[omega]/d theta is unbounded over the domain"),
+    /// Why `constants` is `None` (e.g. "`d f[omega] / d theta` is unbounded over the domain"),
     /// shown when the analysis is asked to run.
     pub constants_error: Option<String>,
 }

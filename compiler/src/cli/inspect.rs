@@ -1,6 +1,6 @@
 //! `reachc inspect`: the checked model, its Jacobians, atoms and bounds, as text or JSON.
 //!
-//! Both forms come from one [`Report`]. Expressions are printed once per distinct IR node (a
+//! Both forms come from one `Report`. Expressions are printed once per distinct IR node (a
 //! 1000-state chain has a million Jacobian entries but few distinct ones), and the JSON is
 //! streamed from borrowed data rather than built as a tree.
 

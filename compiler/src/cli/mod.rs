@@ -42,7 +42,7 @@ pub enum Command {
     Build {
         /// The .sde spec.
         spec: PathBuf,
-        /// The crate's directory (default: ./<crate name>); replaced if it holds an older one.
+        /// The crate's directory (default: ./CRATE_NAME); replaced if it holds an older one.
         #[arg(short, long)]
         out: Option<PathBuf>,
         /// Only write the crate; do not run cargo.
@@ -62,7 +62,7 @@ pub enum Command {
         /// Generated and compiled code, or the IR interpreter (no cargo needed).
         #[arg(long, value_enum, default_value = "compiled")]
         backend: run::Backend,
-        /// Directory for <analysis>.json and <analysis>.csv (default: reachc-out).
+        /// Directory for ANALYSIS.json and ANALYSIS.csv (default: reachc-out).
         #[arg(short, long)]
         out: Option<PathBuf>,
     },

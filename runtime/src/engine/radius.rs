@@ -52,17 +52,11 @@ fn expm1_over(a: f64, h: Interval) -> Interval {
 }
 
 /// One exact step of `Psi' = 2 c Psi + sigma^2` over a step of length `h` on which `c` and
-/// `sigma` are constant: `Psi(t+h) = Psi(t) e^(2ch) + sigma^2 expm1(2ch) / (2c)`.
+/// `sigma` are constant: `Psi(t+h) = Psi(t) e^(2ch) + sigma^2 expm1(2ch) / (2c)`, written per
+/// step so piecewise-constant rates only need another `(c, sigma)` per step; `Psi(t+h)` is
+/// increasing in `Psi(t)`, so an enclosure of `Psi(t)` maps to one of `Psi(t+h)`.
 ///
-/// Written per step (rather than with the closed form) so that piecewise-constant `c_t`,
-/// `sigma_t` only need a different `(c, sigma)` per step. `Psi(t+h)` is increasing in `Psi(t)`,
-/// so feeding an enclosure of `Psi(t)` gives an enclosure of `Psi(t+h)`.
-#[cfg_attr(not(test), allow(dead_code))]
-pub(crate) fn psi_step(psi: Interval, c: f64, sigma: f64, h: Interval) -> Interval {
-    PsiStep::new(c, sigma, h).apply(psi)
-}
-
-/// The affine map `Psi -> Psi decay + gain` of one step, kept so that equal consecutive steps
+/// The affine map `Psi -> Psi decay + gain` of one step is kept so that equal consecutive steps
 /// (the usual case: constant rates, uniform grid) reuse it instead of recomputing `exp` and
 /// `expm1` in interval arithmetic.
 #[derive(Clone, Copy, Debug)]
@@ -241,7 +235,7 @@ mod tests {
         let mut psi = Interval::ZERO;
         let h = 0.01;
         for k in 1..=400 {
-            psi = psi_step(psi, c, sigma, Interval::point(h));
+            psi = PsiStep::new(c, sigma, Interval::point(h)).apply(psi);
             let t = k as f64 * h;
             let exact = sigma * sigma * (2.0 * c * t).exp_m1() / (2.0 * c);
             assert!(psi.lo() <= exact * (1.0 + 1e-15) && exact * (1.0 - 1e-15) <= psi.hi());
@@ -251,7 +245,7 @@ mod tests {
 
     #[test]
     fn psi_at_zero_rate_is_linear() {
-        let psi = psi_step(Interval::ZERO, 0.0, 3.0, Interval::point(0.5));
+        let psi = PsiStep::new(0.0, 3.0, Interval::point(0.5)).apply(Interval::ZERO);
         assert!(psi.contains(4.5));
     }
 
