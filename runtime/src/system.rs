@@ -137,6 +137,30 @@ pub enum RadiusRule {
     PaperOptimal,
 }
 
+/// The inclusion function of the drift used by the interval method's embedding system.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Inclusion {
+    /// Natural inclusion: `System::drift_interval` on the (pinned) box and the input box.
+    Natural,
+    /// Jacobian-based (mean-value) inclusion around the centre `(xc, uc)` of the pinned box and
+    /// the input box: `f(xc, uc) + J_x([x], U) ([x] - xc) + J_u([x], U) (U - uc)`.
+    #[default]
+    Jacobian,
+    /// Mixed Jacobian (one column at a time, as immrax's `mjacif`).
+    Mixed,
+}
+
+impl Inclusion {
+    /// Its name in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Inclusion::Natural => "natural",
+            Inclusion::Jacobian => "jacobian",
+            Inclusion::Mixed => "mixed",
+        }
+    }
+}
+
 /// Time integrator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrator {
@@ -179,8 +203,13 @@ pub struct Analysis {
     pub radius: RadiusRule,
     /// Integrator.
     pub integrator: Integrator,
+    /// Inclusion function of the interval method.
+    pub inclusion: Inclusion,
     /// States to report (indices).
     pub outputs: Vec<usize>,
+    /// The coordinate transform `y = T x` of the interval method (n x n row-major), if given.
+    /// An engine that cannot honour it must refuse the analysis rather than ignore it.
+    pub transform: Option<Vec<f64>>,
     /// Derived constants (`None` if they could not be bounded; the engine refuses to run then).
     pub constants: Option<Constants>,
     /// Why `constants` is `None` (e.g. "`d f[omega] / d theta` is unbounded over the domain"),

@@ -22,8 +22,8 @@ use std::collections::BTreeMap;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
 use reachc_runtime::system::{
-    Analysis, Constants, InitialBall, InitialSet, Integrator, Method, ModelInfo, RadiusRule,
-    UnsafeSet, UnsafeShape,
+    Analysis, Constants, Inclusion, InitialBall, InitialSet, Integrator, Method, ModelInfo,
+    RadiusRule, UnsafeSet, UnsafeShape,
 };
 
 use super::mangle;
@@ -783,7 +783,13 @@ impl InfoWriter {
             Integrator::Rk4 => quote!(Integrator::Rk4),
             Integrator::Euler => quote!(Integrator::Euler),
         };
+        let inclusion = match a.inclusion {
+            Inclusion::Natural => quote!(Inclusion::Natural),
+            Inclusion::Jacobian => quote!(Inclusion::Jacobian),
+            Inclusion::Mixed => quote!(Inclusion::Mixed),
+        };
         let outputs = indices(&a.outputs);
+        let transform = option(&a.transform, |t| self.floats(t));
         let consts = option(&a.constants, |c| self.constants(c));
         let error = option(&a.constants_error, |s| string(s));
         quote! {
@@ -795,7 +801,9 @@ impl InfoWriter {
                 step: #step,
                 radius: #radius,
                 integrator: #integrator,
+                inclusion: #inclusion,
                 outputs: #outputs,
+                transform: #transform,
                 constants: #consts,
                 constants_error: #error,
             }

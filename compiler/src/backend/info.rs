@@ -64,7 +64,12 @@ pub fn prepare(model: &mut Model) -> Prepared {
             step: a.step,
             radius: a.radius,
             integrator: a.integrator,
+            inclusion: a.inclusion,
             outputs: a.outputs.clone(),
+            transform: a
+                .transform
+                .as_ref()
+                .map(|t| t.iter().flatten().copied().collect()),
             constants,
             constants_error,
         });

@@ -9,7 +9,7 @@ use crate::diagnostics::Span;
 use crate::ir::{ExprId, Pool, Table};
 
 // The analysis settings are the runtime's own types: the compiler hands them on unchanged.
-pub use reachc_runtime::system::{Integrator, Method, RadiusRule};
+pub use reachc_runtime::system::{Inclusion, Integrator, Method, RadiusRule};
 
 /// A checked spec, ready for analysis and code generation.
 #[derive(Clone, Debug)]
@@ -140,17 +140,6 @@ pub enum Metric {
     Matrix(Vec<Vec<f64>>),
     /// Synthesised by the compiler.
     Auto,
-}
-
-/// The inclusion function for interval analysis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Inclusion {
-    /// Interval evaluation of the simplified expression.
-    Natural,
-    /// `f(xc) + [J]([x] - xc)`.
-    Jacobian,
-    /// Mixed Jacobian, one column at a time.
-    Mixed,
 }
 
 /// An `analysis NAME { ... }` block, with defaults filled in.

@@ -4,19 +4,22 @@
 //! stochastic ball `B_P(r_t)`, `r_t = sqrt(Psi_t kappa(n, delta))` (Theorem 2). This module
 //! implements the contraction-based engine (Proposition 3), where `Rbar_t` is itself a P-ball
 //! `B_P(x*_t, R_t)` around the nominal trajectory, so the PRS is the P-ball
-//! `B_P(x*_t, R_t + r_t)`. The interval-based engine (Proposition 4) is not implemented yet.
+//! `B_P(x*_t, R_t + r_t)`. The interval-based engine (Proposition 4, [`run_interval`]) propagates
+//! a box by an embedding system instead; its PRS is `box (+) B_P(r_t)`.
 //!
 //! What is rigorous: the constants come certified from the compiler; `kappa`, `Psi_t`, `r1`,
 //! `R_t`, `r_t` and the safety margins are computed in outward-rounded interval arithmetic with
 //! the conservative end kept. What is not: the nominal trajectory is integrated numerically
 //! (RK4 or Euler) and taken as exact. The result records this in [`Validation`].
 
+mod interval;
 mod linalg;
 mod nominal;
 mod radius;
 mod result;
 mod safety;
 
+pub use interval::run_interval;
 pub use radius::MAX_VERTEX_COORDS;
 pub use result::{
     AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, StepRecord, UnsafeReport,
@@ -30,7 +33,8 @@ use std::fmt;
 /// Why an analysis could not run.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RunError {
-    /// The analysis asks for something this engine does not do (yet), e.g. the interval method.
+    /// The analysis asks for something this engine does not do (yet), e.g. a coordinate
+    /// transform for the interval method.
     Unsupported(String),
     /// The compiler could not bound the constants of Assumption 1.
     NoConstants(String),
@@ -55,19 +59,16 @@ impl std::error::Error for RunError {}
 
 /// Runs one analysis of the model.
 ///
-/// Only [`Method::Contraction`] is supported; [`Method::Interval`] gives
-/// [`RunError::Unsupported`]. The constants must be present ([`RunError::NoConstants`]).
+/// [`Method::Interval`] runs [`run_interval`] with the default [`Inclusion::Jacobian`] (an
+/// analysis with a coordinate transform gives [`RunError::Unsupported`]). The constants must be
+/// present ([`RunError::NoConstants`]).
 pub fn run(
     sys: &dyn System,
     info: &ModelInfo,
     analysis: &Analysis,
 ) -> Result<AnalysisResult, RunError> {
     if analysis.method == Method::Interval {
-        return Err(RunError::Unsupported(format!(
-            "analysis `{}` uses the interval method (Proposition 4), which this runtime does not \
-             implement yet; use `method = contraction`",
-            analysis.name
-        )));
+        return interval::run_interval(sys, info, analysis, analysis.inclusion);
     }
     let consts = analysis.constants.as_ref().ok_or_else(|| {
         let why = analysis.constants_error.as_deref().unwrap_or(
@@ -193,6 +194,8 @@ pub fn run(
                 center: x.clone(),
                 radius: det,
                 metric: "constants.metric",
+                lo: None,
+                hi: None,
             },
             nominal: x,
             r_t,
@@ -221,6 +224,7 @@ pub fn run(
         model: info.name.clone(),
         analysis: analysis.name.clone(),
         method: "contraction".into(),
+        inclusion: None,
         delta: analysis.delta,
         horizon: analysis.horizon,
         step: analysis.step,
@@ -260,13 +264,17 @@ pub fn run(
     })
 }
 
-/// Whether `x` lies in the PRS `B_P(x*_t, R_t + r_t)` at report step `step_index`.
+/// Whether `x` lies in the PRS `B_P(x*_t, R_t + r_t)` at report step `step_index` (for an
+/// interval-method result: in `box (+) B_P(r_t)`).
 ///
 /// Decided in interval arithmetic and conservatively: `true` only if `|x - x*_t|_P^2` is
 /// certainly at most the squared PRS radius (a point within rounding of the boundary counts as
 /// outside). Panics if `step_index` is out of range or `x` has the wrong length.
 pub fn contains(result: &AnalysisResult, step_index: usize, x: &[f64]) -> bool {
     let st = &result.steps[step_index];
+    if st.det_set.lo.is_some() {
+        return interval::contains(result, step_index, x);
+    }
     let n = st.nominal.len();
     assert_eq!(x.len(), n, "contains: x has the wrong dimension");
     let d: Vec<Interval> = x

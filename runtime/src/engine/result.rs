@@ -13,8 +13,12 @@ pub struct AnalysisResult {
     pub model: String,
     /// The analysis' name.
     pub analysis: String,
-    /// Deterministic-set method (`"contraction"`).
+    /// Deterministic-set method (`"contraction"` or `"interval"`).
     pub method: String,
+    /// Inclusion function of the interval method (`"natural"` or `"jacobian"`); absent (not
+    /// serialised) for the contraction method.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inclusion: Option<String>,
     /// Probability level: each PRS holds `X_t` with probability `>= 1 - delta`.
     pub delta: f64,
     /// Final time.
@@ -82,7 +86,7 @@ pub struct RadiusRuleReport {
 pub struct StepRecord {
     /// Time.
     pub t: f64,
-    /// Nominal state `x*_t` (all states).
+    /// Nominal state `x*_t` (all states). Interval method: the centre of the box.
     pub nominal: Vec<f64>,
     /// Deterministic reachable set `Rbar_t`.
     pub det_set: DetSet,
@@ -94,7 +98,8 @@ pub struct StepRecord {
     pub c: f64,
     /// Noise level on the step ending here.
     pub sigma: f64,
-    /// Radius of the PRS `B_P(x*_t, R_t + r_t)`.
+    /// Radius of the PRS `B_P(x*_t, R_t + r_t)`. Interval method: radius of a P-ball around the
+    /// box centre containing the PRS `box (+) B_P(r_t)` (coarser than the PRS).
     pub prs_radius: f64,
     /// Safety margin per unsafe set (same order as `unsafe_sets`; `> 0` means shown safe).
     pub margins: Vec<f64>,
@@ -103,14 +108,21 @@ pub struct StepRecord {
 /// A deterministic reachable set.
 #[derive(Clone, Debug, Serialize)]
 pub struct DetSet {
-    /// `"p_ball"`: `{x : |x - center|_P <= radius}`.
+    /// `"p_ball"`: `{x : |x - center|_P <= radius}`; `"box"`: `{x : lo <= x <= hi}` (interval
+    /// method), with `center`, `radius` a P-ball containing the box.
     pub shape: &'static str,
     /// Centre.
     pub center: Vec<f64>,
-    /// Radius `R_t` (upper bound).
+    /// Radius `R_t` (upper bound); for a box, an upper bound of its P-radius around `center`.
     pub radius: f64,
     /// Where the metric is: `"constants.metric"`.
     pub metric: &'static str,
+    /// Lower corner of the box (shape `"box"` only; not serialised otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lo: Option<Vec<f64>>,
+    /// Upper corner of the box (shape `"box"` only; not serialised otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hi: Option<Vec<f64>>,
 }
 
 /// One unsafe set's verdict.
@@ -179,10 +191,46 @@ impl AnalysisResult {
         }
     }
 
+    /// Whether the deterministic sets are boxes (interval method).
+    fn has_boxes(&self) -> bool {
+        self.steps.first().is_some_and(|s| s.det_set.lo.is_some())
+    }
+
     /// CSV with header `t,<output state names...>,det_radius,r_t,psi,c,sigma,prs_radius` and one
-    /// row per report time (the nominal state in the state columns).
+    /// row per report time (the nominal state in the state columns). For the interval method
+    /// (box sets) the header is `t,<state>_lo,<state>_hi,...,r_t,psi` instead.
     pub fn write_csv(&self, w: &mut dyn Write) -> io::Result<()> {
         let shown = self.shown_states();
+        if self.has_boxes() {
+            let mut header = String::from("t");
+            for &i in &shown {
+                let _ = write!(
+                    header,
+                    ",{},{}",
+                    csv_field(&format!("{}_lo", self.states[i])),
+                    csv_field(&format!("{}_hi", self.states[i]))
+                );
+            }
+            header.push_str(",r_t,psi");
+            writeln!(w, "{header}")?;
+            for s in &self.steps {
+                let mut row = format!("{}", s.t);
+                let (lo, hi) = (
+                    s.det_set.lo.as_deref().unwrap_or(&[]),
+                    s.det_set.hi.as_deref().unwrap_or(&[]),
+                );
+                for &i in &shown {
+                    let (a, b) = (
+                        lo.get(i).copied().unwrap_or(f64::NAN),
+                        hi.get(i).copied().unwrap_or(f64::NAN),
+                    );
+                    let _ = write!(row, ",{a},{b}");
+                }
+                let _ = write!(row, ",{},{}", s.r_t, s.psi);
+                writeln!(w, "{row}")?;
+            }
+            return Ok(());
+        }
         let mut header = String::from("t");
         for &i in &shown {
             header.push(',');
@@ -240,23 +288,27 @@ impl AnalysisResult {
             self.delta,
             self.kappa
         );
-        let _ = writeln!(
-            s,
-            "  r1 = {:.6} ({}), r2 = {}",
-            self.r1, self.r1_how, self.r2
-        );
-        let _ = writeln!(
-            s,
-            "  {:>10}  {:>12}  {:>12}  {:>12}",
-            "t", "R_t", "r_t", "PRS radius"
-        );
-        for i in summary_indices(self.steps.len()) {
-            let st = &self.steps[i];
+        if self.has_boxes() {
+            self.summary_boxes(&mut s);
+        } else {
             let _ = writeln!(
                 s,
-                "  {:>10.4}  {:>12.6}  {:>12.6}  {:>12.6}",
-                st.t, st.det_set.radius, st.r_t, st.prs_radius
+                "  r1 = {:.6} ({}), r2 = {}",
+                self.r1, self.r1_how, self.r2
             );
+            let _ = writeln!(
+                s,
+                "  {:>10}  {:>12}  {:>12}  {:>12}",
+                "t", "R_t", "r_t", "PRS radius"
+            );
+            for i in summary_indices(self.steps.len()) {
+                let st = &self.steps[i];
+                let _ = writeln!(
+                    s,
+                    "  {:>10.4}  {:>12.6}  {:>12.6}  {:>12.6}",
+                    st.t, st.det_set.radius, st.r_t, st.prs_radius
+                );
+            }
         }
         if self.unsafe_sets.is_empty() {
             let _ = writeln!(s, "  safety: no unsafe sets");
@@ -291,6 +343,42 @@ impl AnalysisResult {
             self.validated.not_validated.join("; ")
         );
         s
+    }
+}
+
+impl AnalysisResult {
+    /// The table of the summary for box sets: per shown state the box `[lo, hi]`, and `r_t`.
+    fn summary_boxes(&self, s: &mut String) {
+        let shown = self.shown_states();
+        let _ = writeln!(
+            s,
+            "  deterministic sets: boxes of the embedding system ({} inclusion); PRS = box (+) \
+             B_P(r_t)",
+            self.inclusion.as_deref().unwrap_or("?")
+        );
+        let mut head = format!("  {:>10}", "t");
+        for &i in &shown {
+            let _ = write!(head, "  {:>27}", format!("{} [lo, hi]", self.states[i]));
+        }
+        let _ = write!(head, "  {:>12}", "r_t");
+        let _ = writeln!(s, "{head}");
+        for k in summary_indices(self.steps.len()) {
+            let st = &self.steps[k];
+            let mut row = format!("  {:>10.4}", st.t);
+            let (lo, hi) = (
+                st.det_set.lo.as_deref().unwrap_or(&[]),
+                st.det_set.hi.as_deref().unwrap_or(&[]),
+            );
+            for &i in &shown {
+                let (a, b) = (
+                    lo.get(i).copied().unwrap_or(f64::NAN),
+                    hi.get(i).copied().unwrap_or(f64::NAN),
+                );
+                let _ = write!(row, "  [{a:>12.6}, {b:>12.6}]");
+            }
+            let _ = write!(row, "  {:>12.6}", st.r_t);
+            let _ = writeln!(s, "{row}");
+        }
     }
 }
 
