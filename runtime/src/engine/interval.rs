@@ -25,12 +25,10 @@
 //! integrated numerically (RK4 or Euler, no remainder bound), so the box is an enclosure only
 //! up to the time-discretisation error. The result says so.
 
-use super::result::{
-    AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, StepRecord, Validation,
-};
+use super::result::{AnalysisResult, ConstantsReport, DetSet, StepRecord, Validation};
 use super::{integrator_name, linalg, nominal, radius, safety, validate, verdicts, RunError};
 use crate::interval::Interval;
-use crate::system::{Analysis, Inclusion, Integrator, ModelInfo, RadiusRule, System};
+use crate::system::{Analysis, Inclusion, Integrator, ModelInfo, System};
 
 /// Runs an interval-method analysis with the given inclusion function.
 ///
@@ -115,21 +113,7 @@ pub fn run_interval(
         .collect();
     let u_center: Vec<f64> = ubox.iter().map(|u| u.mid()).collect();
 
-    let kappa = crate::kappa::kappa(n, analysis.delta, analysis.radius);
-    let radius_rule = match analysis.radius {
-        RadiusRule::Amgf => RadiusRuleReport {
-            rule: "amgf".into(),
-            eps: None,
-        },
-        RadiusRule::Paper(eps) => RadiusRuleReport {
-            rule: "paper".into(),
-            eps: Some(eps),
-        },
-        RadiusRule::PaperOptimal => RadiusRuleReport {
-            rule: "paper_optimal".into(),
-            eps: Some(crate::kappa::kappa_paper_optimal(n, analysis.delta).1),
-        },
-    };
+    let (kappa, radius_rule) = radius::stochastic_factor(n, analysis);
 
     // The embedding system (not validated in time).
     let grid = nominal::time_grid(analysis.horizon, analysis.step);
@@ -152,30 +136,15 @@ pub fn run_interval(
             ))
         })?;
 
-    let checks = info
-        .unsafe_sets
-        .iter()
-        .map(|s| safety::Check::new(s, n, &chol, &p_inv))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(RunError::Invalid)?;
+    let checks =
+        safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv).map_err(RunError::Invalid)?;
 
-    let kappa_iv = Interval::point(kappa);
-    let mut psi = Interval::ZERO;
-    let mut psi_map: Option<radius::PsiStep> = None;
+    let mut stochastic = radius::Stochastic::new(kappa);
     let mut steps = Vec::with_capacity(grid.len());
     for (k, (&t, (blo, bhi))) in grid.iter().zip(boxes).enumerate() {
         let (c_k, sigma_k) = (consts.c, consts.sigma);
-        if k > 0 {
-            let h = Interval::point(t) - Interval::point(grid[k - 1]);
-            let map = match psi_map {
-                Some(m) if m.matches(c_k, sigma_k, h) => m,
-                _ => radius::PsiStep::new(c_k, sigma_k, h),
-            };
-            psi = map.apply(psi);
-            psi_map = Some(map);
-        }
-        let psi_hi = psi.hi();
-        let r_t = (Interval::point(psi_hi) * kappa_iv).sqrt().hi();
+        let prev = k.checked_sub(1).map(|j| grid[j]);
+        let (psi_hi, r_t) = stochastic.advance(prev, t, c_k, sigma_k);
         let ivs: Vec<Interval> = blo
             .iter()
             .zip(&bhi)

@@ -131,21 +131,7 @@ pub fn run(
     };
 
     // Stochastic factor, computed once.
-    let kappa = crate::kappa::kappa(n, analysis.delta, analysis.radius);
-    let radius_rule = match analysis.radius {
-        RadiusRule::Amgf => RadiusRuleReport {
-            rule: "amgf".into(),
-            eps: None,
-        },
-        RadiusRule::Paper(eps) => RadiusRuleReport {
-            rule: "paper".into(),
-            eps: Some(eps),
-        },
-        RadiusRule::PaperOptimal => RadiusRuleReport {
-            rule: "paper_optimal".into(),
-            eps: Some(crate::kappa::kappa_paper_optimal(n, analysis.delta).1),
-        },
-    };
+    let (kappa, radius_rule) = radius::stochastic_factor(n, analysis);
 
     // Nominal trajectory (not validated).
     let grid = nominal::time_grid(analysis.horizon, analysis.step);
@@ -158,33 +144,18 @@ pub fn run(
         })?;
 
     // Safety checks, precomputed (they depend on P only).
-    let checks = info
-        .unsafe_sets
-        .iter()
-        .map(|s| safety::Check::new(s, n, &chol, &p_inv))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(RunError::Invalid)?;
+    let checks =
+        safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv).map_err(RunError::Invalid)?;
 
-    let kappa_iv = Interval::point(kappa);
-    let mut psi = Interval::ZERO;
-    let mut psi_map: Option<radius::PsiStep> = None;
+    let mut stochastic = radius::Stochastic::new(kappa);
     let mut steps = Vec::with_capacity(grid.len());
     for (k, (&t, x)) in grid.iter().zip(traj).enumerate() {
         // c_t, sigma_t on the step ending at t: constant for now; the Psi recursion and the
         // records are already per step so that piecewise-constant rates can be plugged in.
         let (c_k, sigma_k) = (consts.c, consts.sigma);
-        if k > 0 {
-            let h = Interval::point(t) - Interval::point(grid[k - 1]);
-            let map = match psi_map {
-                Some(m) if m.matches(c_k, sigma_k, h) => m,
-                _ => radius::PsiStep::new(c_k, sigma_k, h),
-            };
-            psi = map.apply(psi);
-            psi_map = Some(map);
-        }
-        let psi_hi = psi.hi();
+        let prev = k.checked_sub(1).map(|j| grid[j]);
+        let (psi_hi, r_t) = stochastic.advance(prev, t, c_k, sigma_k);
         let det = radius::det_radius(consts.c, rho, r1, r2, t);
-        let r_t = (Interval::point(psi_hi) * kappa_iv).sqrt().hi();
         let prs = (Interval::point(det) + Interval::point(r_t)).hi();
         let margins = checks.iter().map(|c| c.margin(&x, prs)).collect();
         steps.push(StepRecord {

@@ -225,6 +225,64 @@ pub(crate) fn r1_bound(p: &[f64], half: &[f64]) -> f64 {
     Interval::point(max_sq.max(0.0)).sqrt().hi()
 }
 
+/// `kappa(n, delta)` of the analysis' radius rule, and the rule as reported (with the
+/// minimising `eps` for `paper(optimal)`).
+pub(crate) fn stochastic_factor(
+    n: usize,
+    analysis: &crate::system::Analysis,
+) -> (f64, super::result::RadiusRuleReport) {
+    use crate::system::RadiusRule;
+    let kappa = crate::kappa::kappa(n, analysis.delta, analysis.radius);
+    let (rule, eps) = match analysis.radius {
+        RadiusRule::Amgf => ("amgf", None),
+        RadiusRule::Paper(eps) => ("paper", Some(eps)),
+        RadiusRule::PaperOptimal => (
+            "paper_optimal",
+            Some(crate::kappa::kappa_paper_optimal(n, analysis.delta).1),
+        ),
+    };
+    let report = super::result::RadiusRuleReport {
+        rule: rule.into(),
+        eps,
+    };
+    (kappa, report)
+}
+
+/// `Psi_t` and `r_t = sqrt(Psi_t kappa)` along the report grid: exact per-step Psi, reusing the
+/// step map while the rates and the step length repeat; upper ends kept.
+pub(crate) struct Stochastic {
+    kappa: Interval,
+    psi: Interval,
+    map: Option<PsiStep>,
+}
+
+impl Stochastic {
+    /// Starts at `Psi_0 = 0`.
+    pub(crate) fn new(kappa: f64) -> Stochastic {
+        Stochastic {
+            kappa: Interval::point(kappa),
+            psi: Interval::ZERO,
+            map: None,
+        }
+    }
+
+    /// Advances `Psi` over `[prev, t]` with the rates `(c, sigma)` of that step (nothing at the
+    /// first report time, `prev = None`); returns upper bounds of `(Psi_t, r_t)`.
+    pub(crate) fn advance(&mut self, prev: Option<f64>, t: f64, c: f64, sigma: f64) -> (f64, f64) {
+        if let Some(prev) = prev {
+            let h = Interval::point(t) - Interval::point(prev);
+            let map = match self.map {
+                Some(m) if m.matches(c, sigma, h) => m,
+                _ => PsiStep::new(c, sigma, h),
+            };
+            self.psi = map.apply(self.psi);
+            self.map = Some(map);
+        }
+        let psi = self.psi.hi();
+        (psi, (Interval::point(psi) * self.kappa).sqrt().hi())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

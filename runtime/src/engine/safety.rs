@@ -47,6 +47,16 @@ impl Check {
         }
     }
 
+    /// Precomputes the checks of every unsafe set (see [`Check::new`]).
+    pub(crate) fn all(
+        sets: &[UnsafeSet],
+        n: usize,
+        l: &[Interval],
+        p_inv: &[Interval],
+    ) -> Result<Vec<Check>, String> {
+        sets.iter().map(|s| Check::new(s, n, l, p_inv)).collect()
+    }
+
     /// Precomputes the check; `l` is the interval Cholesky factor of `P`, `p_inv` an enclosure
     /// of `P^-1`.
     pub(crate) fn new(
