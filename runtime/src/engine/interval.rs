@@ -26,7 +26,7 @@
 //! up to the time-discretisation error. The result says so.
 
 use super::result::{AnalysisResult, ConstantsReport, DetSet, StepRecord, Validation};
-use super::{integrator_name, linalg, nominal, radius, safety, validate, verdicts, RunError};
+use super::{integrator_name, nominal, radius, safety, verdicts, RunError};
 use crate::interval::Interval;
 use crate::system::{Analysis, Inclusion, Integrator, ModelInfo, System};
 
@@ -48,34 +48,14 @@ pub fn run_interval(
             analysis.name
         )));
     }
-    let consts = analysis.constants.as_ref().ok_or_else(|| {
-        let why = analysis.constants_error.as_deref().unwrap_or(
-            "the compiler could not bound them; see its diagnostics (a `domain` box may help)",
-        );
-        RunError::NoConstants(format!(
-            "analysis `{}` has no constants (c, sigma) for the stochastic radius: {why}",
-            analysis.name
-        ))
-    })?;
-    let n = sys.n();
-    let p = sys.p();
-    validate(info, analysis, n, p)?;
+    let super::Setup {
+        consts,
+        n,
+        p,
+        chol,
+        p_inv,
+    } = super::setup(sys, info, analysis, &["c", "sigma"])?;
     let metric = &consts.metric;
-    if metric.len() != n * n {
-        return Err(RunError::Invalid(format!(
-            "the metric has {} entries, expected {n} x {n}",
-            metric.len()
-        )));
-    }
-    for (what, v) in [("c", consts.c), ("sigma", consts.sigma)] {
-        if !v.is_finite() {
-            return Err(RunError::NoConstants(format!("{what} = {v} is not finite")));
-        }
-    }
-    let chol = linalg::cholesky(&linalg::to_intervals(metric), n).ok_or_else(|| {
-        RunError::Invalid("the metric P is not (certifiably) symmetric positive definite".into())
-    })?;
-    let p_inv = linalg::inverse(&chol, n);
     // Upper bounds of sqrt((P^-1)_ii): B_P(r) lies in the box |d_i| <= r w_i.
     let w: Vec<f64> = (0..n).map(|i| p_inv[i * n + i].sqrt().hi()).collect();
 

@@ -27,7 +27,7 @@ pub use result::{
 };
 
 use crate::interval::Interval;
-use crate::system::{Analysis, Integrator, Method, ModelInfo, RadiusRule, System};
+use crate::system::{Analysis, Constants, Integrator, Method, ModelInfo, RadiusRule, System};
 use std::fmt;
 
 /// Why an analysis could not run.
@@ -57,30 +57,35 @@ impl fmt::Display for RunError {
 
 impl std::error::Error for RunError {}
 
-/// Runs one analysis of the model.
-///
-/// [`Method::Interval`] runs [`run_interval`] with the default [`Inclusion::Jacobian`] (an
-/// analysis with a coordinate transform gives [`RunError::Unsupported`]). The constants must be
-/// present ([`RunError::NoConstants`]).
-pub fn run(
+/// What both engines check and derive before stepping: the constants (only those `used` must be
+/// finite), the dimensions, and the rigorous Cholesky factor of `P` with an enclosure of `P^-1`.
+pub(crate) struct Setup<'a> {
+    pub(crate) consts: &'a Constants,
+    pub(crate) n: usize,
+    pub(crate) p: usize,
+    pub(crate) chol: Vec<Interval>,
+    pub(crate) p_inv: Vec<Interval>,
+}
+
+/// Builds the [`Setup`] of `analysis`; `used` names the constants the engine needs
+/// (`"c"`, `"sigma"`, `"rho"`).
+pub(crate) fn setup<'a>(
     sys: &dyn System,
     info: &ModelInfo,
-    analysis: &Analysis,
-) -> Result<AnalysisResult, RunError> {
-    if analysis.method == Method::Interval {
-        return interval::run_interval(sys, info, analysis, analysis.inclusion);
-    }
+    analysis: &'a Analysis,
+    used: &[&str],
+) -> Result<Setup<'a>, RunError> {
     let consts = analysis.constants.as_ref().ok_or_else(|| {
         let why = analysis.constants_error.as_deref().unwrap_or(
             "the compiler could not bound them; see its diagnostics (a `domain` box may help)",
         );
         RunError::NoConstants(format!(
-            "analysis `{}` has no contraction constants (c, sigma, rho): {why}",
-            analysis.name
+            "analysis `{}` has no constants ({}): {why}",
+            analysis.name,
+            used.join(", ")
         ))
     })?;
-    let n = sys.n();
-    let p = sys.p();
+    let (n, p) = (sys.n(), sys.p());
     validate(info, analysis, n, p)?;
     let metric = &consts.metric;
     if metric.len() != n * n {
@@ -94,7 +99,7 @@ pub fn run(
         ("sigma", consts.sigma),
         ("rho", consts.rho),
     ] {
-        if !v.is_finite() {
+        if used.contains(&what) && !v.is_finite() {
             return Err(RunError::NoConstants(format!("{what} = {v} is not finite")));
         }
     }
@@ -103,6 +108,36 @@ pub fn run(
         RunError::Invalid("the metric P is not (certifiably) symmetric positive definite".into())
     })?;
     let p_inv = linalg::inverse(&chol, n);
+    Ok(Setup {
+        consts,
+        n,
+        p,
+        chol,
+        p_inv,
+    })
+}
+
+/// Runs one analysis of the model.
+///
+/// [`Method::Interval`] runs [`run_interval`] with the default [`Inclusion::Jacobian`] (an
+/// analysis with a coordinate transform gives [`RunError::Unsupported`]). The constants must be
+/// present ([`RunError::NoConstants`]).
+pub fn run(
+    sys: &dyn System,
+    info: &ModelInfo,
+    analysis: &Analysis,
+) -> Result<AnalysisResult, RunError> {
+    if analysis.method == Method::Interval {
+        return interval::run_interval(sys, info, analysis, analysis.inclusion);
+    }
+    let Setup {
+        consts,
+        n,
+        p,
+        chol,
+        p_inv,
+    } = setup(sys, info, analysis, &["c", "sigma", "rho"])?;
+    let metric = &consts.metric;
 
     // Initial set and inputs.
     let (x0, half) =
