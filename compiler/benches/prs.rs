@@ -20,10 +20,7 @@ fn main() {
 fn pendulum() -> (Interpreter, reachc_runtime::system::ModelInfo) {
     let mut model = reachc::driver::load(&spec("pendulum.sde")).unwrap().model;
     let prepared = prepare(&mut model);
-    (
-        Interpreter::new(model, &prepared.derivatives),
-        prepared.info,
-    )
+    (Interpreter::new(model, &prepared), prepared.info)
 }
 
 #[divan::bench]

@@ -145,7 +145,7 @@ impl Config {
                     spec.display()
                 )));
             }
-            let code = codegen::generate(&loaded.model, &prepared.derivatives, &prepared.info);
+            let code = codegen::generate(&loaded.model, &prepared);
             let path = out_dir.join(format!("{ident}.rs"));
             // Unchanged output keeps its timestamp (no needless recompilation).
             if std::fs::read(&path).ok().as_deref() != Some(code.as_bytes()) {

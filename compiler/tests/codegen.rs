@@ -25,8 +25,8 @@ fn generate_for(path: &Path) -> (Model, String, String) {
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         .model;
     let prepared = prepare(&mut model);
-    let code = generate(&model, &prepared.derivatives, &prepared.info);
-    let again = generate(&model, &prepared.derivatives, &prepared.info);
+    let code = generate(&model, &prepared);
+    let again = generate(&model, &prepared);
     (model, code, again)
 }
 

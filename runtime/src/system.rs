@@ -25,6 +25,26 @@ pub trait System {
     fn jac_x(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]);
     /// Interval enclosure of `D_x f` over the boxes.
     fn jac_x_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]);
+    /// The entries `(i, j)` of `D_x f` such that `f_i` depends on `x_j`, in row-major order:
+    /// the layout of [`System::jac_x_sparse_interval`]. Engines rely on `f_i` (and row `i` of
+    /// `D_x f`) not depending on the states missing from row `i`. The default lists all `n * n`
+    /// entries; generated code lists the actual dependencies, so engines can work in time
+    /// proportional to the expressions rather than to `n^2`.
+    fn jac_x_pattern(&self) -> Vec<(usize, usize)> {
+        let n = self.n();
+        (0..n).flat_map(|i| (0..n).map(move |j| (i, j))).collect()
+    }
+    /// Interval enclosures of the entries of `D_x f` listed by [`System::jac_x_pattern`], in
+    /// that order. The default is [`System::jac_x_interval`] (the dense pattern).
+    fn jac_x_sparse_interval(
+        &self,
+        x: &[Interval],
+        u: &[Interval],
+        t: Interval,
+        out: &mut [Interval],
+    ) {
+        self.jac_x_interval(x, u, t, out);
+    }
     /// `D_u f`, n x p row-major.
     fn jac_u(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]);
     /// Interval enclosure of `D_u f`.
@@ -33,6 +53,13 @@ pub trait System {
     fn diffusion(&self, x: &[f64], t: f64, out: &mut [f64]);
     /// Interval enclosure of `G`.
     fn diffusion_interval(&self, x: &[Interval], t: Interval, out: &mut [Interval]);
+    /// The transformed system of frame `k` (see [`Transform::frame`]): the same interface in
+    /// the coordinates `y = T x`, i.e. drift `T f(T^-1 y, u, t)` and diffusion `T G(T^-1 y, t)`.
+    /// `None` if the model has no such frame (the default).
+    fn frame(&self, k: usize) -> Option<&dyn System> {
+        let _ = k;
+        None
+    }
 }
 
 /// A closed interval of reals given by its ends (`-inf`/`inf` allowed), as plain data.
@@ -170,6 +197,19 @@ pub enum Integrator {
     Euler,
 }
 
+/// A coordinate transform `y = T x` of an interval analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transform {
+    /// `T`, n x n row-major.
+    pub matrix: Vec<f64>,
+    /// `T^-1` as computed by the compiler in floating point, n x n row-major (the engine
+    /// encloses the exact inverse around it).
+    pub inverse: Vec<f64>,
+    /// Which [`System::frame`] holds the transformed system (analyses with the same `T` share
+    /// one).
+    pub frame: usize,
+}
+
 /// Constants of Assumption 1 for one metric, derived by the compiler.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Constants {
@@ -207,9 +247,9 @@ pub struct Analysis {
     pub inclusion: Inclusion,
     /// States to report (indices).
     pub outputs: Vec<usize>,
-    /// The coordinate transform `y = T x` of the interval method (n x n row-major), if given.
-    /// An engine that cannot honour it must refuse the analysis rather than ignore it.
-    pub transform: Option<Vec<f64>>,
+    /// The coordinate transform `y = T x` of the interval method, if given. An engine that
+    /// cannot honour it must refuse the analysis rather than ignore it.
+    pub transform: Option<Transform>,
     /// Derived constants (`None` if they could not be bounded; the engine refuses to run then).
     pub constants: Option<Constants>,
     /// Why `constants` is `None` (e.g. "`d f[omega] / d theta` is unbounded over the domain"),

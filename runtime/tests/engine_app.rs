@@ -3,7 +3,7 @@
 use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::system::{
-    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule,
+    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Transform,
 };
 use reachc_runtime::System;
 
@@ -111,9 +111,13 @@ fn cli(info: &ModelInfo, args: &[&str]) -> (u8, String, String) {
 fn runs_writes_and_skips_interval() {
     let info = model(vec![
         analysis("main", Method::Contraction, true),
-        // The interval engine runs now; a coordinate transform is still unsupported (skipped).
+        // A coordinate transform on a system without transformed frames is skipped, not run.
         Analysis {
-            transform: Some(vec![1.0]),
+            transform: Some(Transform {
+                matrix: vec![1.0],
+                inverse: vec![1.0],
+                frame: 0,
+            }),
             ..analysis("boxes", Method::Interval, true)
         },
     ]);
@@ -122,7 +126,7 @@ fn runs_writes_and_skips_interval() {
     assert_eq!(code, EXIT_OK, "{err}");
     assert!(out.contains("analysis `main`"), "{out}");
     assert!(
-        err.contains("skipped analysis `boxes`") && err.contains("interval"),
+        err.contains("skipped analysis `boxes`") && err.contains("no frame 0"),
         "{err}"
     );
     let json = std::fs::read_to_string(dir.join("main.json")).unwrap();

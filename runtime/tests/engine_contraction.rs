@@ -5,8 +5,8 @@ use reachc_runtime::engine::{self, RunError, Verdict};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::kappa::kappa;
 use reachc_runtime::system::{
-    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, UnsafeSet,
-    UnsafeShape,
+    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Transform,
+    UnsafeSet, UnsafeShape,
 };
 use reachc_runtime::System;
 
@@ -672,9 +672,13 @@ fn pendulum_radii_finite_and_decreasing() {
 #[test]
 fn errors() {
     let (sys, inf, mut an) = linear_setup(1e-3, 1.0, 0.1);
-    // The interval engine refuses coordinate transforms (not supported yet).
+    // A coordinate transform needs the system's transformed frame, which this one lacks.
     an.method = Method::Interval;
-    an.transform = Some(identity(sys.n));
+    an.transform = Some(Transform {
+        matrix: identity(sys.n),
+        inverse: identity(sys.n),
+        frame: 0,
+    });
     assert!(matches!(
         engine::run(&sys, &inf, &an),
         Err(RunError::Unsupported(_))

@@ -6,7 +6,7 @@ use reachc_runtime::engine::{self, RunError, Verdict};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::system::{
     Analysis, Constants, Inclusion, InitialSet, Integrator, Method, ModelInfo, RadiusRule,
-    UnsafeSet, UnsafeShape,
+    Transform, UnsafeSet, UnsafeShape,
 };
 use reachc_runtime::System;
 
@@ -315,7 +315,11 @@ fn linear_runs_through_dispatch_and_renders() {
 #[test]
 fn refuses_transform_and_missing_constants() {
     let mut a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
-    a.transform = Some(vec![1.0]);
+    a.transform = Some(Transform {
+        matrix: vec![1.0],
+        inverse: vec![1.0],
+        frame: 0,
+    });
     assert!(matches!(
         engine::run(&Lin, &lin_info(vec![]), &a),
         Err(RunError::Unsupported(_))

@@ -346,7 +346,7 @@ fn generated_code_agrees_with_the_interpreter() {
 
         let mut model = load(&path).unwrap().model;
         let prepared = prepare(&mut model);
-        let interp = Interpreter::new(model.clone(), &prepared.derivatives);
+        let interp = Interpreter::new(model.clone(), &prepared);
         let (n, p, m) = (interp.n(), interp.p(), interp.m());
 
         let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ name.len() as u64);

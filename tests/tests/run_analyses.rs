@@ -19,7 +19,7 @@ fn run(
     let mut model = load(&workspace().join("specs").join(spec)).unwrap().model;
     let prepared = prepare(&mut model);
     assert!(prepared.warnings.is_empty(), "{:#?}", prepared.warnings);
-    let interp = Interpreter::new(model, &prepared.derivatives);
+    let interp = Interpreter::new(model, &prepared);
     let analysis = prepared
         .info
         .analyses

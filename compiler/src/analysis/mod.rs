@@ -9,9 +9,11 @@ mod metric;
 mod psd;
 #[cfg(feature = "sdp")]
 pub mod sdp;
+mod transform;
 
 pub use atoms::{split_atoms, Atom, AtomSplit};
 pub use bounds::{bound_matrix, eval_box, time_range};
 pub use contraction::{constants, ConstantsError, MAX_SIGN_INPUTS, MAX_VERTEX_ATOMS};
 pub use derivatives::{Derivatives, GradEntry};
 pub use metric::{synthesize_metric, FULL_METRIC_MAX_DIM};
+pub use transform::Frame;

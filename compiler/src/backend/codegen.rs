@@ -26,7 +26,7 @@ use reachc_runtime::system::{
     RadiusRule, UnsafeSet, UnsafeShape,
 };
 
-use super::mangle;
+use super::{mangle, Prepared};
 use crate::analysis::Derivatives;
 use crate::ir::{ExprId, Func1, Func2, Node, Pool, Var};
 use crate::model::Model;
@@ -52,47 +52,82 @@ fn allow_lints() -> TokenStream {
     }
 }
 
-/// The text of the generated crate's `src/lib.rs` for `model`, whose Jacobians `d` were
-/// computed on its pool and whose sets, analyses and constants are `info`.
+/// The text of the generated crate's `src/lib.rs` for `model`, with what [`super::prepare`]
+/// derived from it: the Jacobians (computed on its pool), the transformed systems of its
+/// coordinate transforms, and its sets, analyses and constants.
 ///
 /// Panics only on a malformed model (a noise variable inside the drift or a diffusion
 /// coefficient, or a table index out of range), which the checker rules out.
-pub fn generate(model: &Model, d: &Derivatives, info: &ModelInfo) -> String {
+pub fn generate(model: &Model, prepared: &Prepared) -> String {
     let name = format_ident!("{}", mangle::type_name(&model.name));
     let n = int(model.states.len());
     let p = int(model.inputs.len());
     let m = int(model.noises.len());
 
-    let drift: Vec<ExprId> = model.drift.clone();
-    let jac_x: Vec<ExprId> = d.jac_x.iter().flatten().copied().collect();
-    let jac_u: Vec<ExprId> = d.jac_u.iter().flatten().copied().collect();
-    let diffusion: Vec<ExprId> = model.diffusion.iter().flatten().copied().collect();
-
     let mut tables = Tables::default();
-    let methods = [
-        ("drift", &drift, true),
-        ("jac_x", &jac_x, true),
-        ("jac_u", &jac_u, true),
-        ("diffusion", &diffusion, false),
-    ];
-    let mut bodies = TokenStream::new();
-    for (method, roots, with_u) in methods {
-        for kind in [Kind::F64, Kind::Interval] {
-            bodies.extend(method_fn(
-                &model.pool,
-                &mut tables,
-                method,
-                kind,
-                roots,
-                with_u,
-            ));
-        }
+    let bodies = system_bodies(
+        &model.pool,
+        &mut tables,
+        &model.drift,
+        &model.diffusion,
+        &prepared.derivatives,
+    );
+    let mut frame_items = TokenStream::new();
+    let mut frame_arms = TokenStream::new();
+    for (k, frame) in prepared.frames.iter().enumerate() {
+        let frame_name = format_ident!("{name}Frame{k}");
+        let frame_bodies = system_bodies(
+            &model.pool,
+            &mut tables,
+            &frame.drift,
+            &frame.diffusion,
+            &frame.derivatives,
+        );
+        let doc = format!(
+            " `{name}` in the coordinates `y = T x`, `T = {}`: drift `T f(T^-1 y, u, t)`, \
+             diffusion `T G(T^-1 y, t)` (the frame {k} of [`{name}`]'s `System::frame`).",
+            matrix_text(&frame.transform.matrix)
+        );
+        let lints = allow_lints();
+        let k = int(k);
+        frame_arms.extend(quote! { #k => Some(&#frame_name), });
+        frame_items.extend(quote! {
+            #[doc = #doc]
+            #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+            pub struct #frame_name;
+
+            #lints
+            impl reachc_runtime::System for #frame_name {
+                fn n(&self) -> usize {
+                    #name::N
+                }
+                fn p(&self) -> usize {
+                    #name::P
+                }
+                fn m(&self) -> usize {
+                    #name::M
+                }
+                #frame_bodies
+            }
+        });
     }
+    let frame_fn = if prepared.frames.is_empty() {
+        TokenStream::new()
+    } else {
+        quote! {
+            fn frame(&self, k: usize) -> Option<&dyn reachc_runtime::System> {
+                match k {
+                    #frame_arms
+                    _ => None,
+                }
+            }
+        }
+    };
 
     let struct_doc = struct_doc(model);
     let lints = allow_lints();
     let statics = tables.statics(model);
-    let info_fn = info_fn(info);
+    let info_fn = info_fn(&prepared.info);
     let file = quote! {
         #struct_doc
         #lints
@@ -120,13 +155,73 @@ pub fn generate(model: &Model, d: &Derivatives, info: &ModelInfo) -> String {
                 Self::M
             }
             #bodies
+            #frame_fn
         }
+
+        #frame_items
 
         #statics
 
         #info_fn
     };
     format_file(file)
+}
+
+/// The `System` methods (f64 and interval) of a drift, diffusion and their Jacobians.
+fn system_bodies(
+    pool: &Pool,
+    tables: &mut Tables,
+    drift: &[ExprId],
+    diffusion: &[Vec<ExprId>],
+    d: &Derivatives,
+) -> TokenStream {
+    let flat = |m: &[Vec<ExprId>]| -> Vec<ExprId> { m.iter().flatten().copied().collect() };
+    let (jac_x, jac_u, diffusion) = (flat(&d.jac_x), flat(&d.jac_u), flat(diffusion));
+    let methods = [
+        ("drift", drift, true),
+        ("jac_x", &jac_x[..], true),
+        ("jac_u", &jac_u[..], true),
+        ("diffusion", &diffusion[..], false),
+    ];
+    let mut bodies = TokenStream::new();
+    for (method, roots, with_u) in methods {
+        for kind in [Kind::F64, Kind::Interval] {
+            bodies.extend(method_fn(pool, tables, method, kind, roots, with_u));
+        }
+    }
+    let nonzeros = d.jac_x_dependencies(pool, drift);
+    let sparse: Vec<ExprId> = nonzeros.iter().map(|&(_, _, e)| e).collect();
+    bodies.extend(method_fn(
+        pool,
+        tables,
+        "jac_x_sparse",
+        Kind::Interval,
+        &sparse,
+        true,
+    ));
+    let pattern = nonzeros.iter().map(|&(i, j, _)| {
+        let (i, j) = (int(i), int(j));
+        quote!((#i, #j))
+    });
+    bodies.extend(quote! {
+        fn jac_x_pattern(&self) -> Vec<(usize, usize)> {
+            const PATTERN: &[(usize, usize)] = &[#(#pattern),*];
+            PATTERN.to_vec()
+        }
+    });
+    bodies
+}
+
+/// `[[a, b], [c, d]]`, for docs.
+fn matrix_text(m: &[Vec<f64>]) -> String {
+    let rows: Vec<String> = m
+        .iter()
+        .map(|r| {
+            let r: Vec<String> = r.iter().map(|&v| short(v)).collect();
+            format!("[{}]", r.join(", "))
+        })
+        .collect();
+    format!("[{}]", rows.join(", "))
 }
 
 /// The text of the generated crate's `src/main.rs`: the command line of the runtime, run on
@@ -789,7 +884,14 @@ impl InfoWriter {
             Inclusion::Mixed => quote!(Inclusion::Mixed),
         };
         let outputs = indices(&a.outputs);
-        let transform = option(&a.transform, |t| self.floats(t));
+        let transform = option(&a.transform, |t| {
+            let (matrix, inverse, frame) = (
+                self.floats(&t.matrix),
+                self.floats(&t.inverse),
+                int(t.frame),
+            );
+            quote!(Transform { matrix: #matrix, inverse: #inverse, frame: #frame })
+        });
         let consts = option(&a.constants, |c| self.constants(c));
         let error = option(&a.constants_error, |s| string(s));
         quote! {

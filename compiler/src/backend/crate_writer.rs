@@ -202,7 +202,7 @@ pub fn generate_files(
         .spec_label
         .clone()
         .unwrap_or_else(|| format!("model `{}`", model.name));
-    let lib = codegen::generate(model, &prepared.derivatives, &prepared.info);
+    let lib = codegen::generate(model, &prepared);
     let main = codegen::main_rs(&crate_ident, &type_name);
     let analyses: Vec<&str> = prepared
         .info

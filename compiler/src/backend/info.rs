@@ -3,7 +3,7 @@
 
 use reachc_runtime::system::{self as rt, ModelInfo};
 
-use crate::analysis::{constants, synthesize_metric, ConstantsError, Derivatives};
+use crate::analysis::{constants, synthesize_metric, ConstantsError, Derivatives, Frame};
 use crate::diagnostics::Diagnostic;
 use crate::ir::Names;
 use crate::model::{self, Bounds, Model};
@@ -13,6 +13,9 @@ use crate::model::{self, Bounds, Model};
 pub struct Prepared {
     /// The Jacobians (their expressions live in the model's pool).
     pub derivatives: Derivatives,
+    /// The transformed systems of the analyses' coordinate transforms (one per distinct `T`,
+    /// indexed by [`rt::Transform::frame`]).
+    pub frames: Vec<Frame>,
     /// Sets, analyses and derived constants, as the runtime consumes them.
     pub info: ModelInfo,
     /// Warnings, e.g. an analysis whose constants are unbounded (it cannot run; the model can
@@ -34,7 +37,8 @@ pub fn prepare(model: &mut Model) -> Prepared {
     let n = model.states.len();
     let mut warnings = Vec::new();
     let mut analyses = Vec::new();
-    for a in &model.analyses {
+    let mut frames: Vec<Frame> = Vec::new();
+    for a in model.analyses.clone() {
         let metric = match &a.metric {
             model::Metric::Identity => Ok(identity(n)),
             model::Metric::Matrix(m) => Ok(m.iter().flatten().copied().collect()),
@@ -66,10 +70,20 @@ pub fn prepare(model: &mut Model) -> Prepared {
             integrator: a.integrator,
             inclusion: a.inclusion,
             outputs: a.outputs.clone(),
-            transform: a
-                .transform
-                .as_ref()
-                .map(|t| t.iter().flatten().copied().collect()),
+            transform: a.transform.as_ref().map(|t| {
+                let frame = match frames.iter().position(|f| &f.transform == t) {
+                    Some(k) => k,
+                    None => {
+                        frames.push(Frame::of(model, t));
+                        frames.len() - 1
+                    }
+                };
+                rt::Transform {
+                    matrix: t.matrix.iter().flatten().copied().collect(),
+                    inverse: t.inverse.iter().flatten().copied().collect(),
+                    frame,
+                }
+            }),
             constants,
             constants_error,
         });
@@ -134,6 +148,7 @@ pub fn prepare(model: &mut Model) -> Prepared {
     };
     Prepared {
         derivatives,
+        frames,
         info,
         warnings,
     }

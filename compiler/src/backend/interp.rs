@@ -5,6 +5,9 @@
 
 use reachc_runtime::{Interval, System};
 
+use std::sync::Arc;
+
+use super::Prepared;
 use crate::analysis::Derivatives;
 use crate::ir::{Arith, ExprId, VarValues};
 use crate::model::Model;
@@ -29,28 +32,51 @@ impl Plan {
 /// A model evaluated by walking its IR.
 #[derive(Debug)]
 pub struct Interpreter {
-    model: Model,
+    model: Arc<Model>,
     drift: Plan,
     jac_x: Plan,
+    /// The entries of `jac_x` where the drift depends on the state, and where they are.
+    jac_x_sparse: Plan,
+    jac_x_pattern: Vec<(usize, usize)>,
     jac_u: Plan,
     diffusion: Plan,
+    /// The transformed systems ([`System::frame`]), over the same model (and pool).
+    frames: Vec<Interpreter>,
 }
 
 impl Interpreter {
-    /// Wraps a model and its derivatives (from the same pool).
-    pub fn new(model: Model, derivatives: &Derivatives) -> Self {
+    /// Wraps a model and what [`super::prepare`] derived from it (its pool holds the
+    /// derivatives and the transformed systems).
+    pub fn new(model: Model, prepared: &Prepared) -> Self {
+        let model = Arc::new(model);
+        let frames = prepared
+            .frames
+            .iter()
+            .map(|f| Interpreter::of(&model, &f.drift, &f.diffusion, &f.derivatives, Vec::new()))
+            .collect();
+        let drift = model.drift.clone();
+        let diffusion = model.diffusion.clone();
+        Interpreter::of(&model, &drift, &diffusion, &prepared.derivatives, frames)
+    }
+
+    fn of(
+        model: &Arc<Model>,
+        drift: &[ExprId],
+        diffusion: &[Vec<ExprId>],
+        derivatives: &Derivatives,
+        frames: Vec<Interpreter>,
+    ) -> Self {
+        let flat = |m: &[Vec<ExprId>]| m.iter().flatten().copied().collect();
+        let nonzeros = derivatives.jac_x_dependencies(&model.pool, drift);
         Interpreter {
-            drift: Plan::new(&model, model.drift.clone()),
-            jac_x: Plan::new(
-                &model,
-                derivatives.jac_x.iter().flatten().copied().collect(),
-            ),
-            jac_u: Plan::new(
-                &model,
-                derivatives.jac_u.iter().flatten().copied().collect(),
-            ),
-            diffusion: Plan::new(&model, model.diffusion.iter().flatten().copied().collect()),
-            model,
+            jac_x_sparse: Plan::new(model, nonzeros.iter().map(|&(_, _, e)| e).collect()),
+            jac_x_pattern: nonzeros.iter().map(|&(i, j, _)| (i, j)).collect(),
+            drift: Plan::new(model, drift.to_vec()),
+            jac_x: Plan::new(model, flat(&derivatives.jac_x)),
+            jac_u: Plan::new(model, flat(&derivatives.jac_u)),
+            diffusion: Plan::new(model, flat(diffusion)),
+            model: Arc::clone(model),
+            frames,
         }
     }
 
@@ -105,6 +131,20 @@ impl System for Interpreter {
         self.eval_into(&self.jac_x, x, u, t, out);
     }
 
+    fn jac_x_pattern(&self) -> Vec<(usize, usize)> {
+        self.jac_x_pattern.clone()
+    }
+
+    fn jac_x_sparse_interval(
+        &self,
+        x: &[Interval],
+        u: &[Interval],
+        t: Interval,
+        out: &mut [Interval],
+    ) {
+        self.eval_into(&self.jac_x_sparse, x, u, t, out);
+    }
+
     fn jac_u(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
         self.eval_into(&self.jac_u, x, u, t, out);
     }
@@ -119,5 +159,9 @@ impl System for Interpreter {
 
     fn diffusion_interval(&self, x: &[Interval], t: Interval, out: &mut [Interval]) {
         self.eval_into(&self.diffusion, x, &[], t, out);
+    }
+
+    fn frame(&self, k: usize) -> Option<&dyn System> {
+        self.frames.get(k).map(|f| f as &dyn System)
     }
 }

@@ -11,6 +11,8 @@ use crate::backend::crate_writer::{compile_crate, shared_target_dir, write_crate
 use crate::backend::interp::Interpreter;
 use crate::backend::{mangle, prepare};
 use crate::diagnostics::render;
+use crate::driver::Loaded;
+use reachc_runtime::system::ModelInfo;
 
 /// Which backend computes the sets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -40,41 +42,17 @@ pub fn run_spec(
     }
     let code = match backend {
         Backend::Interp => {
-            let prepared = prepare(&mut loaded.model);
-            if !prepared.warnings.is_empty() {
-                let path = loaded.path.display().to_string();
-                eprint!(
-                    "{}",
-                    render(&prepared.warnings, &path, &loaded.source, color)
-                );
-            }
-            let interp = Interpreter::new(loaded.model, &prepared.derivatives);
+            let (interp, info) = interpreter(loaded, color);
             reachc_runtime::app::run_cli(
                 &interp,
-                &prepared.info,
+                &info,
                 &args,
                 &mut std::io::stdout().lock(),
                 &mut std::io::stderr().lock(),
             )
         }
         Backend::Compiled => {
-            let crates = shared_target_dir()
-                .and_then(|t| t.parent().map(|p| p.join("crates")))
-                .unwrap_or_else(|| PathBuf::from("target/reachc-crates"));
-            std::fs::create_dir_all(&crates).map_err(|e| {
-                eprintln!("error: cannot create {}: {e}", crates.display());
-                EXIT_USAGE
-            })?;
-            let dir = crates.join(mangle::crate_name(&loaded.model.name));
-            let written =
-                write_crate(&mut loaded, &dir, &CrateOptions::default()).map_err(|e| {
-                    eprint!("{}", e.report(color));
-                    e.exit_code()
-                })?;
-            let binary = compile_crate(&written.dir, true).map_err(|e| {
-                eprint!("{}", e.report(color));
-                EXIT_USAGE
-            })?;
+            let binary = compiled_binary(&mut loaded, color)?;
             let status = std::process::Command::new(&binary)
                 .args(&args)
                 .status()
@@ -92,4 +70,39 @@ pub fn run_spec(
         1 => Err(EXIT_SPEC),
         c => Err(c),
     }
+}
+
+/// The interpreter backend of a loaded spec and its model info (warnings printed to stderr).
+pub(super) fn interpreter(mut loaded: Loaded, color: bool) -> (Interpreter, ModelInfo) {
+    let prepared = prepare(&mut loaded.model);
+    if !prepared.warnings.is_empty() {
+        let path = loaded.path.display().to_string();
+        eprint!(
+            "{}",
+            render(&prepared.warnings, &path, &loaded.source, color)
+        );
+    }
+    let interp = Interpreter::new(loaded.model, &prepared);
+    (interp, prepared.info)
+}
+
+/// Writes the spec's crate into the shared cache and compiles it (release); the binary's path,
+/// or the exit code after reporting the failure.
+pub(super) fn compiled_binary(loaded: &mut Loaded, color: bool) -> Result<PathBuf, u8> {
+    let crates = shared_target_dir()
+        .and_then(|t| t.parent().map(|p| p.join("crates")))
+        .unwrap_or_else(|| PathBuf::from("target/reachc-crates"));
+    std::fs::create_dir_all(&crates).map_err(|e| {
+        eprintln!("error: cannot create {}: {e}", crates.display());
+        EXIT_USAGE
+    })?;
+    let dir = crates.join(mangle::crate_name(&loaded.model.name));
+    let written = write_crate(loaded, &dir, &CrateOptions::default()).map_err(|e| {
+        eprint!("{}", e.report(color));
+        e.exit_code()
+    })?;
+    compile_crate(&written.dir, true).map_err(|e| {
+        eprint!("{}", e.report(color));
+        EXIT_USAGE
+    })
 }

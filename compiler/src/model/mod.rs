@@ -142,6 +142,15 @@ pub enum Metric {
     Auto,
 }
 
+/// A coordinate transform `y = T x` of an interval analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transform {
+    /// `T`, square and invertible, by rows.
+    pub matrix: Vec<Vec<f64>>,
+    /// `T^-1` computed in floating point (Gauss-Jordan with partial pivoting), by rows.
+    pub inverse: Vec<Vec<f64>>,
+}
+
 /// An `analysis NAME { ... }` block, with defaults filled in.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Analysis {
@@ -165,8 +174,8 @@ pub struct Analysis {
     pub inclusion: Inclusion,
     /// `integrator` (default rk4).
     pub integrator: Integrator,
-    /// `transform`: the square non-singular `T` of `y = T x` (interval method).
-    pub transform: Option<Vec<Vec<f64>>>,
+    /// `transform`: the coordinate change `y = T x` (interval method only).
+    pub transform: Option<Transform>,
     /// `outputs`: indices of the states to report (default all).
     pub outputs: Vec<usize>,
 }

@@ -16,15 +16,31 @@
 
 use crate::interval::Interval;
 
+/// Lower bandwidth of a square matrix: the largest `i - j` with a non-zero entry `(i, j)`.
+/// Cholesky factors keep it, so banded metrics (diagonal ones in particular) cost `O(n b^2)`
+/// instead of `O(n^3)`.
+pub(crate) fn bandwidth(a: &[Interval], n: usize) -> usize {
+    (0..n)
+        .filter_map(|i| {
+            (0..i)
+                .find(|&j| a[i * n + j] != Interval::ZERO)
+                .map(|j| i - j)
+        })
+        .max()
+        .unwrap_or(0)
+}
+
 /// Interval Cholesky factor `L` (lower triangular, row-major `n x n`) of the symmetric matrix
 /// whose lower triangle is enclosed by `a`. `None` when a pivot is not certainly positive
 /// (the matrix may not be positive definite, or the enclosure is too wide to tell).
 pub(crate) fn cholesky(a: &[Interval], n: usize) -> Option<Vec<Interval>> {
     debug_assert_eq!(a.len(), n * n);
+    let bw = bandwidth(a, n);
     let mut l = vec![Interval::ZERO; n * n];
     for j in 0..n {
+        let first = j.saturating_sub(bw);
         let mut d = a[j * n + j];
-        for k in 0..j {
+        for k in first..j {
             d -= l[j * n + k].sqr();
         }
         // (Interval ends are never NaN.)
@@ -33,9 +49,9 @@ pub(crate) fn cholesky(a: &[Interval], n: usize) -> Option<Vec<Interval>> {
         }
         let ljj = d.sqrt();
         l[j * n + j] = ljj;
-        for i in j + 1..n {
+        for i in j + 1..n.min(j + bw + 1) {
             let mut s = a[i * n + j];
-            for k in 0..j {
+            for k in i.saturating_sub(bw)..j {
                 s -= l[i * n + k] * l[j * n + k];
             }
             l[i * n + j] = s / ljj;
@@ -47,10 +63,16 @@ pub(crate) fn cholesky(a: &[Interval], n: usize) -> Option<Vec<Interval>> {
 /// Enclosure of `L^-1 v` by interval forward substitution (`L` from [`cholesky`], so its
 /// diagonal is certainly positive).
 pub(crate) fn forward_solve(l: &[Interval], n: usize, v: &[Interval]) -> Vec<Interval> {
+    forward_solve_banded(l, n, bandwidth(l, n), v)
+}
+
+/// [`forward_solve`] for `L` of lower bandwidth `bw`, starting at the first non-zero of `v`.
+fn forward_solve_banded(l: &[Interval], n: usize, bw: usize, v: &[Interval]) -> Vec<Interval> {
     let mut w = vec![Interval::ZERO; n];
-    for i in 0..n {
+    let start = v.iter().position(|x| *x != Interval::ZERO).unwrap_or(n);
+    for i in start..n {
         let mut s = v[i];
-        for k in 0..i {
+        for k in i.saturating_sub(bw).max(start)..i {
             s -= l[i * n + k] * w[k];
         }
         w[i] = s / l[i * n + i];
@@ -69,32 +91,52 @@ pub(crate) fn inv_quad_form(l: &[Interval], n: usize, v: &[f64]) -> Interval {
     w.iter().fold(Interval::ZERO, |acc, wi| acc + wi.sqr())
 }
 
-/// Enclosure of the whole inverse `A^-1 = L^-T L^-1` (row-major), given the interval Cholesky
-/// factor of `A`.
-pub(crate) fn inverse(l: &[Interval], n: usize) -> Vec<Interval> {
-    // Column j of L^-1 is L^-1 e_j; store them as rows of `cols`.
-    let cols: Vec<Vec<Interval>> = (0..n)
-        .map(|j| {
+/// Enclosure of the block of `A^-1 = L^-T L^-1` over the indices `idx` (`k x k` row-major,
+/// `k = idx.len()`), given the interval Cholesky factor of `A`. Costs `k` forward solves, so
+/// the whole inverse is never formed for large `n`.
+pub(crate) fn inverse_block(l: &[Interval], n: usize, idx: &[usize]) -> Vec<Interval> {
+    let bw = bandwidth(l, n);
+    // Column j of L^-1 is L^-1 e_j.
+    let cols: Vec<Vec<Interval>> = idx
+        .iter()
+        .map(|&j| {
             let mut e = vec![Interval::ZERO; n];
             e[j] = Interval::ONE;
-            forward_solve(l, n, &e)
+            forward_solve_banded(l, n, bw, &e)
         })
         .collect();
-    let mut out = vec![Interval::ZERO; n * n];
-    for i in 0..n {
-        for j in 0..=i {
-            // (A^-1)_ij = sum_k (L^-1)_ki (L^-1)_kj; use sqr on the diagonal (tighter).
-            let s = cols[i]
+    let k = idx.len();
+    let mut out = vec![Interval::ZERO; k * k];
+    for a in 0..k {
+        for b in 0..=a {
+            // (A^-1)_ab = sum_m (L^-1)_ma (L^-1)_mb (zero for m < max(a, b)); sqr on the
+            // diagonal (tighter).
+            let from = idx[a].max(idx[b]);
+            let s = cols[a][from..]
                 .iter()
-                .zip(&cols[j])
-                .fold(Interval::ZERO, |acc, (&a, &b)| {
-                    acc + if i == j { a.sqr() } else { a * b }
+                .zip(&cols[b][from..])
+                .fold(Interval::ZERO, |acc, (&x, &y)| {
+                    acc + if a == b { x.sqr() } else { x * y }
                 });
-            out[i * n + j] = s;
-            out[j * n + i] = s;
+            out[a * k + b] = s;
+            out[b * k + a] = s;
         }
     }
     out
+}
+
+/// Enclosure of the diagonal of `A^-1`, given the interval Cholesky factor of `A`.
+pub(crate) fn inverse_diagonal(l: &[Interval], n: usize) -> Vec<Interval> {
+    let bw = bandwidth(l, n);
+    (0..n)
+        .map(|i| {
+            let mut e = vec![Interval::ZERO; n];
+            e[i] = Interval::ONE;
+            forward_solve_banded(l, n, bw, &e)[i..]
+                .iter()
+                .fold(Interval::ZERO, |acc, x| acc + x.sqr())
+        })
+        .collect()
 }
 
 /// Eigenvalues of a symmetric `f64` matrix by the cyclic Jacobi method (an estimate only; the
@@ -218,7 +260,7 @@ mod tests {
     fn inverse_of_pendulum_metric_encloses_exact() {
         let p = [35.68, 2.21, 2.21, 1.27];
         let l = cholesky(&to_intervals(&p), 2).unwrap();
-        let inv = inverse(&l, 2);
+        let inv = inverse_block(&l, 2, &[0, 1]);
         let det = 35.68 * 1.27 - 2.21 * 2.21;
         let exact = [1.27 / det, -2.21 / det, -2.21 / det, 35.68 / det];
         for (e, i) in exact.iter().zip(&inv) {

@@ -12,18 +12,20 @@
 //! the conservative end kept. What is not: the nominal trajectory is integrated numerically
 //! (RK4 or Euler) and taken as exact. The result records this in [`Validation`].
 
+mod embedding;
 mod interval;
 mod linalg;
 mod nominal;
 mod radius;
 mod result;
 mod safety;
+mod transform;
 
 pub use interval::run_interval;
 pub use radius::MAX_VERTEX_COORDS;
 pub use result::{
-    AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, StepRecord, UnsafeReport,
-    Validation, Verdict,
+    AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, StepRecord, TransformReport,
+    UnsafeReport, Validation, Verdict,
 };
 
 use crate::interval::Interval;
@@ -64,7 +66,8 @@ pub(crate) struct Setup<'a> {
     pub(crate) n: usize,
     pub(crate) p: usize,
     pub(crate) chol: Vec<Interval>,
-    pub(crate) p_inv: Vec<Interval>,
+    /// Enclosure of the diagonal of `P^-1`.
+    pub(crate) p_inv_diag: Vec<Interval>,
 }
 
 /// Builds the [`Setup`] of `analysis`; `used` names the constants the engine needs
@@ -107,13 +110,13 @@ pub(crate) fn setup<'a>(
     let chol = linalg::cholesky(&linalg::to_intervals(metric), n).ok_or_else(|| {
         RunError::Invalid("the metric P is not (certifiably) symmetric positive definite".into())
     })?;
-    let p_inv = linalg::inverse(&chol, n);
+    let p_inv_diag = linalg::inverse_diagonal(&chol, n);
     Ok(Setup {
         consts,
         n,
         p,
         chol,
-        p_inv,
+        p_inv_diag,
     })
 }
 
@@ -135,7 +138,7 @@ pub fn run(
         n,
         p,
         chol,
-        p_inv,
+        p_inv_diag,
     } = setup(sys, info, analysis, &["c", "sigma", "rho"])?;
     let metric = &consts.metric;
 
@@ -180,7 +183,7 @@ pub fn run(
 
     // Safety checks, precomputed (they depend on P only).
     let checks =
-        safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv).map_err(RunError::Invalid)?;
+        safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv_diag).map_err(RunError::Invalid)?;
 
     let mut stochastic = radius::Stochastic::new(kappa);
     let mut steps = Vec::with_capacity(grid.len());
@@ -202,6 +205,8 @@ pub fn run(
                 metric: "constants.metric",
                 lo: None,
                 hi: None,
+                hull_lo: None,
+                hull_hi: None,
             },
             nominal: x,
             r_t,
@@ -249,6 +254,7 @@ pub fn run(
         r1,
         r2,
         r1_how,
+        transform: None,
         initial_center: x0,
         input_center: u_center,
         steps,

@@ -155,7 +155,7 @@ pub(crate) fn initial_center_and_halfwidths(
                 let l = linalg::cholesky(&linalg::to_intervals(m), k).ok_or_else(|| {
                     format!("initial ball #{bi}: metric is not (certifiably) positive definite")
                 })?;
-                let inv = linalg::inverse(&l, k);
+                let inv = linalg::inverse_block(&l, k, &(0..k).collect::<Vec<_>>());
                 (0..k).map(|i| inv[i * k + i]).collect()
             }
         };
@@ -188,6 +188,24 @@ pub(crate) fn r1_bound(p: &[f64], half: &[f64]) -> f64 {
         return 0.0;
     }
     let k = active.len();
+    if k > MAX_VERTEX_COORDS {
+        // Only the non-zero entries of P contribute (O(n^2) scan, no n^2 intervals).
+        return Interval::point(
+            p.iter()
+                .enumerate()
+                .filter(|&(_, &v)| v != 0.0)
+                .fold(Interval::ZERO, |acc, (idx, &v)| {
+                    let (i, j) = (idx / n, idx % n);
+                    acc + Interval::point(v.abs())
+                        * Interval::point(half[i])
+                        * Interval::point(half[j])
+                })
+                .hi()
+                .max(0.0),
+        )
+        .sqrt()
+        .hi();
+    }
     // q_ab = P_ij h_i h_j over the active coordinates.
     let mut q = vec![Interval::ZERO; k * k];
     for (a, &i) in active.iter().enumerate() {
@@ -196,32 +214,25 @@ pub(crate) fn r1_bound(p: &[f64], half: &[f64]) -> f64 {
                 Interval::point(p[i * n + j]) * Interval::point(half[i]) * Interval::point(half[j]);
         }
     }
-    let max_sq = if k <= MAX_VERTEX_COORDS {
-        // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the same
-        // value, so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
-        let mut best = f64::NEG_INFINITY;
-        for bits in 0u32..(1u32 << (k - 1)) {
-            let sign = |a: usize| a == 0 || (bits >> (a - 1)) & 1 == 0;
-            let mut s = Interval::ZERO;
-            for a in 0..k {
-                s += q[a * k + a];
-                for b in a + 1..k {
-                    let term = q[a * k + b] + q[b * k + a];
-                    if sign(a) == sign(b) {
-                        s += term;
-                    } else {
-                        s -= term;
-                    }
+    // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the same value,
+    // so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
+    let mut max_sq = f64::NEG_INFINITY;
+    for bits in 0u32..(1u32 << (k - 1)) {
+        let sign = |a: usize| a == 0 || (bits >> (a - 1)) & 1 == 0;
+        let mut s = Interval::ZERO;
+        for a in 0..k {
+            s += q[a * k + a];
+            for b in a + 1..k {
+                let term = q[a * k + b] + q[b * k + a];
+                if sign(a) == sign(b) {
+                    s += term;
+                } else {
+                    s -= term;
                 }
             }
-            best = best.max(s.hi());
         }
-        best
-    } else {
-        q.iter()
-            .fold(Interval::ZERO, |acc, x| acc + Interval::point(x.mag()))
-            .hi()
-    };
+        max_sq = max_sq.max(s.hi());
+    }
     Interval::point(max_sq.max(0.0)).sqrt().hi()
 }
 

@@ -43,6 +43,10 @@ pub struct AnalysisResult {
     pub r2: f64,
     /// How `r1` was bounded.
     pub r1_how: String,
+    /// The coordinate transform of an interval analysis (absent otherwise). The boxes
+    /// (`det_set.lo`, `det_set.hi`) are then in the coordinates `y = T x`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub transform: Option<TransformReport>,
     /// Centre of the initial set (the nominal's start).
     pub initial_center: Vec<f64>,
     /// Centre of the input box (the nominal's input).
@@ -70,6 +74,17 @@ pub struct ConstantsReport {
     pub how: String,
     /// The metric `P`, by rows.
     pub metric: Vec<Vec<f64>>,
+}
+
+/// A coordinate transform `y = T x`, as used.
+#[derive(Clone, Debug, Serialize)]
+pub struct TransformReport {
+    /// `T`, by rows.
+    pub matrix: Vec<Vec<f64>>,
+    /// `T^-1` computed in floating point, by rows (`x = T^-1 y`).
+    pub inverse: Vec<Vec<f64>>,
+    /// A rigorous bound of `|(T^-1)_ij - inverse_ij|` over all entries (0 when exact).
+    pub inverse_error: f64,
 }
 
 /// The stochastic radius rule used.
@@ -109,7 +124,10 @@ pub struct StepRecord {
 #[derive(Clone, Debug, Serialize)]
 pub struct DetSet {
     /// `"p_ball"`: `{x : |x - center|_P <= radius}`; `"box"`: `{x : lo <= x <= hi}` (interval
-    /// method), with `center`, `radius` a P-ball containing the box.
+    /// method), with `center`, `radius` a P-ball containing the box; `"parallelotope"`:
+    /// `{x : lo <= T x <= hi}` (interval method with the transform `T` of
+    /// [`AnalysisResult::transform`]), with its interval hull `hull_lo`, `hull_hi` in `x` and
+    /// `center`, `radius` a P-ball containing the hull.
     pub shape: &'static str,
     /// Centre.
     pub center: Vec<f64>,
@@ -117,12 +135,20 @@ pub struct DetSet {
     pub radius: f64,
     /// Where the metric is: `"constants.metric"`.
     pub metric: &'static str,
-    /// Lower corner of the box (shape `"box"` only; not serialised otherwise).
+    /// Lower corner of the box (shapes `"box"` and `"parallelotope"`, where it is in `y`; not
+    /// serialised otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lo: Option<Vec<f64>>,
-    /// Upper corner of the box (shape `"box"` only; not serialised otherwise).
+    /// Upper corner of the box (shapes `"box"` and `"parallelotope"`; not serialised
+    /// otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hi: Option<Vec<f64>>,
+    /// Lower corner of the parallelotope's interval hull in `x` (shape `"parallelotope"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hull_lo: Option<Vec<f64>>,
+    /// Upper corner of the parallelotope's interval hull in `x` (shape `"parallelotope"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hull_hi: Option<Vec<f64>>,
 }
 
 /// One unsafe set's verdict.
@@ -198,32 +224,28 @@ impl AnalysisResult {
 
     /// CSV with header `t,<output state names...>,det_radius,r_t,psi,c,sigma,prs_radius` and one
     /// row per report time (the nominal state in the state columns). For the interval method
-    /// (box sets) the header is `t,<state>_lo,<state>_hi,...,r_t,psi` instead.
+    /// (box sets) the header is `t,<state>_lo,<state>_hi,...,r_t,psi` instead; with a coordinate
+    /// transform, `t,y1_lo,y1_hi,...,yn_lo,yn_hi,<state>_lo,<state>_hi,...,r_t,psi` (the box in
+    /// `y = T x`, then the parallelotope's interval hull in the output states).
     pub fn write_csv(&self, w: &mut dyn Write) -> io::Result<()> {
         let shown = self.shown_states();
         if self.has_boxes() {
             let mut header = String::from("t");
-            for &i in &shown {
-                let _ = write!(
-                    header,
-                    ",{},{}",
-                    csv_field(&format!("{}_lo", self.states[i])),
-                    csv_field(&format!("{}_hi", self.states[i]))
-                );
+            if let Some(first) = self.steps.first() {
+                for (label, _, _) in self.box_columns(first) {
+                    let _ = write!(
+                        header,
+                        ",{},{}",
+                        csv_field(&format!("{label}_lo")),
+                        csv_field(&format!("{label}_hi"))
+                    );
+                }
             }
             header.push_str(",r_t,psi");
             writeln!(w, "{header}")?;
             for s in &self.steps {
                 let mut row = format!("{}", s.t);
-                let (lo, hi) = (
-                    s.det_set.lo.as_deref().unwrap_or(&[]),
-                    s.det_set.hi.as_deref().unwrap_or(&[]),
-                );
-                for &i in &shown {
-                    let (a, b) = (
-                        lo.get(i).copied().unwrap_or(f64::NAN),
-                        hi.get(i).copied().unwrap_or(f64::NAN),
-                    );
+                for (_, a, b) in self.box_columns(s) {
                     let _ = write!(row, ",{a},{b}");
                 }
                 let _ = write!(row, ",{},{}", s.r_t, s.psi);
@@ -347,37 +369,69 @@ impl AnalysisResult {
 }
 
 impl AnalysisResult {
-    /// The table of the summary for box sets: per shown state the box `[lo, hi]`, and `r_t`.
+    /// The table of the summary for box sets: per column of [`Self::box_columns`] the range
+    /// `[lo, hi]`, and `r_t`.
     fn summary_boxes(&self, s: &mut String) {
-        let shown = self.shown_states();
-        let _ = writeln!(
-            s,
-            "  deterministic sets: boxes of the embedding system ({} inclusion); PRS = box (+) \
-             B_P(r_t)",
-            self.inclusion.as_deref().unwrap_or("?")
-        );
+        let inclusion = self.inclusion.as_deref().unwrap_or("?");
+        match &self.transform {
+            None => {
+                let _ = writeln!(
+                    s,
+                    "  deterministic sets: boxes of the embedding system ({inclusion} \
+                     inclusion); PRS = box (+) B_P(r_t)"
+                );
+            }
+            Some(tr) => {
+                let rows: Vec<String> = tr.matrix.iter().map(|r| format!("{r:?}")).collect();
+                let _ = writeln!(
+                    s,
+                    "  deterministic sets: parallelotopes {{x : T x in box}}, T = [{}], box of the \
+                     embedding system in y = T x ({inclusion} inclusion); PRS = parallelotope \
+                     (+) B_P(r_t); columns: the box in y, then the parallelotope's hull in x",
+                    rows.join(", ")
+                );
+            }
+        }
+        let Some(first) = self.steps.first() else {
+            return;
+        };
         let mut head = format!("  {:>10}", "t");
-        for &i in &shown {
-            let _ = write!(head, "  {:>27}", format!("{} [lo, hi]", self.states[i]));
+        for (label, _, _) in self.box_columns(first) {
+            let _ = write!(head, "  {:>27}", format!("{label} [lo, hi]"));
         }
         let _ = write!(head, "  {:>12}", "r_t");
         let _ = writeln!(s, "{head}");
         for k in summary_indices(self.steps.len()) {
             let st = &self.steps[k];
             let mut row = format!("  {:>10.4}", st.t);
-            let (lo, hi) = (
-                st.det_set.lo.as_deref().unwrap_or(&[]),
-                st.det_set.hi.as_deref().unwrap_or(&[]),
-            );
-            for &i in &shown {
-                let (a, b) = (
-                    lo.get(i).copied().unwrap_or(f64::NAN),
-                    hi.get(i).copied().unwrap_or(f64::NAN),
-                );
+            for (_, a, b) in self.box_columns(st) {
                 let _ = write!(row, "  [{a:>12.6}, {b:>12.6}]");
             }
             let _ = write!(row, "  {:>12.6}", st.r_t);
             let _ = writeln!(s, "{row}");
+        }
+    }
+
+    /// The ranges shown for a box step, `(label, lo, hi)`: the box over the shown states, or
+    /// with a transform the box in `y` (`y1`, `y2`, ...) and then the parallelotope's interval
+    /// hull over the shown states.
+    fn box_columns(&self, st: &StepRecord) -> Vec<(String, f64, f64)> {
+        let at = |v: &Option<Vec<f64>>, i: usize| {
+            v.as_deref()
+                .and_then(|v| v.get(i).copied())
+                .unwrap_or(f64::NAN)
+        };
+        let d = &st.det_set;
+        let shown = self.shown_states().into_iter();
+        if self.transform.is_some() {
+            let ys =
+                (0..self.states.len()).map(|i| (format!("y{}", i + 1), at(&d.lo, i), at(&d.hi, i)));
+            ys.chain(shown.map(|i| (self.states[i].clone(), at(&d.hull_lo, i), at(&d.hull_hi, i))))
+                .collect()
+        } else {
+            shown
+                .map(|i| (self.states[i].clone(), at(&d.lo, i), at(&d.hi, i)))
+                .collect()
         }
     }
 }

@@ -52,18 +52,20 @@ impl Check {
         sets: &[UnsafeSet],
         n: usize,
         l: &[Interval],
-        p_inv: &[Interval],
+        p_inv_diag: &[Interval],
     ) -> Result<Vec<Check>, String> {
-        sets.iter().map(|s| Check::new(s, n, l, p_inv)).collect()
+        sets.iter()
+            .map(|s| Check::new(s, n, l, p_inv_diag))
+            .collect()
     }
 
-    /// Precomputes the check; `l` is the interval Cholesky factor of `P`, `p_inv` an enclosure
-    /// of `P^-1`.
+    /// Precomputes the check; `l` is the interval Cholesky factor of `P`, `p_inv_diag` an
+    /// enclosure of the diagonal of `P^-1`.
     pub(crate) fn new(
         set: &UnsafeSet,
         n: usize,
         l: &[Interval],
-        p_inv: &[Interval],
+        p_inv_diag: &[Interval],
     ) -> Result<Check, String> {
         let bad = |what: &str| format!("unsafe set `{}`: {what}", set.name);
         match &set.shape {
@@ -92,7 +94,7 @@ impl Check {
                     if i >= n {
                         return Err(bad(&format!("refers to state {i}, n = {n}")));
                     }
-                    out.push((i, range, p_inv[i * n + i].sqrt().hi()));
+                    out.push((i, range, p_inv_diag[i].sqrt().hi()));
                 }
                 Ok(Check::Box { coords: out })
             }
@@ -105,9 +107,7 @@ impl Check {
                 if center.len() != k || states.iter().any(|&s| s >= n) {
                     return Err(bad("states and centre do not match the model"));
                 }
-                let sub: Vec<Interval> = (0..k * k)
-                    .map(|idx| p_inv[states[idx / k] * n + states[idx % k]])
-                    .collect();
+                let sub = linalg::inverse_block(l, n, states);
                 let lam = linalg::lambda_max_upper(&sub, k);
                 Ok(Check::Ball {
                     states: states.clone(),

@@ -5,7 +5,7 @@ use super::scope::did_you_mean;
 use super::sets::Fields;
 use super::Checker;
 use crate::diagnostics::{Diagnostic, Span};
-use crate::model::{Analysis, Inclusion, Integrator, Method, Metric, RadiusRule};
+use crate::model::{Analysis, Inclusion, Integrator, Method, Metric, RadiusRule, Transform};
 use crate::syntax::ast::{Block, Expr, ExprKind, Ident};
 
 const KEYS: &[&str] = &[
@@ -116,7 +116,7 @@ impl Checker<'_> {
         };
         let transform = match f.get("transform") {
             None => Some(None),
-            Some((e, _)) => self.square(e, n, "transform", false).map(Some),
+            Some((e, _)) => self.transform(e, n).map(Some),
         };
         let outputs = match f.get("outputs") {
             None => Some((0..n).collect()),
@@ -138,6 +138,22 @@ impl Checker<'_> {
         else {
             return;
         };
+        if let (Some(_), Some((e, _))) = (&transform, f.get("transform")) {
+            if method != Method::Interval {
+                self.fail::<()>(
+                    Diagnostic::error(
+                        "a coordinate transform needs `method = interval`",
+                        e.span.clone(),
+                        "the contraction method does not use it",
+                    )
+                    .with_help(
+                        "remove `transform`, or set `method = interval` (the metric plays its \
+                         role for the contraction method)",
+                    ),
+                );
+                return;
+            }
+        }
         self.analyses.push(Analysis {
             name: name.name.clone(),
             span,
@@ -209,6 +225,14 @@ impl Checker<'_> {
         }
     }
 
+    /// A coordinate transform: an invertible n x n matrix, with its inverse.
+    fn transform(&mut self, e: &Expr, n: usize) -> Option<Transform> {
+        let matrix = self.square(e, n, "transform", false)?;
+        // `square` checked invertibility by the same elimination, so this succeeds.
+        let inverse = matrix::inverse(&matrix).ok()?;
+        Some(Transform { matrix, inverse })
+    }
+
     /// An n x n matrix, symmetric positive definite (`spd`) or non-singular.
     fn square(&mut self, e: &Expr, n: usize, key: &str, spd: bool) -> Option<Vec<Vec<f64>>> {
         let m = self.matrix(e)?;
@@ -216,7 +240,7 @@ impl Checker<'_> {
             if spd {
                 matrix::check_spd(&m)
             } else {
-                matrix::check_nonsingular(&m)
+                matrix::inverse(&m).map(drop)
             }
         });
         match check {

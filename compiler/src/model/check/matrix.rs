@@ -2,7 +2,7 @@
 
 /// Why a matrix was rejected.
 #[derive(Debug, PartialEq)]
-pub(super) enum MatrixError {
+pub(crate) enum MatrixError {
     NotSquare {
         rows: usize,
         bad_row: usize,
@@ -95,12 +95,21 @@ pub(super) fn check_spd(m: &[Vec<f64>]) -> Result<(), MatrixError> {
     Ok(())
 }
 
-/// Checks that a square matrix is invertible: Gaussian elimination with partial pivoting,
-/// rejecting pivots below `n * 1e-12` relative to the largest entry.
-pub(super) fn check_nonsingular(m: &[Vec<f64>]) -> Result<(), MatrixError> {
+/// The inverse of a square matrix by Gauss-Jordan elimination with partial pivoting, rejecting
+/// pivots below `n * 1e-12` relative to the largest entry (so nearly singular matrices too).
+pub(crate) fn inverse(m: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, MatrixError> {
     let n = m.len();
     let scale = max_abs(m);
-    let mut a = m.to_vec();
+    // [A | I] reduced to [I | A^-1].
+    let mut a: Vec<Vec<f64>> = m
+        .iter()
+        .enumerate()
+        .map(|(i, row)| {
+            let mut r = row.clone();
+            r.extend((0..n).map(|j| if i == j { 1.0 } else { 0.0 }));
+            r
+        })
+        .collect();
     for col in 0..n {
         let pivot = (col..n)
             .max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))
@@ -110,16 +119,21 @@ pub(super) fn check_nonsingular(m: &[Vec<f64>]) -> Result<(), MatrixError> {
             return Err(MatrixError::Singular);
         }
         a.swap(col, pivot);
-        let (top, bottom) = a.split_at_mut(col + 1);
-        let pivot_row = &top[col];
-        for row in bottom {
-            let factor = row[col] / pivot_row[col];
-            for (x, p) in row[col..].iter_mut().zip(&pivot_row[col..]) {
-                *x -= factor * p;
+        let d = a[col][col];
+        for v in &mut a[col] {
+            *v /= d;
+        }
+        let pivot_row = a[col].clone();
+        for (r, row) in a.iter_mut().enumerate() {
+            if r != col && row[col] != 0.0 {
+                let factor = row[col];
+                for (x, p) in row.iter_mut().zip(&pivot_row) {
+                    *x -= factor * p;
+                }
             }
         }
     }
-    Ok(())
+    Ok(a.into_iter().map(|row| row[n..].to_vec()).collect())
 }
 
 #[cfg(test)]
@@ -143,9 +157,29 @@ mod tests {
 
     #[test]
     fn singular() {
-        assert_eq!(check_nonsingular(&[vec![1.0, 0.2], vec![1.0, 0.0]]), Ok(()));
+        // The paper's pendulum transform: T^-1 = [[0, 1], [5, -5]].
+        let inv = inverse(&[vec![1.0, 0.2], vec![1.0, 0.0]]).unwrap();
+        let expected = [[0.0, 1.0], [5.0, -5.0]];
+        for (row, want) in inv.iter().zip(expected) {
+            for (v, w) in row.iter().zip(want) {
+                assert!((v - w).abs() <= 1e-14, "{inv:?}");
+            }
+        }
+        // Row swaps (a zero first pivot) and a 3 x 3 case: A A^-1 = I.
+        let a = vec![
+            vec![0.0, 2.0, 1.0],
+            vec![1.0, 1.0, 0.0],
+            vec![3.0, 0.0, 4.0],
+        ];
+        let b = inverse(&a).unwrap();
+        for (i, row) in a.iter().enumerate() {
+            for j in 0..3 {
+                let v: f64 = row.iter().zip(&b).map(|(x, b_row)| x * b_row[j]).sum();
+                assert!((v - f64::from(u8::from(i == j))).abs() <= 1e-14);
+            }
+        }
         assert_eq!(
-            check_nonsingular(&[vec![1.0, 2.0], vec![2.0, 4.0]]),
+            inverse(&[vec![1.0, 2.0], vec![2.0, 4.0]]),
             Err(MatrixError::Singular)
         );
         assert_eq!(
