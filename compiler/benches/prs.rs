@@ -1,6 +1,8 @@
-//! The contraction delta-PRS of the pendulum through the IR interpreter: 401 report steps
-//! (step 0.01, horizon 4). Compare with `cargo bench -p pendulum-buildrs` (generated code), and
-//! `reachc build` (code generation, no cargo) of the 1000-state chain.
+//! The pendulum's delta-PRS through the IR interpreter (contraction: 401 report steps, step
+//! 0.01, horizon 4; interval in y = T x with each inclusion function: 400 Euler steps), the
+//! embedding step of chains of 10, 100 and 1000 states, and `reachc build` (code generation, no
+//! cargo) of the 1000-state chain. Compare with `cargo bench -p pendulum-buildrs` (generated
+//! code).
 
 use std::path::PathBuf;
 
@@ -35,6 +37,64 @@ fn contraction_prs_interpreted(bencher: divan::Bencher) {
         reachc_runtime::engine::run(&interp, &info, analysis)
             .unwrap()
             .steps
+            .len()
+    });
+}
+
+/// The interval-based PRS of the pendulum in y = T x (the paper's Fig. 6, right): the analysis
+/// `interval` with each inclusion function.
+#[divan::bench(args = ["natural", "jacobian", "mixed"])]
+fn interval_prs_interpreted(bencher: divan::Bencher, inclusion: &str) {
+    let (interp, info) = pendulum();
+    let analysis = with_inclusion(&info, "interval", inclusion);
+    bencher.bench(|| {
+        reachc_runtime::engine::run(&interp, &info, &analysis)
+            .unwrap()
+            .steps
+            .len()
+    });
+}
+
+/// The analysis `name` of `info` with the given inclusion function.
+fn with_inclusion(
+    info: &reachc_runtime::system::ModelInfo,
+    name: &str,
+    inclusion: &str,
+) -> reachc_runtime::system::Analysis {
+    use reachc_runtime::system::Inclusion;
+    let mut a = info
+        .analyses
+        .iter()
+        .find(|a| a.name == name)
+        .unwrap()
+        .clone();
+    a.inclusion = match inclusion {
+        "natural" => Inclusion::Natural,
+        "mixed" => Inclusion::Mixed,
+        _ => Inclusion::Jacobian,
+    };
+    a
+}
+
+/// The embedding system of `specs/chain1000.sde` resized to `n` states (`engine::reach`, Jacobian
+/// inclusion): 10 Euler steps (divide by 10 for one step). The cost of a step grows with the
+/// size of the expressions (linear in n for the chain), not with n^2.
+#[divan::bench(args = [10, 100, 1000], sample_count = 20)]
+fn chain_embedding_10_steps(bencher: divan::Bencher, n: usize) {
+    let src = std::fs::read_to_string(spec("chain1000.sde"))
+        .unwrap()
+        .replace("const N = 1000", &format!("const N = {n}"));
+    let mut model = reachc::driver::check_source(&src, &spec("")).0.unwrap();
+    let prepared = prepare(&mut model);
+    let info = prepared.info.clone();
+    let interp = Interpreter::new(model, &prepared);
+    let mut a = with_inclusion(&info, "contraction", "jacobian");
+    a.method = reachc_runtime::system::Method::Interval;
+    a.integrator = reachc_runtime::system::Integrator::Euler;
+    a.horizon = 10.0 * a.step;
+    bencher.bench(|| {
+        reachc_runtime::engine::reach(&interp, &info, &a)
+            .unwrap()
             .len()
     });
 }

@@ -7,6 +7,7 @@ pub mod func;
 mod include;
 pub mod interval;
 pub mod kappa;
+pub mod simulate;
 pub mod system;
 pub mod table;
 

@@ -231,6 +231,24 @@ fn pendulum_in_transformed_coordinates() {
             half[0] > 0.035 && half[0] < 0.0385 && half[1] > 0.04 && half[1] < 0.043,
             "{name}: half-widths at t = 4: {half:?}"
         );
+        // `engine::reach` gives the same boxes without the stochastic part.
+        let (sys, info) = interpreter(&workspace().join("specs/pendulum.sde"));
+        let a = info.analyses.iter().find(|a| a.name == "interval").unwrap();
+        let boxes = engine::reach(
+            &sys,
+            &info,
+            &Analysis {
+                inclusion,
+                ..a.clone()
+            },
+        )
+        .unwrap();
+        assert_eq!(boxes.len(), r.steps.len());
+        for ((t, lo, hi), st) in boxes.iter().zip(&r.steps) {
+            assert_eq!(*t, st.t);
+            assert_eq!(Some(lo), st.det_set.lo.as_ref());
+            assert_eq!(Some(hi), st.det_set.hi.as_ref());
+        }
         // The hull in x contains the parallelotope's vertices.
         let (hl, hh) = (
             last.hull_lo.as_ref().unwrap(),

@@ -3,6 +3,7 @@
 mod build;
 pub mod inspect;
 mod run;
+mod simulate;
 
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -66,6 +67,21 @@ pub enum Command {
         #[arg(short, long)]
         out: Option<PathBuf>,
     },
+    /// Monte Carlo check of the analyses: Euler-Maruyama sample paths against each delta-PRS;
+    /// writes ANALYSIS.sim.json. Exit code 1 when a coverage check fails.
+    Simulate {
+        /// The .sde spec.
+        spec: PathBuf,
+        /// What to simulate and how.
+        #[command(flatten)]
+        sim: simulate::SimulateArgs,
+        /// Generated and compiled code, or the IR interpreter (no cargo needed).
+        #[arg(long, value_enum, default_value = "compiled")]
+        backend: run::Backend,
+        /// Directory for ANALYSIS.sim.json (default: reachc-out).
+        #[arg(short, long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// Exit code for spec errors.
@@ -103,6 +119,12 @@ fn run(command: Command) -> Result<(), u8> {
             backend,
             out,
         } => run::run_spec(&spec, analysis, backend, out),
+        Command::Simulate {
+            spec,
+            sim,
+            backend,
+            out,
+        } => simulate::run_simulate(&spec, &sim, backend, out),
         Command::Check { spec } => {
             let loaded = load_reporting(&spec)?;
             println!(

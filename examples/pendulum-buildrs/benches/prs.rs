@@ -1,5 +1,7 @@
-//! The contraction delta-PRS of the pendulum with generated (compiled) code: 401 report steps
-//! (step 0.01, horizon 4). Compare with `cargo bench -p reachc --bench prs` (the interpreter).
+//! The pendulum's delta-PRS with generated (compiled) code: contraction (401 report steps,
+//! step 0.01, horizon 4) and interval in y = T x with each inclusion function (400 Euler
+//! steps; the immrax comparison in docs/benchmarks.md). Compare with
+//! `cargo bench -p reachc --bench prs` (the interpreter).
 
 use pendulum_buildrs::{info, Pendulum};
 
@@ -21,6 +23,53 @@ fn contraction_prs_compiled(bencher: divan::Bencher) {
             .steps
             .len()
     });
+}
+
+/// The interval-based PRS of the pendulum in y = T x (the paper's Fig. 6, right), per
+/// inclusion function: one whole analysis (box trajectory, stochastic radius, report).
+#[divan::bench(args = ["natural", "jacobian", "mixed"])]
+fn interval_prs_compiled(bencher: divan::Bencher, inclusion: &str) {
+    let info = info();
+    let analysis = interval_analysis(&info, inclusion);
+    bencher.bench(|| {
+        reachc_runtime::engine::run(&Pendulum, &info, &analysis)
+            .unwrap()
+            .steps
+            .len()
+    });
+}
+
+/// The boxes alone (`engine::reach`: the embedding system's 400 Euler steps in y = T x), per
+/// inclusion function: what immrax computes per reach.
+#[divan::bench(args = ["natural", "jacobian", "mixed"])]
+fn interval_reach_compiled(bencher: divan::Bencher, inclusion: &str) {
+    let info = info();
+    let analysis = interval_analysis(&info, inclusion);
+    bencher.bench(|| {
+        reachc_runtime::engine::reach(&Pendulum, &info, &analysis)
+            .unwrap()
+            .len()
+    });
+}
+
+/// The pendulum's analysis `interval` with the given inclusion function.
+fn interval_analysis(
+    info: &reachc_runtime::system::ModelInfo,
+    inclusion: &str,
+) -> reachc_runtime::system::Analysis {
+    use reachc_runtime::system::Inclusion;
+    let mut analysis = info
+        .analyses
+        .iter()
+        .find(|a| a.name == "interval")
+        .unwrap()
+        .clone();
+    analysis.inclusion = match inclusion {
+        "natural" => Inclusion::Natural,
+        "mixed" => Inclusion::Mixed,
+        _ => Inclusion::Jacobian,
+    };
+    analysis
 }
 
 /// One drift evaluation (the nominal trajectory's inner loop).

@@ -21,7 +21,7 @@ mod result;
 mod safety;
 mod transform;
 
-pub use interval::run_interval;
+pub use interval::{reach, run_interval};
 pub use radius::MAX_VERTEX_COORDS;
 pub use result::{
     AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, StepRecord, TransformReport,

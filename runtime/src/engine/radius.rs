@@ -182,58 +182,77 @@ pub(crate) fn initial_center_and_halfwidths(
 /// arithmetic); otherwise `d' P d <= sum_ij |P_ij| h_i h_j` is used. The square root is
 /// rounded up.
 pub(crate) fn r1_bound(p: &[f64], half: &[f64]) -> f64 {
-    let n = half.len();
-    let active: Vec<usize> = (0..n).filter(|&i| half[i] > 0.0).collect();
-    if active.is_empty() {
-        return 0.0;
+    BoxRadius::new(p, half.len()).bound(half)
+}
+
+/// [`r1_bound`] for one metric and many boxes: the non-zero entries of `P` are found once, so
+/// a bound for many coordinates costs `O(nnz(P))` rather than `O(n^2)`.
+pub(crate) struct BoxRadius<'a> {
+    p: &'a [f64],
+    nonzeros: Vec<(usize, usize, f64)>,
+}
+
+impl<'a> BoxRadius<'a> {
+    /// `p` is `n x n` row-major.
+    pub(crate) fn new(p: &'a [f64], n: usize) -> Self {
+        let nonzeros = p
+            .iter()
+            .enumerate()
+            .filter(|&(_, &v)| v != 0.0)
+            .map(|(idx, &v)| (idx / n, idx % n, v))
+            .collect();
+        BoxRadius { p, nonzeros }
     }
-    let k = active.len();
-    if k > MAX_VERTEX_COORDS {
-        // Only the non-zero entries of P contribute (O(n^2) scan, no n^2 intervals).
-        return Interval::point(
-            p.iter()
-                .enumerate()
-                .filter(|&(_, &v)| v != 0.0)
-                .fold(Interval::ZERO, |acc, (idx, &v)| {
-                    let (i, j) = (idx / n, idx % n);
+
+    /// Upper bound of `max |d|_P` over `|d_i| <= half_i` (see [`r1_bound`]).
+    pub(crate) fn bound(&self, half: &[f64]) -> f64 {
+        let (p, n) = (self.p, half.len());
+        let active: Vec<usize> = (0..n).filter(|&i| half[i] > 0.0).collect();
+        if active.is_empty() {
+            return 0.0;
+        }
+        let k = active.len();
+        if k > MAX_VERTEX_COORDS {
+            let sum = self
+                .nonzeros
+                .iter()
+                .fold(Interval::ZERO, |acc, &(i, j, v)| {
                     acc + Interval::point(v.abs())
                         * Interval::point(half[i])
                         * Interval::point(half[j])
-                })
-                .hi()
-                .max(0.0),
-        )
-        .sqrt()
-        .hi();
-    }
-    // q_ab = P_ij h_i h_j over the active coordinates.
-    let mut q = vec![Interval::ZERO; k * k];
-    for (a, &i) in active.iter().enumerate() {
-        for (b, &j) in active.iter().enumerate() {
-            q[a * k + b] =
-                Interval::point(p[i * n + j]) * Interval::point(half[i]) * Interval::point(half[j]);
+                });
+            return Interval::point(sum.hi().max(0.0)).sqrt().hi();
         }
-    }
-    // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the same value,
-    // so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
-    let mut max_sq = f64::NEG_INFINITY;
-    for bits in 0u32..(1u32 << (k - 1)) {
-        let sign = |a: usize| a == 0 || (bits >> (a - 1)) & 1 == 0;
-        let mut s = Interval::ZERO;
-        for a in 0..k {
-            s += q[a * k + a];
-            for b in a + 1..k {
-                let term = q[a * k + b] + q[b * k + a];
-                if sign(a) == sign(b) {
-                    s += term;
-                } else {
-                    s -= term;
-                }
+        // q_ab = P_ij h_i h_j over the active coordinates.
+        let mut q = vec![Interval::ZERO; k * k];
+        for (a, &i) in active.iter().enumerate() {
+            for (b, &j) in active.iter().enumerate() {
+                q[a * k + b] = Interval::point(p[i * n + j])
+                    * Interval::point(half[i])
+                    * Interval::point(half[j]);
             }
         }
-        max_sq = max_sq.max(s.hi());
+        // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the same value,
+        // so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
+        let mut max_sq = f64::NEG_INFINITY;
+        for bits in 0u32..(1u32 << (k - 1)) {
+            let sign = |a: usize| a == 0 || (bits >> (a - 1)) & 1 == 0;
+            let mut s = Interval::ZERO;
+            for a in 0..k {
+                s += q[a * k + a];
+                for b in a + 1..k {
+                    let term = q[a * k + b] + q[b * k + a];
+                    if sign(a) == sign(b) {
+                        s += term;
+                    } else {
+                        s -= term;
+                    }
+                }
+            }
+            max_sq = max_sq.max(s.hi());
+        }
+        Interval::point(max_sq.max(0.0)).sqrt().hi()
     }
-    Interval::point(max_sq.max(0.0)).sqrt().hi()
 }
 
 /// `kappa(n, delta)` of the analysis' radius rule, and the rule as reported (with the

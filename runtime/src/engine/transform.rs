@@ -141,20 +141,6 @@ impl Frame {
             .hi()
     }
 
-    /// Whether `x` certainly lies in the parallelotope `{x : lo <= T x <= hi}` (`T` is exact,
-    /// so no inverse is involved).
-    pub(crate) fn contains(&self, x: &[f64], lo: &[f64], hi: &[f64]) -> bool {
-        let xi: Vec<Interval> = x.iter().map(|&v| Interval::point(v)).collect();
-        self.t
-            .chunks(self.n)
-            .map(|row| {
-                let row: Vec<Interval> = row.iter().map(|&v| Interval::point(v)).collect();
-                dot(&row, &xi)
-            })
-            .zip(lo.iter().zip(hi))
-            .all(|(y, (&a, &b))| a <= y.lo() && y.hi() <= b)
-    }
-
     /// Whether `|x - T^-1 y|_P^2 <= r^2` certainly (interval arithmetic), `p` by rows.
     pub(crate) fn certify(&self, p: &[Vec<f64>], x: &[f64], y: &[f64], r: f64) -> bool {
         let yi: Vec<Interval> = y.iter().map(|&v| Interval::point(v)).collect();
@@ -199,6 +185,17 @@ impl Frame {
             inverse_error: self.e,
         }
     }
+}
+
+/// Whether `x` certainly lies in the parallelotope `{x : lo <= T x <= hi}`, `T` by rows (`T`
+/// is exact, so no inverse is involved).
+pub(crate) fn inside(t: &[Vec<f64>], x: &[f64], lo: &[f64], hi: &[f64]) -> bool {
+    t.iter().zip(lo.iter().zip(hi)).all(|(row, (&a, &b))| {
+        let y = row.iter().zip(x).fold(Interval::ZERO, |acc, (&tij, &xj)| {
+            acc + Interval::point(tij) * Interval::point(xj)
+        });
+        a <= y.lo() && y.hi() <= b
+    })
 }
 
 /// Whether `d' P d <= r^2` certainly, for an interval vector `d` and `P` by rows.
@@ -275,7 +272,8 @@ mod tests {
         assert!(f.certify(&p, &[0.0, 1.5], &[0.2, 0.0], 0.5 + 1e-12));
         assert!(!f.certify(&p, &[0.0, 1.5], &[0.2, 0.0], 0.5 - 1e-12));
         // x = (0, 1) is T^-1 (0.2, 0): inside a box around (0.2, 0), outside one next to it.
-        assert!(f.contains(&[0.0, 1.0], &[0.1, -0.1], &[0.3, 0.1]));
-        assert!(!f.contains(&[0.0, 1.0], &[0.21, -0.1], &[0.3, 0.1]));
+        let t = [vec![1.0, 0.2], vec![1.0, 0.0]];
+        assert!(inside(&t, &[0.0, 1.0], &[0.1, -0.1], &[0.3, 0.1]));
+        assert!(!inside(&t, &[0.0, 1.0], &[0.21, -0.1], &[0.3, 0.1]));
     }
 }

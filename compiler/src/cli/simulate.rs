@@ -1,0 +1,222 @@
+//! `reachc simulate`: Monte Carlo check of the spec's delta-PRS analyses (Euler-Maruyama sample
+//! paths, `reachc_runtime::simulate`), with the compiled backend (the generated binary's
+//! `simulate` mode) or the interpreter. On a terminal, a progress bar follows the paths.
+
+use std::io::{BufRead, BufReader, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
+
+use super::run::{compiled_binary, interpreter, Backend};
+use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
+
+/// The options passed on to the simulation (the runtime's `simulate` command line).
+#[derive(clap::Args, Debug)]
+pub struct SimulateArgs {
+    /// Check only this analysis (default: all).
+    #[arg(long)]
+    pub analysis: Option<String>,
+    /// Number of sample paths.
+    #[arg(long)]
+    pub paths: u64,
+    /// Random seed; the same seed gives the same results, whatever the number of threads.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Largest Euler-Maruyama step (default: the analysis' step).
+    #[arg(long)]
+    pub dt: Option<f64>,
+    /// Recompute the PRS at this delta instead of the analysis' own.
+    #[arg(long)]
+    pub delta: Option<f64>,
+    /// Inputs: uniform in the box, random corners (both piecewise constant), or the centre.
+    #[arg(long, value_parser = ["random", "corners", "centre", "center"], default_value = "random")]
+    pub inputs: String,
+    /// Hold time of piecewise-constant inputs (default: the analysis' step).
+    #[arg(long)]
+    pub hold: Option<f64>,
+    /// Confidence level of the Clopper-Pearson bounds and of the coverage check.
+    #[arg(long, default_value_t = 0.999)]
+    pub confidence: f64,
+    /// Worker threads (default: all cores); the results do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Do not print the summaries.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl SimulateArgs {
+    /// The arguments of the runtime's `simulate` mode (without the word `simulate`).
+    fn to_args(&self, out: Option<&Path>) -> Vec<String> {
+        let mut args = vec!["--paths".to_string(), self.paths.to_string()];
+        let mut opt = |flag: &str, v: Option<String>| {
+            if let Some(v) = v {
+                args.extend([flag.to_string(), v]);
+            }
+        };
+        opt("--analysis", self.analysis.clone());
+        opt("--seed", Some(self.seed.to_string()));
+        opt("--dt", self.dt.map(|v| v.to_string()));
+        opt("--delta", self.delta.map(|v| v.to_string()));
+        opt("--inputs", Some(self.inputs.clone()));
+        opt("--hold", self.hold.map(|v| v.to_string()));
+        opt("--confidence", Some(self.confidence.to_string()));
+        opt("--threads", self.threads.map(|v| v.to_string()));
+        opt("-o", out.map(|d| d.display().to_string()));
+        if self.quiet {
+            args.push("--quiet".into());
+        }
+        args
+    }
+}
+
+/// One progress bar per analysis, under a [`MultiProgress`] that also prints other output.
+struct Bars {
+    multi: MultiProgress,
+    current: Option<(String, ProgressBar)>,
+}
+
+impl Bars {
+    fn new() -> Self {
+        Bars {
+            multi: MultiProgress::new(),
+            current: None,
+        }
+    }
+
+    /// `done` of `total` paths of `analysis`; the bar disappears when they are all done (so
+    /// the summary that follows is not interleaved with it).
+    fn update(&mut self, analysis: &str, done: u64, total: u64) {
+        if self.current.as_ref().is_none_or(|(a, _)| a != analysis) {
+            let bar = self.multi.add(ProgressBar::new(total));
+            // A fixed template: cannot fail to parse.
+            if let Ok(style) = ProgressStyle::with_template(
+                "{msg} [{bar:40}] {pos}/{len} paths, {per_sec}, eta {eta}",
+            ) {
+                bar.set_style(style.progress_chars("=> "));
+            }
+            bar.set_message(format!("simulating `{analysis}`"));
+            self.current = Some((analysis.to_string(), bar));
+        }
+        if let Some((_, bar)) = &self.current {
+            bar.set_position(done);
+            if done >= total {
+                bar.finish_and_clear();
+                self.current = None;
+            }
+        }
+    }
+}
+
+/// Runs `reachc simulate`. Exit codes: 0 every coverage check passed, 1 one failed (or spec
+/// errors, or an analysis that could not run), 2 usage, I/O or cargo failures.
+pub fn run_simulate(
+    spec: &Path,
+    sim: &SimulateArgs,
+    backend: Backend,
+    out: Option<PathBuf>,
+) -> Result<(), u8> {
+    let color = std::io::stderr().is_terminal();
+    let show_bar = std::io::stderr().is_terminal();
+    let mut loaded = load_reporting(spec)?;
+    let args = sim.to_args(out.as_deref());
+    let code = match backend {
+        Backend::Interp => {
+            let (interp, info) = interpreter(loaded, color);
+            let mut bars = Bars::new();
+            let mut progress = |a: &str, done: u64, total: u64| bars.update(a, done, total);
+            reachc_runtime::app::simulate_cli(
+                &interp,
+                &info,
+                &args,
+                &mut std::io::stdout().lock(),
+                &mut std::io::stderr().lock(),
+                show_bar.then_some(&mut progress as &mut dyn FnMut(&str, u64, u64)),
+            )
+        }
+        Backend::Compiled => {
+            let binary = compiled_binary(&mut loaded, color)?;
+            run_binary(&binary, &args, show_bar)?
+        }
+    };
+    match code {
+        0 => Ok(()),
+        1 => Err(EXIT_SPEC),
+        c => Err(c),
+    }
+}
+
+/// Runs the generated binary's `simulate` mode; with a bar, its `reachc-progress` lines drive
+/// the bar and its other output is printed around it.
+fn run_binary(binary: &Path, args: &[String], show_bar: bool) -> Result<u8, u8> {
+    let cannot_run = |e: std::io::Error| {
+        eprintln!("error: cannot run {}: {e}", binary.display());
+        EXIT_USAGE
+    };
+    let mut cmd = Command::new(binary);
+    cmd.arg("simulate").args(args);
+    if !show_bar {
+        let status = cmd.status().map_err(cannot_run)?;
+        return Ok(exit_code(status));
+    }
+    let mut child = cmd
+        .arg("--progress")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(cannot_run)?;
+    let mut bars = Bars::new();
+    let (stdout, stderr) = (child.stdout.take(), child.stderr.take());
+    std::thread::scope(|scope| {
+        // The summaries go to stdout: print them above the bar, from their own thread so that
+        // neither pipe can fill up and block the child.
+        let multi = bars.multi.clone();
+        scope.spawn(move || {
+            for line in stdout.into_iter().flat_map(|s| BufReader::new(s).lines()) {
+                let Ok(line) = line else { break };
+                multi.suspend(|| {
+                    let _ = writeln!(std::io::stdout().lock(), "{line}");
+                });
+            }
+        });
+        for line in stderr.into_iter().flat_map(|s| BufReader::new(s).lines()) {
+            let Ok(line) = line else { break };
+            match parse_progress(&line) {
+                Some((analysis, done, total)) => bars.update(analysis, done, total),
+                None => bars.multi.suspend(|| eprintln!("{line}")),
+            }
+        }
+    });
+    let status = child.wait().map_err(cannot_run)?;
+    Ok(exit_code(status))
+}
+
+/// `reachc-progress ANALYSIS DONE TOTAL` (analysis names are identifiers: no spaces).
+fn parse_progress(line: &str) -> Option<(&str, u64, u64)> {
+    let mut words = line.strip_prefix("reachc-progress ")?.split(' ');
+    let (a, d, t) = (words.next()?, words.next()?, words.next()?);
+    Some((a, d.parse().ok()?, t.parse().ok()?))
+}
+
+/// A child's exit status as ours (killed by a signal: a usage/I/O-class failure).
+fn exit_code(status: std::process::ExitStatus) -> u8 {
+    status
+        .code()
+        .map_or(EXIT_USAGE, |c| u8::try_from(c).unwrap_or(EXIT_USAGE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn progress_lines_parse() {
+        assert_eq!(
+            parse_progress("reachc-progress amgf_rule 65536 100000"),
+            Some(("amgf_rule", 65536, 100000))
+        );
+        assert_eq!(parse_progress("skipped analysis `x`"), None);
+        assert_eq!(parse_progress("reachc-progress a b c"), None);
+    }
+}

@@ -1,0 +1,93 @@
+//! Exact empirical quantiles in bounded memory: per report step, only the `j` largest
+//! (squared) distances can matter for the `(1 - delta)` quantile (the `j`-th largest, `j = floor(delta N)
+//! + 1`), so each step keeps a buffer of at most `2 j` values and prunes it to its `j` largest
+//! when it overflows. Memory is `O(j * steps)`, independent of the number of paths beyond `j`.
+//!
+//! The `j`-th largest of what has been kept so far is a threshold: later values not above it
+//! cannot change the result and are dropped before they are stored (workers compare with a
+//! snapshot of it). The kept multiset's `j`-th largest equals that of all values whatever the
+//! order values arrive in, so the quantile does not depend on threads or batching.
+
+/// The buffers of all steps.
+#[derive(Clone, Debug)]
+pub(crate) struct TopK {
+    j: usize,
+    bufs: Vec<Vec<f64>>,
+    /// Per step, the `j`-th largest kept value once known (`-inf` before).
+    thresholds: Vec<f64>,
+}
+
+/// Sorts descending (largest first); distances are never NaN here (non-finite ones are `inf`).
+fn descending(a: &f64, b: &f64) -> std::cmp::Ordering {
+    b.total_cmp(a)
+}
+
+impl TopK {
+    /// For `steps` report steps, keeping the `j >= 1` largest.
+    pub(crate) fn new(steps: usize, j: usize) -> Self {
+        TopK {
+            j,
+            bufs: vec![Vec::new(); steps],
+            thresholds: vec![f64::NEG_INFINITY; steps],
+        }
+    }
+
+    /// Values not above these cannot enter the result (one per step).
+    pub(crate) fn thresholds(&self) -> &[f64] {
+        &self.thresholds
+    }
+
+    /// Adds a value of step `k`.
+    pub(crate) fn push(&mut self, k: usize, v: f64) {
+        if v <= self.thresholds[k] {
+            return;
+        }
+        let buf = &mut self.bufs[k];
+        buf.push(v);
+        if buf.len() >= 2 * self.j {
+            buf.select_nth_unstable_by(self.j - 1, descending);
+            buf.truncate(self.j);
+            self.thresholds[k] = buf.iter().copied().fold(f64::INFINITY, f64::min);
+        }
+    }
+
+    /// `(j-th largest, largest)` of step `k`, or `None` if fewer than `j` values were pushed.
+    pub(crate) fn result(&mut self, k: usize) -> Option<(f64, f64)> {
+        let buf = &mut self.bufs[k];
+        if buf.len() < self.j {
+            return None;
+        }
+        let (_, &mut kth, _) = buf.select_nth_unstable_by(self.j - 1, descending);
+        let max = buf.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        Some((kth, max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keeps_the_exact_order_statistic_in_any_order() {
+        let values: Vec<f64> = (0..10_000u64)
+            .map(|i| ((i * 7919) % 10_007) as f64 * 0.5)
+            .collect();
+        let mut sorted = values.clone();
+        sorted.sort_by(descending);
+        for j in [1, 3, 100, 2500] {
+            let mut fwd = TopK::new(1, j);
+            let mut rev = TopK::new(1, j);
+            for &v in &values {
+                fwd.push(0, v);
+            }
+            for &v in values.iter().rev() {
+                rev.push(0, v);
+            }
+            let want = Some((sorted[j - 1], sorted[0]));
+            assert_eq!(fwd.result(0), want, "j = {j}");
+            assert_eq!(rev.result(0), want, "j = {j}");
+            assert!(fwd.bufs[0].len() < 2 * j);
+        }
+        assert_eq!(TopK::new(1, 5).result(0), None);
+    }
+}

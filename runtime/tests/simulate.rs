@@ -1,0 +1,383 @@
+//! Monte Carlo validation (`reachc_runtime::simulate`): quantiles against the exact Gaussian of
+//! the linear example, independence of the thread count, a wrong PRS caught by the coverage
+//! check, and the `simulate` command line of generated binaries.
+
+use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
+use reachc_runtime::engine::{self, AnalysisResult};
+use reachc_runtime::interval::Interval;
+use reachc_runtime::simulate::{self, InputMode, Options, SimReport};
+use reachc_runtime::system::*;
+
+/// `dx = (a x + b u) dt + s dW` per state, `n` states, one input shared by all (`b = 0`: none).
+struct Linear {
+    n: usize,
+    a: f64,
+    b: f64,
+    s: f64,
+}
+
+impl System for Linear {
+    fn n(&self) -> usize {
+        self.n
+    }
+    fn p(&self) -> usize {
+        usize::from(self.b != 0.0)
+    }
+    fn m(&self) -> usize {
+        self.n
+    }
+    fn drift(&self, x: &[f64], u: &[f64], _t: f64, out: &mut [f64]) {
+        for i in 0..self.n {
+            out[i] = self.a * x[i] + u.first().map_or(0.0, |u| self.b * u);
+        }
+    }
+    fn drift_interval(&self, x: &[Interval], u: &[Interval], _t: Interval, out: &mut [Interval]) {
+        for i in 0..self.n {
+            out[i] = Interval::point(self.a) * x[i]
+                + u.first()
+                    .map_or(Interval::ZERO, |&u| Interval::point(self.b) * u);
+        }
+    }
+    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for i in 0..self.n {
+            out[i * self.n + i] = self.a;
+        }
+    }
+    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
+        out.fill(Interval::ZERO);
+        for i in 0..self.n {
+            out[i * self.n + i] = Interval::point(self.a);
+        }
+    }
+    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+        out.fill(self.b);
+    }
+    fn jac_u_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
+        out.fill(Interval::point(self.b));
+    }
+    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for i in 0..self.n {
+            out[i * self.n + i] = self.s;
+        }
+    }
+    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
+        out.fill(Interval::ZERO);
+        for i in 0..self.n {
+            out[i * self.n + i] = Interval::point(self.s);
+        }
+    }
+}
+
+/// The paper's linear example (specs/linear.sde): n = 2, a = -0.4, s = sqrt(2), X0 = 0.
+const LINEAR: Linear = Linear {
+    n: 2,
+    a: -0.4,
+    b: 0.0,
+    s: std::f64::consts::SQRT_2,
+};
+
+/// Model info of a [`Linear`] with the exact constants (`c = a`, `sigma = s`, `rho = |b| h`),
+/// initial box `[x0 - w, x0 + w]` per state and, with an input, the input box `[-h, h]`.
+fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) -> ModelInfo {
+    let n = sys.n;
+    let mut metric = vec![0.0; n * n];
+    for i in 0..n {
+        metric[i * n + i] = 1.0;
+    }
+    ModelInfo {
+        name: "linear".into(),
+        states: (1..=n).map(|i| format!("x{i}")).collect(),
+        inputs: if sys.b != 0.0 {
+            vec!["u".into()]
+        } else {
+            vec![]
+        },
+        noises: (1..=n).map(|i| format!("w{i}")).collect(),
+        input_box: if sys.b != 0.0 { vec![(-h, h)] } else { vec![] },
+        initial: InitialSet {
+            boxes: vec![Some((x0 - w, x0 + w)); n],
+            balls: vec![],
+        },
+        domain: vec![(f64::NEG_INFINITY, f64::INFINITY); n],
+        has_domain: false,
+        unsafe_sets: vec![UnsafeSet {
+            name: "far".into(),
+            shape: UnsafeShape::HalfSpace {
+                normal: (0..n).map(|i| if i == 0 { 1.0 } else { 0.0 }).collect(),
+                offset: 1.5,
+            },
+        }],
+        analyses: vec![Analysis {
+            name: "main".into(),
+            method: Method::Contraction,
+            delta,
+            horizon: 1.5,
+            step: 0.01,
+            radius: RadiusRule::Amgf,
+            integrator: Integrator::Rk4,
+            inclusion: Inclusion::Jacobian,
+            outputs: vec![],
+            transform: None,
+            constants: Some(Constants {
+                metric,
+                c: sys.a,
+                // A factor below 1 makes the PRS too small (a wrong analysis).
+                sigma: sys.s * sigma_factor,
+                rho: (sys.b * h * n as f64).abs(),
+                how: "exact".into(),
+            }),
+            constants_error: None,
+        }],
+    }
+}
+
+fn run(sys: &Linear, info: &ModelInfo) -> AnalysisResult {
+    engine::run(sys, info, &info.analyses[0]).unwrap()
+}
+
+fn simulate(sys: &Linear, info: &ModelInfo, r: &AnalysisResult, opts: &Options) -> SimReport {
+    simulate::simulate(sys, info, r, opts, &mut |_, _| {}).unwrap()
+}
+
+/// With X0 = 0, the Euler-Maruyama iterate is exactly Gaussian: per coordinate,
+/// `v_{k+1} = (1 + a h)^2 v_k + s^2 h`, and `|X|^2 / v` is chi-square with 2 degrees of
+/// freedom, so the (1 - delta) quantile of |X| is `sqrt(-2 v ln delta)`.
+#[test]
+fn linear_quantiles_match_the_exact_gaussian() {
+    let delta = 0.01;
+    let info = info(&LINEAR, 0.0, 0.0, 0.0, delta, 1.0);
+    let r = run(&LINEAR, &info);
+    let paths = 40_000;
+    let rep = simulate(
+        &LINEAR,
+        &info,
+        &r,
+        &Options {
+            paths,
+            ..Options::default()
+        },
+    );
+    assert_eq!(rep.quantile_rank, 401, "floor(delta N) + 1");
+    let h: f64 = 0.01;
+    let mut v = 0.0;
+    let mut max_rel: f64 = 0.0;
+    for (k, st) in rep.steps.iter().enumerate().skip(1) {
+        v = (1.0 + LINEAR.a * h).powi(2) * v + 2.0 * h;
+        let exact = (-2.0 * v * delta.ln()).sqrt();
+        // Relative standard error of the 0.99 quantile with 40000 samples: about 0.5%.
+        let rel = (st.quantile - exact) / exact;
+        max_rel = max_rel.max(rel.abs());
+        if k % 25 == 0 {
+            assert!(
+                rel.abs() < 0.025,
+                "t = {}: {} vs {exact}",
+                st.t,
+                st.quantile
+            );
+        }
+        // The PRS (here the stochastic ball alone) is conservative: r_t above the quantile.
+        assert!(
+            st.r_t > st.quantile && st.prs_radius == st.r_t,
+            "t = {}",
+            st.t
+        );
+        assert!(st.max >= st.quantile);
+    }
+    assert!(max_rel < 0.04, "largest relative error {max_rel}");
+    // The time average of the (correlated) errors is much smaller than each.
+    let mean: f64 = {
+        let mut v = 0.0;
+        let errs: Vec<f64> = rep.steps[1..]
+            .iter()
+            .map(|st| {
+                v = (1.0 + LINEAR.a * h).powi(2) * v + 2.0 * h;
+                st.quantile / (-2.0 * v * delta.ln()).sqrt() - 1.0
+            })
+            .collect();
+        errs.iter().sum::<f64>() / errs.len() as f64
+    };
+    assert!(mean.abs() < 0.01, "mean relative error {mean}");
+    assert!(rep.passed(), "{}", rep.summary());
+    // X0 = 0: the t = 0 state is the nominal exactly, inside the (zero-radius) PRS.
+    assert_eq!(rep.steps[0].outside, 0);
+    assert_eq!(rep.steps[0].quantile, 0.0);
+    assert_eq!(rep.steps_per_path, 150);
+}
+
+/// Paths from a box of initial states, with random piecewise-constant inputs, Euler steps
+/// finer than the report step and an unsafe set: 1 and 2 worker threads give the same report.
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let sys = Linear {
+        n: 2,
+        a: -1.0,
+        b: 1.0,
+        s: 0.5,
+    };
+    let info = info(&sys, 0.5, 0.2, 0.3, 0.05, 1.0);
+    let r = run(&sys, &info);
+    let json = |threads: usize, inputs: InputMode| {
+        simulate(
+            &sys,
+            &info,
+            &r,
+            &Options {
+                paths: 3_000,
+                seed: 7,
+                dt: Some(0.004),
+                hold: Some(0.05),
+                inputs,
+                threads: Some(threads),
+                ..Options::default()
+            },
+        )
+        .to_json()
+    };
+    for inputs in [InputMode::Random, InputMode::Corners] {
+        let one = json(1, inputs);
+        assert_eq!(one, json(2, inputs), "{inputs:?}");
+        let v: serde_json::Value = serde_json::from_str(&one).unwrap();
+        assert_eq!(v["steps_per_path"], 450);
+        assert_eq!(v["inputs"]["mode"], inputs.name());
+        // Some paths reach x1 >= 1.5 (the drift pulls towards u / 1 <= 0.3; noise 0.5).
+        let hits = v["unsafe_sets"][0]["hits"].as_u64().unwrap();
+        assert!(hits > 0 && hits < 3_000, "{hits}");
+    }
+    // Another seed gives other paths.
+    let other = simulate(
+        &sys,
+        &info,
+        &r,
+        &Options {
+            paths: 3_000,
+            seed: 8,
+            dt: Some(0.004),
+            hold: Some(0.05),
+            ..Options::default()
+        },
+    );
+    assert_ne!(other.to_json(), json(1, InputMode::Random));
+}
+
+/// A PRS computed with half the true noise level is too small: the coverage check fails, and
+/// a PRS shrunk after the fact as well. The correct one passes.
+#[test]
+fn a_too_small_prs_fails_the_coverage_check() {
+    let opts = Options {
+        paths: 5_000,
+        ..Options::default()
+    };
+    let good = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 1.0);
+    let r = run(&LINEAR, &good);
+    assert!(simulate(&LINEAR, &good, &r, &opts).passed());
+
+    let wrong = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 0.5);
+    let rep = simulate(&LINEAR, &wrong, &run(&LINEAR, &wrong), &opts);
+    assert!(!rep.passed());
+    // Half the radius: with r_t about q_0.99 / 0.86 (the amgf rule's slack at n = 2),
+    // P(chi2_2 > ln(100) / (4 * 0.86^2)) = 0.21 of the paths outside at each step.
+    let last = rep.steps.last().unwrap();
+    assert!(
+        last.fraction > 0.15 && last.fraction < 0.25,
+        "{}",
+        last.fraction
+    );
+    assert_eq!(
+        rep.verdict.failing_steps, 150,
+        "every step after t = 0 fails"
+    );
+
+    let mut shrunk = r.clone();
+    for st in &mut shrunk.steps {
+        st.prs_radius *= 0.6;
+    }
+    let rep = simulate(&LINEAR, &good, &shrunk, &opts);
+    assert!(!rep.passed());
+    assert!(rep.verdict.worst_cp_lower > 0.01, "{:?}", rep.verdict);
+}
+
+fn cli(info: &ModelInfo, args: &[&str]) -> (u8, String, String) {
+    let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = run_cli(&LINEAR, info, &args, &mut out, &mut err);
+    (
+        code,
+        String::from_utf8(out).unwrap(),
+        String::from_utf8(err).unwrap(),
+    )
+}
+
+#[test]
+fn simulate_command_line() {
+    let dir = std::env::temp_dir().join(format!("reachc-simulate-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    let good = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 1.0);
+    let (code, out, err) = cli(&good, &["simulate", "--paths", "2000", "-o", d]);
+    assert_eq!(code, EXIT_OK, "{err}");
+    assert!(
+        out.contains("coverage: PASS") && out.contains("path-steps/s"),
+        "{out}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("main.sim.json")).unwrap()).unwrap();
+    assert_eq!(json["verdict"]["status"], "pass");
+    assert_eq!(json["paths"], 2000);
+    assert_eq!(json["steps"].as_array().unwrap().len(), 151);
+
+    // --delta recomputes the PRS: a larger delta, a smaller PRS.
+    let (code, _, err) = cli(
+        &good,
+        &[
+            "simulate", "--paths", "500", "--delta", "0.2", "-q", "-o", d,
+        ],
+    );
+    assert_eq!(code, EXIT_OK, "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("main.sim.json")).unwrap()).unwrap();
+    assert_eq!(json["delta"], 0.2);
+
+    // A wrong PRS: exit status 1, the report still written.
+    let wrong = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 0.5);
+    let (code, out, _) = cli(&wrong, &["simulate", "--paths", "2000", "-o", d]);
+    assert_eq!(code, EXIT_FAILED);
+    assert!(out.contains("coverage: FAIL"), "{out}");
+
+    // --progress writes machine-readable lines.
+    let (_, _, err) = cli(
+        &good,
+        &["simulate", "--paths", "10", "--progress", "-q", "-o", d],
+    );
+    assert!(err.contains("reachc-progress main 10 10"), "{err}");
+
+    // An analysis without constants has no PRS: skipped, not a failure.
+    let mut none = good.clone();
+    none.analyses[0].constants = None;
+    let (code, _, err) = cli(&none, &["simulate", "--paths", "10", "-o", d]);
+    assert_eq!(code, EXIT_OK);
+    assert!(
+        err.contains("skipped analysis `main`: no PRS to check"),
+        "{err}"
+    );
+
+    for bad in [
+        &["simulate"][..],
+        &["simulate", "--paths", "0"],
+        &["simulate", "--paths", "ten"],
+        &["simulate", "--paths", "10", "--inputs", "sideways"],
+        &["simulate", "--paths", "10", "--delta", "1.5"],
+        &["simulate", "--paths", "10", "--dt", "-1"],
+        &["simulate", "--paths", "10", "--analysis", "nope"],
+        &["simulate", "--paths", "10", "--threads", "0"],
+    ] {
+        let (code, _, err) = cli(&good, bad);
+        assert_eq!(code, EXIT_USAGE, "{bad:?}: {err}");
+        assert!(err.starts_with("error: "), "{bad:?}: {err}");
+    }
+    let (code, out, _) = cli(&good, &["simulate", "--help"]);
+    assert_eq!(code, EXIT_OK);
+    assert!(out.contains("--paths N"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
