@@ -13,5 +13,6 @@ pub mod diagnostics;
 pub mod driver;
 pub mod ir;
 pub mod model;
+pub mod plot;
 pub mod syntax;
 pub use config::Config;

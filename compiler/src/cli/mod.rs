@@ -2,6 +2,7 @@
 
 mod build;
 pub mod inspect;
+mod plot;
 mod run;
 mod simulate;
 
@@ -66,6 +67,9 @@ pub enum Command {
         /// Directory for ANALYSIS.json and ANALYSIS.csv (default: reachc-out).
         #[arg(short, long)]
         out: Option<PathBuf>,
+        /// Pictures of the results.
+        #[command(flatten)]
+        plot: plot::RunPlotArgs,
     },
     /// Monte Carlo check of the analyses: Euler-Maruyama sample paths against each delta-PRS;
     /// writes ANALYSIS.sim.json. Exit code 1 when a coverage check fails.
@@ -82,6 +86,9 @@ pub enum Command {
         #[arg(short, long)]
         out: Option<PathBuf>,
     },
+    /// Draw a result of `reachc run` (ANALYSIS.json): its sets in a 2-D projection with sample
+    /// paths and unsafe sets (given the spec), and its radii against time; SVG and PNG.
+    Plot(plot::PlotArgs),
 }
 
 /// Exit code for spec errors.
@@ -118,13 +125,15 @@ fn run(command: Command) -> Result<(), u8> {
             analysis,
             backend,
             out,
-        } => run::run_spec(&spec, analysis, backend, out),
+            plot,
+        } => run::run_spec(&spec, analysis, backend, out, &plot),
         Command::Simulate {
             spec,
             sim,
             backend,
             out,
         } => simulate::run_simulate(&spec, &sim, backend, out),
+        Command::Plot(args) => plot::run_plot(&args),
         Command::Check { spec } => {
             let loaded = load_reporting(&spec)?;
             println!(

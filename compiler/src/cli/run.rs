@@ -6,12 +6,14 @@ use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
 
+use super::plot::{self, RunPlotArgs};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
 use crate::backend::crate_writer::{compile_crate, shared_target_dir, write_crate, CrateOptions};
 use crate::backend::interp::Interpreter;
 use crate::backend::{mangle, prepare};
 use crate::diagnostics::render;
 use crate::driver::Loaded;
+use reachc_runtime::app::DEFAULT_OUT_DIR;
 use reachc_runtime::system::ModelInfo;
 
 /// Which backend computes the sets.
@@ -23,33 +25,35 @@ pub enum Backend {
     Interp,
 }
 
-/// Runs `reachc run`. Exit codes: 0 ok, 1 spec errors or an analysis that cannot run, 2 usage,
-/// I/O or cargo failures.
+/// Runs `reachc run` (and, with `--plot`, plots the results). Exit codes: 0 ok, 1 spec errors
+/// or an analysis that cannot run, 2 usage, I/O or cargo failures.
 pub fn run_spec(
     spec: &Path,
     analysis: Option<String>,
     backend: Backend,
     out: Option<PathBuf>,
+    plot: &RunPlotArgs,
 ) -> Result<(), u8> {
     let color = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
-    let mut args = Vec::new();
-    if let Some(name) = analysis {
-        args.extend(["--analysis".to_string(), name]);
+    plot::check_states(plot, &loaded)?;
+    let out_dir = out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR));
+    let mut args = vec!["-o".to_string(), out_dir.display().to_string()];
+    if let Some(name) = &analysis {
+        args.extend(["--analysis".to_string(), name.clone()]);
     }
-    if let Some(dir) = out {
-        args.extend(["-o".to_string(), dir.display().to_string()]);
-    }
-    let code = match backend {
+    let before = plot::result_stamps(plot, &loaded, &out_dir);
+    let (code, model) = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
-            reachc_runtime::app::run_cli(
+            let code = reachc_runtime::app::run_cli(
                 &interp,
                 &info,
                 &args,
                 &mut std::io::stdout().lock(),
                 &mut std::io::stderr().lock(),
-            )
+            );
+            (code, Some((interp, info)))
         }
         Backend::Compiled => {
             let binary = compiled_binary(&mut loaded, color)?;
@@ -60,15 +64,32 @@ pub fn run_spec(
                     eprintln!("error: cannot run {}: {e}", binary.display());
                     EXIT_USAGE
                 })?;
-            status
+            let code = status
                 .code()
-                .map_or(EXIT_USAGE, |c| u8::try_from(c).unwrap_or(EXIT_USAGE))
+                .map_or(EXIT_USAGE, |c| u8::try_from(c).unwrap_or(EXIT_USAGE));
+            // The plots simulate paths in-process: the interpreter computes the same numbers.
+            (
+                code,
+                plot.plot.is_some().then(|| plot::interpreter_quiet(loaded)),
+            )
         }
     };
-    match code {
-        0 => Ok(()),
-        1 => Err(EXIT_SPEC),
-        c => Err(c),
+    // A usage error (e.g. an unknown analysis) ran nothing worth plotting.
+    let plotted = match model {
+        Some((interp, info)) if code != EXIT_USAGE => plot::plot_after_run(
+            plot,
+            (&interp, &info),
+            analysis.as_deref(),
+            &out_dir,
+            &before,
+        ),
+        _ => Ok(()),
+    };
+    match (code, plotted) {
+        (0, p) => p,
+        (1, Err(p)) => Err(p.max(EXIT_SPEC)),
+        (1, Ok(())) => Err(EXIT_SPEC),
+        (c, _) => Err(c),
     }
 }
 

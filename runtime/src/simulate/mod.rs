@@ -27,11 +27,13 @@ mod prs;
 mod regions;
 mod report;
 mod rng;
+mod sample;
 mod topk;
 
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
 pub use inputs::InputMode;
 pub use report::{Coverage, HorizonReport, InputsReport, SimReport, SimStep, UnsafeHits};
+pub use sample::{sample_paths, MAX_SAMPLE_PATHS};
 
 use crate::engine::AnalysisResult;
 use crate::system::{ModelInfo, System, UnsafeShape};

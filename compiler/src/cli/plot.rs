@@ -1,0 +1,318 @@
+//! `reachc plot RESULT.json` and `reachc run --plot DIR`: pictures of a result (see
+//! [`crate::plot`]). Sample paths are simulated in-process with the IR interpreter (the same
+//! numbers as generated code, no cargo).
+//!
+//! The radius figure's empirical quantile comes from the Monte Carlo report
+//! `<analysis>.sim.json` beside the result when there is one for the same analysis, delta and
+//! report times (written by `reachc simulate -o DIR`); otherwise `reachc run --plot` simulates
+//! [`RUN_QUANTILE_PATHS`] paths itself, and `reachc plot` draws no quantile.
+
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
+
+use reachc_runtime::engine;
+use reachc_runtime::simulate::{self, SimReport};
+use reachc_runtime::system::ModelInfo;
+
+use super::{load_reporting, EXIT_USAGE};
+use crate::backend::interp::Interpreter;
+use crate::backend::prepare;
+use crate::driver::Loaded;
+use crate::plot::input::{ResultFile, SimFile};
+use crate::plot::{self, select, Choice, Model, Quantile};
+
+/// Paths `reachc run --plot` simulates for the quantile when no report is at hand.
+pub const RUN_QUANTILE_PATHS: u64 = 2000;
+/// Most state updates (paths x states x report times) of that simulation: about a second with
+/// the interpreter; larger models (the 1000-state chain: 2 * 10^8) get no quantile.
+const RUN_QUANTILE_WORK: f64 = 2e7;
+
+/// `reachc plot`'s options.
+#[derive(clap::Args, Debug)]
+pub struct PlotArgs {
+    /// The result of `reachc run` (DIR/ANALYSIS.json).
+    pub result: PathBuf,
+    /// The spec the result was computed from: adds sample paths and unsafe sets.
+    #[arg(long)]
+    pub spec: Option<PathBuf>,
+    /// The two plotted states, e.g. `theta,omega` (default: the first two output states).
+    #[arg(long, value_delimiter = ',')]
+    pub states: Option<Vec<String>>,
+    /// Times at which the sets are drawn, e.g. `0.5,1,4` (default: four, evenly spaced, ending
+    /// at the horizon).
+    #[arg(long, value_delimiter = ',')]
+    pub times: Option<Vec<f64>>,
+    /// Number of sample paths (with --spec).
+    #[arg(long, default_value_t = plot::DEFAULT_PATHS)]
+    pub paths: u64,
+    /// Random seed of the paths (path p is path p of `reachc simulate --seed S`).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Monte Carlo report for the quantile (default: ANALYSIS.sim.json beside the result).
+    #[arg(long)]
+    pub sim: Option<PathBuf>,
+    /// Directory for the pictures (default: the result's directory).
+    #[arg(short, long)]
+    pub out: Option<PathBuf>,
+}
+
+/// `reachc run`'s plot options.
+#[derive(clap::Args, Debug, Default)]
+pub struct RunPlotArgs {
+    /// Also draw each analysis' sets and radii into DIR (ANALYSIS_sets.svg/.png,
+    /// ANALYSIS_radius.svg/.png).
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// The two plotted states, e.g. `theta,omega` (default: the first two output states).
+    #[arg(long, value_delimiter = ',', requires = "plot", value_name = "A,B")]
+    pub plot_states: Option<Vec<String>>,
+    /// Times at which the sets are drawn (default: four, evenly spaced, ending at the horizon).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        requires = "plot",
+        value_name = "T1,T2,..."
+    )]
+    pub plot_times: Option<Vec<f64>>,
+    /// Number of sample paths drawn.
+    #[arg(long, default_value_t = plot::DEFAULT_PATHS, requires = "plot", value_name = "N")]
+    pub plot_paths: u64,
+}
+
+/// Checks `--plot-states` against the spec's states before anything runs.
+pub(super) fn check_states(args: &RunPlotArgs, loaded: &Loaded) -> Result<(), u8> {
+    let Some(names) = &args.plot_states else {
+        return Ok(());
+    };
+    let states: Vec<String> = loaded.model.states.iter().map(|s| s.name.clone()).collect();
+    select::pick_states(&states, &[], Some(names))
+        .map(|_| ())
+        .map_err(|e| {
+            eprintln!("error: --plot-states: {e}");
+            EXIT_USAGE
+        })
+}
+
+/// When each analysis' result in `out_dir` was last modified (`None`: absent), taken before a
+/// run: a result is from the run if it changed. (Comparing with the run's start time is not
+/// enough: many file systems stamp files with a clock that lags the system time by a few
+/// milliseconds.)
+pub(super) fn result_stamps(args: &RunPlotArgs, loaded: &Loaded, out_dir: &Path) -> Stamps {
+    if args.plot.is_none() {
+        return Vec::new();
+    }
+    loaded
+        .model
+        .analyses
+        .iter()
+        .map(|a| (a.name.clone(), modified(&result_path(out_dir, &a.name))))
+        .collect()
+}
+
+/// Modification times of results, per analysis (see [`result_stamps`]).
+pub(super) type Stamps = Vec<(String, Option<SystemTime>)>;
+
+fn result_path(out_dir: &Path, analysis: &str) -> PathBuf {
+    out_dir.join(format!("{analysis}.json"))
+}
+
+fn modified(path: &Path) -> Option<SystemTime> {
+    std::fs::metadata(path).and_then(|m| m.modified()).ok()
+}
+
+/// The interpreter of a loaded spec, without printing its warnings again.
+pub(super) fn interpreter_quiet(mut loaded: Loaded) -> (Interpreter, ModelInfo) {
+    let prepared = prepare(&mut loaded.model);
+    let info = prepared.info.clone();
+    (Interpreter::new(loaded.model, &prepared), info)
+}
+
+/// Prints the files written.
+fn report_written(files: &[PathBuf]) {
+    let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
+    println!("  plotted {}", names.join(", "));
+}
+
+/// The quantile of a Monte Carlo report.
+fn quantile_of(sim: &SimFile, source: String) -> Quantile {
+    Quantile {
+        values: sim.steps.iter().map(|s| s.quantile).collect(),
+        paths: sim.paths,
+        source,
+    }
+}
+
+/// `<analysis>.sim.json` beside the result, if it is there and belongs to it (otherwise a
+/// message on stderr says why it is not used).
+fn sibling_report(result_path: &Path, result: &ResultFile) -> Option<Quantile> {
+    let path = result_path.with_file_name(format!("{}.sim.json", result.analysis));
+    if !path.is_file() {
+        return None;
+    }
+    match SimFile::read(&path).map(|s| (s.mismatch(result), s)) {
+        Ok((None, sim)) => Some(quantile_of(&sim, format!("report {}", path.display()))),
+        Ok((Some(why), _)) => {
+            eprintln!("note: not using {}: {why}", path.display());
+            None
+        }
+        Err(e) => {
+            eprintln!("note: not using {e}");
+            None
+        }
+    }
+}
+
+/// Runs `reachc plot`. Exit codes: 0 ok, 1 errors in the spec, 2 usage or I/O errors (a missing
+/// or malformed result, an unknown state, a spec that does not match the result).
+pub fn run_plot(args: &PlotArgs) -> Result<(), u8> {
+    let usage = |e: String| {
+        eprintln!("error: {e}");
+        EXIT_USAGE
+    };
+    let result = ResultFile::read(&args.result).map_err(usage)?;
+    let quantile = match &args.sim {
+        Some(path) => {
+            let sim = SimFile::read(path).map_err(usage)?;
+            if let Some(why) = sim.mismatch(&result) {
+                return Err(usage(format!(
+                    "{} does not belong to the result: {why}",
+                    path.display()
+                )));
+            }
+            Some(quantile_of(&sim, format!("report {}", path.display())))
+        }
+        None => sibling_report(&args.result, &result),
+    };
+    let model = match &args.spec {
+        Some(spec) => Some(interpreter_quiet(load_reporting(spec)?)),
+        None => None,
+    };
+    let choice = Choice {
+        states: args.states.clone(),
+        times: args.times.clone(),
+        paths: args.paths,
+        seed: args.seed,
+    };
+    let dir = match &args.out {
+        Some(d) => d.clone(),
+        None => args
+            .result
+            .parent()
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
+    };
+    let model = model.as_ref().map(|(sys, info)| Model { sys, info });
+    let files = plot::plot_result(&result, model.as_ref(), quantile.as_ref(), &choice, &dir)
+        .map_err(usage)?;
+    report_written(&files);
+    Ok(())
+}
+
+/// The quantile for `reachc run --plot`: the report beside the result, or a simulation of
+/// [`RUN_QUANTILE_PATHS`] paths of the analysis (computed again in-process: the interpreter
+/// gives the result's numbers).
+fn run_quantile(model: &Model<'_>, json: &Path, result: &ResultFile) -> Option<Quantile> {
+    if let Some(q) = sibling_report(json, result) {
+        return Some(q);
+    }
+    let work = RUN_QUANTILE_PATHS as f64 * (result.states.len() * result.steps.len()) as f64;
+    if work > RUN_QUANTILE_WORK {
+        eprintln!(
+            "note: no quantile for `{}`: {RUN_QUANTILE_PATHS} paths of {} states are too many \
+             for a plot (`reachc simulate -o` writes a report that is used)",
+            result.analysis,
+            result.states.len()
+        );
+        return None;
+    }
+    let analysis = model
+        .info
+        .analyses
+        .iter()
+        .find(|a| a.name == result.analysis)?;
+    let computed = engine::run(model.sys, model.info, analysis).ok()?;
+    let opts = simulate::Options {
+        paths: RUN_QUANTILE_PATHS,
+        ..simulate::Options::default()
+    };
+    let report: SimReport =
+        match simulate::simulate(model.sys, model.info, &computed, &opts, &mut |_, _| {}) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("note: no quantile for `{}`: {e}", result.analysis);
+                return None;
+            }
+        };
+    Some(Quantile {
+        values: report
+            .steps
+            .iter()
+            .map(|s| Some(s.quantile).filter(|q| q.is_finite()))
+            .collect(),
+        paths: report.paths,
+        source: format!(
+            "{} paths simulated for this plot (seed 0; `reachc simulate -o` writes a report \
+             that is used instead)",
+            report.paths
+        ),
+    })
+}
+
+/// After `reachc run` wrote its results into `out_dir` (`before`: their [`result_stamps`]
+/// before the run): plots each selected analysis into `args.plot`. `interp` is the spec's interpreter and model info.
+/// Analyses without a PRS get sample paths and unsafe sets only; those without a fresh result
+/// (they failed or were skipped) are not plotted. Returns the exit code of a failure.
+pub(super) fn plot_after_run(
+    args: &RunPlotArgs,
+    (sys, info): (&Interpreter, &ModelInfo),
+    analysis: Option<&str>,
+    out_dir: &Path,
+    before: &Stamps,
+) -> Result<(), u8> {
+    let Some(dir) = &args.plot else {
+        return Ok(());
+    };
+    let model = Model { sys, info };
+    let choice = Choice {
+        states: args.plot_states.clone(),
+        times: args.plot_times.clone(),
+        paths: args.plot_paths,
+        seed: 0,
+    };
+    let mut status = Ok(());
+    for a in info
+        .analyses
+        .iter()
+        .filter(|a| analysis.is_none_or(|name| a.name == name))
+    {
+        let plotted = if a.constants.is_none() {
+            eprintln!(
+                "note: analysis `{}` has no PRS: plotting its sample paths and unsafe sets only",
+                a.name
+            );
+            plot::plot_without_result(&model, a, &choice, dir)
+        } else {
+            let json = result_path(out_dir, &a.name);
+            let previous = before.iter().find(|(n, _)| *n == a.name).and_then(|b| b.1);
+            let fresh = modified(&json).is_some_and(|t| Some(t) != previous);
+            if !fresh {
+                eprintln!(
+                    "note: no result for analysis `{}` from this run: not plotted",
+                    a.name
+                );
+                continue;
+            }
+            ResultFile::read(&json).and_then(|result| {
+                let quantile = run_quantile(&model, &json, &result);
+                plot::plot_result(&result, Some(&model), quantile.as_ref(), &choice, dir)
+            })
+        };
+        match plotted {
+            Ok(files) => report_written(&files),
+            Err(e) => {
+                eprintln!("error: plotting analysis `{}`: {e}", a.name);
+                status = Err(EXIT_USAGE);
+            }
+        }
+    }
+    status
+}

@@ -1,0 +1,559 @@
+//! The two figures, drawn with plotters on any backend (SVG or bitmap, see
+//! [`super::output`]): the sets in a 2-D projection (deterministic sets dashed, PRS solid, as
+//! in the paper's figures; sample paths, the nominal, unsafe sets) and the radii against time.
+//! Each figure has a legend panel on its right, so nothing is drawn over the data.
+
+use plotters::coord::ranged1d::{Ranged, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use super::font::FAMILY;
+use super::geometry::Point;
+use super::output::Draw;
+use super::scene::{RadiusScene, SetsScene};
+
+/// Size of the sets figure.
+pub const SETS_SIZE: (u32, u32) = (1100, 780);
+/// Size of the radius figure.
+pub const RADIUS_SIZE: (u32, u32) = (1100, 560);
+/// Width of the legend panel.
+const LEGEND_WIDTH: u32 = 320;
+/// Characters per legend line (at the legend's font size, within the panel).
+const LEGEND_CHARS: usize = 38;
+
+/// Colours of the successive times (colour-blind-safe order of the usual tab10 palette, red
+/// left out: it marks unsafe sets).
+const PALETTE: [RGBColor; 7] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+const UNSAFE: RGBColor = RGBColor(214, 39, 40);
+const PATHS: RGBColor = RGBColor(100, 100, 100);
+const GRID: RGBColor = RGBColor(232, 232, 232);
+const NOTE: RGBColor = RGBColor(90, 90, 90);
+
+/// How an entry of the legend is marked.
+enum Mark {
+    Line(RGBAColor, u32),
+    Dashed(RGBAColor),
+    Fill(RGBAColor),
+    Dot(RGBAColor),
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    format!("drawing failed: {e}")
+}
+
+/// A number for a label: at most 6 decimals, without trailing zeros.
+fn num(v: f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}
+
+/// An axis label for the value `v` on an axis spanning `span`: enough decimals for ticks a
+/// tenth of the span apart, trailing zeros dropped; large magnitudes in scientific notation
+/// (`2.5e6`), which keeps the labels short.
+fn tick(v: f64, span: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if span.abs() >= 1e5 || v.abs() >= 1e6 || (v.abs() < 1e-4 && span == v.abs()) {
+        let s = format!("{v:.3e}");
+        return match s.split_once('e') {
+            Some((m, e)) if m.contains('.') => {
+                format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            _ => s,
+        };
+    }
+    let decimals = if span > 0.0 {
+        (-(span / 10.0).log10().floor()).clamp(0.0, 12.0) as usize
+    } else {
+        6
+    };
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.into()
+    }
+}
+
+/// Splits `text` into lines of at most `width` characters, at spaces.
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split_whitespace() {
+        match lines.last_mut() {
+            Some(l) if l.chars().count() + 1 + word.chars().count() <= width => {
+                l.push(' ');
+                l.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    lines
+}
+
+/// Draws the legend panel: marked entries, then notes in smaller grey text.
+fn legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: u32,
+    entries: &[(Mark, String)],
+    notes: &[String],
+) -> Result<(), String> {
+    let i = |v: i32| v * s as i32;
+    let label = TextStyle::from((FAMILY, f64::from(15 * s)).into_font())
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let small = TextStyle::from((FAMILY, f64::from(13 * s)).into_font())
+        .color(&NOTE)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let mut y = i(60);
+    for (mark, text) in entries {
+        let (x0, x1) = (i(12), i(46));
+        match mark {
+            Mark::Line(c, w) => area.draw(&PathElement::new(
+                vec![(x0, y), (x1, y)],
+                c.stroke_width(w * s),
+            )),
+            Mark::Dashed(c) => area.draw(&DashedPathElement::new(
+                vec![(x0, y), (x1, y)],
+                i(7),
+                i(4),
+                c.stroke_width(2 * s),
+            )),
+            Mark::Fill(c) => area.draw(&Rectangle::new(
+                [(x0, y - i(7)), (x1, y + i(7))],
+                c.filled(),
+            )),
+            Mark::Dot(c) => area.draw(&Circle::new(((x0 + x1) / 2, y), 4 * s, c.filled())),
+        }
+        .map_err(err)?;
+        for line in wrap(text, LEGEND_CHARS) {
+            area.draw(&Text::new(line, (i(56), y), label.clone()))
+                .map_err(err)?;
+            y += i(19);
+        }
+        y += i(5);
+    }
+    y += i(12);
+    for note in notes {
+        for line in wrap(note, LEGEND_CHARS + 6) {
+            area.draw(&Text::new(line, (i(12), y), small.clone()))
+                .map_err(err)?;
+            y += i(17);
+        }
+        y += i(6);
+    }
+    Ok(())
+}
+
+/// The smallest rectangle holding `points`, padded by 6% (and to a non-zero size).
+fn view(points: impl Iterator<Item = Point>) -> ((f64, f64), (f64, f64)) {
+    let (mut x, mut y) = (
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (f64::INFINITY, f64::NEG_INFINITY),
+    );
+    for p in points.filter(|p| p[0].is_finite() && p[1].is_finite()) {
+        x = (x.0.min(p[0]), x.1.max(p[0]));
+        y = (y.0.min(p[1]), y.1.max(p[1]));
+    }
+    let pad = |(lo, hi): (f64, f64)| {
+        // No finite point: any view.
+        if lo > hi {
+            return (-1.0, 1.0);
+        }
+        let w = (hi - lo)
+            .max(1e-9 * lo.abs().max(hi.abs()))
+            .max(f64::MIN_POSITIVE);
+        let w = if hi > lo { w } else { 1e-3 * lo.abs().max(1.0) };
+        (lo - 0.06 * w, hi + 0.06 * w)
+    };
+    (pad(x), pad(y))
+}
+
+/// A closed polygon's points (the first repeated at the end).
+fn closed(poly: &[Point]) -> Vec<(f64, f64)> {
+    poly.iter()
+        .chain(poly.first())
+        .map(|p| (p[0], p[1]))
+        .collect()
+}
+
+impl Draw for SetsScene {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        s: u32,
+    ) -> Result<(), String> {
+        let (i, f) = (|v: i32| v * s as i32, |v: u32| f64::from(v * s));
+        let (w, _) = area.dim_in_pixel();
+        let (plot_area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s));
+        // The view holds the sets, the paths and the bounded unsafe sets.
+        let bounded = self.regions.iter().filter_map(|(_, r)| r.bounds());
+        let (vx, vy) = view(
+            self.slices
+                .iter()
+                .flat_map(|sl| sl.prs.iter().chain(&sl.det).chain(&sl.samples).copied())
+                .chain(self.nominal.iter().copied())
+                .chain(self.paths.iter().flatten().copied())
+                .chain(bounded.flat_map(|(x, y)| [[x.0, y.0], [x.1, y.1]])),
+        );
+        let mut chart = ChartBuilder::on(&plot_area)
+            .caption(&self.title, (FAMILY, f(22)))
+            .margin(14 * s)
+            .x_label_area_size(50 * s)
+            .y_label_area_size(80 * s)
+            .build_cartesian_2d(vx.0..vx.1, vy.0..vy.1)
+            .map_err(err)?;
+        let x_fmt = |v: &f64| tick(*v, vx.1 - vx.0);
+        let y_fmt = |v: &f64| tick(*v, vy.1 - vy.0);
+        chart
+            .configure_mesh()
+            .x_desc(self.axes[0].as_str())
+            .y_desc(self.axes[1].as_str())
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&y_fmt)
+            .label_style((FAMILY, f(14)))
+            .axis_desc_style((FAMILY, f(17)))
+            .max_light_lines(0)
+            .bold_line_style(GRID.stroke_width(s))
+            .axis_style(BLACK.stroke_width(s))
+            .set_all_tick_mark_size(i(5))
+            .draw()
+            .map_err(err)?;
+        let mut entries = Vec::new();
+
+        // Unsafe sets first: everything else is drawn over them.
+        let unsafe_fill = UNSAFE.mix(0.22);
+        for (name, region) in &self.regions {
+            let poly = region.polygon_in(vx, vy);
+            if poly.len() < 3 {
+                continue;
+            }
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    closed(&poly),
+                    unsafe_fill.filled(),
+                )))
+                .map_err(err)?;
+            chart
+                .draw_series(LineSeries::new(closed(&poly), UNSAFE.stroke_width(s)))
+                .map_err(err)?;
+            let n = poly.len() as f64;
+            let c = (
+                poly.iter().map(|p| p[0]).sum::<f64>() / n,
+                poly.iter().map(|p| p[1]).sum::<f64>() / n,
+            );
+            let style = TextStyle::from((FAMILY, f(14)).into_font())
+                .color(&RGBColor(150, 20, 20))
+                .pos(Pos::new(HPos::Center, VPos::Center));
+            chart
+                .draw_series(std::iter::once(Text::new(name.clone(), c, style)))
+                .map_err(err)?;
+        }
+        if !self.regions.is_empty() {
+            let names: Vec<&str> = self.regions.iter().map(|(n, _)| n.as_str()).collect();
+            entries.push((
+                Mark::Fill(unsafe_fill),
+                format!("unsafe: {}", names.join(", ")),
+            ));
+        }
+
+        for (k, sl) in self.slices.iter().enumerate() {
+            let c = PALETTE[k % PALETTE.len()];
+            if sl.prs.len() >= 3 {
+                chart
+                    .draw_series(std::iter::once(Polygon::new(
+                        closed(&sl.prs),
+                        c.mix(0.07).filled(),
+                    )))
+                    .map_err(err)?;
+            }
+        }
+        for p in &self.paths {
+            // A diverged path stops where its state stops being finite.
+            let finite = p
+                .iter()
+                .take_while(|z| z[0].is_finite() && z[1].is_finite());
+            chart
+                .draw_series(LineSeries::new(
+                    finite.map(|z| (z[0], z[1])),
+                    PATHS.mix(0.3).stroke_width(s),
+                ))
+                .map_err(err)?;
+        }
+        if !self.paths.is_empty() {
+            entries.push((
+                Mark::Line(PATHS.mix(0.6), 1),
+                format!("{} sample paths (Euler-Maruyama)", self.paths.len()),
+            ));
+        }
+        let mut any_det = false;
+        for (k, sl) in self.slices.iter().enumerate() {
+            let c = PALETTE[k % PALETTE.len()];
+            if sl.det.len() >= 2 {
+                any_det = true;
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        closed(&sl.det),
+                        i(7),
+                        i(4),
+                        c.stroke_width(2 * s),
+                    ))
+                    .map_err(err)?;
+            }
+            if sl.prs.len() >= 3 {
+                chart
+                    .draw_series(LineSeries::new(closed(&sl.prs), c.stroke_width(2 * s)))
+                    .map_err(err)?;
+            }
+            chart
+                .draw_series(
+                    sl.samples
+                        .iter()
+                        .map(|z| Circle::new((z[0], z[1]), 2 * s, c.mix(0.85).filled())),
+                )
+                .map_err(err)?;
+            let what = if sl.prs.is_empty() {
+                "X_t of the paths"
+            } else {
+                "PRS"
+            };
+            let mark = if sl.prs.is_empty() {
+                Mark::Dot(c.to_rgba())
+            } else {
+                Mark::Line(c.to_rgba(), 2)
+            };
+            entries.push((mark, format!("t = {}: {what}", num(sl.t))));
+        }
+        if any_det {
+            entries.push((
+                Mark::Dashed(BLACK.mix(0.7)),
+                "deterministic set (dashed, same colour)".into(),
+            ));
+        }
+        if !self.slices.iter().all(|sl| sl.samples.is_empty())
+            && self.slices.iter().any(|sl| !sl.prs.is_empty())
+        {
+            entries.push((
+                Mark::Dot(PATHS.to_rgba()),
+                "dots: the paths' X_t at those times".into(),
+            ));
+        }
+        if !self.nominal.is_empty() {
+            chart
+                .draw_series(LineSeries::new(
+                    self.nominal.iter().map(|z| (z[0], z[1])),
+                    BLACK.stroke_width(2 * s),
+                ))
+                .map_err(err)?;
+            for (k, sl) in self.slices.iter().enumerate() {
+                if let Some(z) = sl.nominal {
+                    let c = PALETTE[k % PALETTE.len()];
+                    chart
+                        .draw_series([
+                            Circle::new((z[0], z[1]), 5 * s, BLACK.filled()),
+                            Circle::new((z[0], z[1]), 3 * s, c.filled()),
+                        ])
+                        .map_err(err)?;
+                }
+            }
+            entries.push((Mark::Line(BLACK.to_rgba(), 2), self.nominal_label.clone()));
+        }
+        let mut notes = self.notes.clone();
+        let (px, py) = view(self.paths.iter().flatten().copied());
+        let ratio = ((vx.1 - vx.0) / (px.1 - px.0)).min((vy.1 - vy.0) / (py.1 - py.0));
+        if !self.paths.is_empty() && ratio > 100.0 {
+            notes.push(format!(
+                "the sets are about {ratio:.0e} times wider than the spread of the sample \
+                 paths: earlier times show both"
+            ));
+        }
+        legend(&legend_area, s, &entries, &notes)
+    }
+}
+
+/// Radii spanning more than this ratio are drawn on a logarithmic axis.
+const LOG_RATIO: f64 = 1e3;
+
+impl Draw for RadiusScene {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        s: u32,
+    ) -> Result<(), String> {
+        let f = |v: u32| f64::from(v * s);
+        let (w, _) = area.dim_in_pixel();
+        let (plot_area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s));
+        let t_last = self.times.last().copied().unwrap_or(1.0);
+        let right = if t_last > 0.0 { t_last } else { 1.0 };
+        let quantiles = self.quantile.iter().flat_map(|(q, _)| q.iter().flatten());
+        let values: Vec<f64> = self
+            .prs_radius
+            .iter()
+            .chain(&self.r_t)
+            .chain(quantiles)
+            .copied()
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .collect();
+        let top = values.iter().copied().fold(0.0, f64::max);
+        let low = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let mut builder = ChartBuilder::on(&plot_area);
+        builder
+            .caption(&self.title, (FAMILY, f(22)))
+            .margin(14 * s)
+            .x_label_area_size(50 * s)
+            .y_label_area_size(80 * s);
+        // Exploding radii (an analysis whose c is positive) would flatten everything else.
+        if top > LOG_RATIO * low {
+            let chart = builder
+                .build_cartesian_2d(0.0..right, (low / 1.5..top * 1.5).log_scale())
+                .map_err(err)?;
+            let note = format!(
+                "logarithmic scale: the radii span {:.0} orders of magnitude",
+                (top / low).log10()
+            );
+            self.draw_radii(chart, s, true, &legend_area, note)
+        } else {
+            let top = if top > 0.0 { 1.08 * top } else { 1.0 };
+            let chart = builder
+                .build_cartesian_2d(0.0..right, 0.0..top)
+                .map_err(err)?;
+            self.draw_radii(chart, s, false, &legend_area, String::new())
+        }
+    }
+}
+
+impl RadiusScene {
+    /// The curves and the legend, on a linear or logarithmic radius axis (`log`: values that
+    /// are not positive are left out).
+    fn draw_radii<DB: DrawingBackend, Y>(
+        &self,
+        mut chart: ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
+        s: u32,
+        log: bool,
+        legend_area: &DrawingArea<DB, Shift>,
+        note: String,
+    ) -> Result<(), String>
+    where
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let (i, f) = (|v: i32| v * s as i32, |v: u32| f64::from(v * s));
+        let x_span = self.times.last().copied().unwrap_or(1.0);
+        let y_span = if log { 0.0 } else { chart.y_range().end };
+        let x_fmt = |v: &f64| tick(*v, x_span);
+        let y_fmt = |v: &f64| {
+            if log {
+                tick(*v, v.abs())
+            } else {
+                tick(*v, y_span)
+            }
+        };
+        chart
+            .configure_mesh()
+            .x_desc("t")
+            .y_desc("radius (P-norm)")
+            .x_label_formatter(&x_fmt)
+            .y_label_formatter(&y_fmt)
+            .label_style((FAMILY, f(14)))
+            .axis_desc_style((FAMILY, f(17)))
+            .max_light_lines(0)
+            .bold_line_style(GRID.stroke_width(s))
+            .axis_style(BLACK.stroke_width(s))
+            .set_all_tick_mark_size(i(5))
+            .draw()
+            .map_err(err)?;
+        // Runs of drawable points: a curve is broken where a value is missing, not finite, or
+        // (log scale) not positive.
+        let runs = |values: &mut dyn Iterator<Item = Option<f64>>| -> Vec<Vec<(f64, f64)>> {
+            let mut runs = vec![Vec::new()];
+            for (t, v) in self.times.iter().zip(values) {
+                match v {
+                    Some(v) if v.is_finite() && (!log || v > 0.0) => {
+                        if let Some(r) = runs.last_mut() {
+                            r.push((*t, v));
+                        }
+                    }
+                    _ => runs.push(Vec::new()),
+                }
+            }
+            runs
+        };
+        let (c_prs, c_r, c_q) = (PALETTE[1], PALETTE[0], PALETTE[2]);
+        for run in runs(&mut self.prs_radius.iter().map(|v| Some(*v))) {
+            chart
+                .draw_series(LineSeries::new(run, c_prs.stroke_width(2 * s)))
+                .map_err(err)?;
+        }
+        // Dashed over the PRS radius: the two are equal for a point initial set and no inputs.
+        for run in runs(&mut self.r_t.iter().map(|v| Some(*v))) {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    run,
+                    i(9),
+                    i(5),
+                    c_r.stroke_width(2 * s),
+                ))
+                .map_err(err)?;
+        }
+        let mut entries = vec![
+            (Mark::Line(c_prs.to_rgba(), 2), self.prs_label.clone()),
+            (
+                Mark::Dashed(c_r.to_rgba()),
+                "stochastic radius r_t".to_string(),
+            ),
+        ];
+        if let Some((q, label)) = &self.quantile {
+            for run in runs(&mut q.iter().copied()) {
+                chart
+                    .draw_series(LineSeries::new(run, c_q.stroke_width(2 * s)))
+                    .map_err(err)?;
+            }
+            entries.push((Mark::Line(c_q.to_rgba(), 2), label.clone()));
+        }
+        let mut notes = self.notes.clone();
+        if !note.is_empty() {
+            notes.push(note);
+        }
+        legend(legend_area, s, &entries, &notes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_and_wrapping() {
+        assert_eq!(num(3.0000000000000004), "3");
+        assert_eq!(num(0.25), "0.25");
+        assert_eq!(num(-0.0), "0");
+        assert_eq!(tick(0.30000000000000004, 0.8), "0.3");
+        assert_eq!(tick(-2.0, 5.0), "-2");
+        assert_eq!(tick(1.5e7, 4e7), "1.5e7");
+        assert_eq!(tick(1.00005, 1e-4), "1.00005");
+        assert_eq!(tick(2e-6, 2e-6), "2e-6");
+        assert_eq!(
+            wrap("a bb ccc dddd", 6),
+            vec!["a bb".to_string(), "ccc".into(), "dddd".into()]
+        );
+    }
+}

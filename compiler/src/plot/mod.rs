@@ -1,0 +1,238 @@
+//! Plots of a result (`reachc plot`, `reachc run --plot`): SVG and PNG pictures of the sets in
+//! a 2-D projection and of the radii against time.
+//!
+//! - [`input`]: the result JSON and the Monte Carlo report, read and checked;
+//! - [`select`]: which states and times to draw;
+//! - [`geometry`]: the exact projections of the sets (support functions, boundary polygons);
+//! - [`regions`]: the unsafe sets in the plane;
+//! - [`scene`]: what the figures show, in plot coordinates;
+//! - [`figures`], [`font`], [`raster`], [`output`]: drawing with plotters, the bundled font,
+//!   the PNG backend's text, SVG and PNG files written atomically.
+//!
+//! This file ties them together: from a result (and, if given, the spec's model for sample
+//! paths and unsafe sets) to the files.
+
+pub mod figures;
+pub mod font;
+pub mod geometry;
+pub mod input;
+pub mod output;
+pub mod raster;
+pub mod regions;
+pub mod scene;
+pub mod select;
+
+use std::path::{Path, PathBuf};
+
+use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::{Analysis, ModelInfo, System};
+
+use geometry::Plane;
+use input::ResultFile;
+use output::Draw;
+use regions::Region;
+
+/// Sample paths drawn by default.
+pub const DEFAULT_PATHS: u64 = 50;
+
+/// What to draw.
+#[derive(Clone, Debug, Default)]
+pub struct Choice {
+    /// The plotted states by name (default: the first two outputs).
+    pub states: Option<Vec<String>>,
+    /// The times at which sets are drawn (default: four, evenly spaced, ending at the horizon).
+    pub times: Option<Vec<f64>>,
+    /// Number of sample paths.
+    pub paths: u64,
+    /// Their random seed (path `p` is path `p` of `reachc simulate --seed S`).
+    pub seed: u64,
+}
+
+/// The spec's model, for sample paths and unsafe sets.
+pub struct Model<'a> {
+    /// The system (the interpreter).
+    pub sys: &'a (dyn System + Sync),
+    /// Its sets and analyses.
+    pub info: &'a ModelInfo,
+}
+
+/// A Monte Carlo quantile for the radius figure.
+#[derive(Clone, Debug)]
+pub struct Quantile {
+    /// Per report time of the result (`None` where not finite).
+    pub values: Vec<Option<f64>>,
+    /// Number of paths.
+    pub paths: u64,
+    /// Where it comes from, for the legend.
+    pub source: String,
+}
+
+/// Output file names: `DIR/<analysis>_sets.svg` and so on.
+fn file(dir: &Path, analysis: &str, figure: &str, ext: &str) -> PathBuf {
+    dir.join(format!("{analysis}_{figure}.{ext}"))
+}
+
+/// The unsafe sets of `info` in the plane; those that do not constrain it are listed in
+/// `notes`.
+fn unsafe_regions(
+    info: &ModelInfo,
+    plane: [usize; 2],
+    notes: &mut Vec<String>,
+) -> Vec<(String, Region)> {
+    let mut regions = Vec::new();
+    for u in &info.unsafe_sets {
+        match Region::of(&u.shape, plane) {
+            Some(r) => regions.push((u.name.clone(), r)),
+            None => notes.push(format!(
+                "unsafe set `{}` does not constrain the plotted states: not drawn",
+                u.name
+            )),
+        }
+    }
+    regions
+}
+
+/// Records `choice.paths` sample paths at `times` (with `simulate`'s defaults: random inputs,
+/// Euler steps and input hold times of one report step).
+fn sample(
+    model: &Model<'_>,
+    times: &[f64],
+    center: Option<&[f64]>,
+    choice: &Choice,
+) -> Result<Vec<Vec<f64>>, String> {
+    let opts = Options {
+        paths: choice.paths,
+        seed: choice.seed,
+        ..Options::default()
+    };
+    simulate::sample_paths(model.sys, model.info, times, center, &opts)
+        .map_err(|e| format!("cannot simulate sample paths: {e}"))
+}
+
+/// Renders every figure first (so that a failure writes nothing), then writes the files.
+fn write_all(
+    dir: &Path,
+    files: Vec<(PathBuf, Result<Vec<u8>, String>)>,
+) -> Result<Vec<PathBuf>, String> {
+    let mut rendered = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        rendered.push((path, bytes?));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    rendered
+        .iter()
+        .map(|(path, bytes)| output::write_atomic(path, bytes))
+        .collect()
+}
+
+/// Both renderings of a figure.
+fn renderings<F: Draw>(
+    figure: &F,
+    size: output::Size,
+    dir: &Path,
+    analysis: &str,
+    name: &str,
+) -> Vec<(PathBuf, Result<Vec<u8>, String>)> {
+    vec![
+        (
+            file(dir, analysis, name, "svg"),
+            output::svg(figure, size).map(String::into_bytes),
+        ),
+        (file(dir, analysis, name, "png"), output::png(figure, size)),
+    ]
+}
+
+/// Plots a result: `DIR/<analysis>_sets.svg/.png` (the sets at the chosen times, sample paths
+/// and unsafe sets when the model is given) and `DIR/<analysis>_radius.svg/.png`. Returns the
+/// files written; the error is a message (nothing is written then).
+pub fn plot_result(
+    result: &ResultFile,
+    model: Option<&Model<'_>>,
+    quantile: Option<&Quantile>,
+    choice: &Choice,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
+    font::register()?;
+    if let Some(m) = model {
+        if m.info.name != result.model || m.info.states != result.states {
+            return Err(format!(
+                "the spec's model `{}` ({} states) is not the result's model `{}` ({} states)",
+                m.info.name,
+                m.info.states.len(),
+                result.model,
+                result.states.len()
+            ));
+        }
+    }
+    let states = select::pick_states(&result.states, &result.outputs, choice.states.as_deref())?;
+    let picked = select::pick_times(&result.times(), choice.times.as_deref())?;
+    let plane = Plane::new(states, &result.constants.metric)
+        .ok_or("the result's metric is not positive definite")?;
+    let mut notes = Vec::new();
+    let (regions, paths) = match model {
+        Some(m) => (
+            unsafe_regions(m.info, states, &mut notes),
+            sample(m, &result.times(), Some(&result.initial_center), choice)?,
+        ),
+        None => {
+            notes.push("no sample paths or unsafe sets: they need the spec (--spec)".into());
+            (Vec::new(), Vec::new())
+        }
+    };
+    let mut sets = scene::sets_scene(result, &plane, &picked, &paths, regions);
+    sets.notes.extend(notes);
+    let radius = scene::radius_scene(
+        result,
+        quantile.map(|q| (q.values.clone(), q.paths, q.source.as_str())),
+    );
+    let mut files = renderings(&sets, figures::SETS_SIZE, dir, &result.analysis, "sets");
+    files.extend(renderings(
+        &radius,
+        figures::RADIUS_SIZE,
+        dir,
+        &result.analysis,
+        "radius",
+    ));
+    write_all(dir, files)
+}
+
+/// The report times `0, step, 2 step, ..., horizon` of an analysis (the last step may be
+/// shorter; a ratio that is an integer up to rounding adds no sliver step).
+fn report_times(analysis: &Analysis) -> Vec<f64> {
+    let (h, s) = (analysis.horizon, analysis.step);
+    let steps = (h / s * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+    let mut times: Vec<f64> = (0..steps).map(|k| k as f64 * s).collect();
+    times.push(h);
+    times
+}
+
+/// Plots an analysis that has no PRS (its constants could not be bounded): sample paths and
+/// unsafe sets only, `DIR/<analysis>_sets.svg/.png`.
+pub fn plot_without_result(
+    model: &Model<'_>,
+    analysis: &Analysis,
+    choice: &Choice,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
+    font::register()?;
+    let info = model.info;
+    if !(analysis.step > 0.0 && analysis.horizon > 0.0 && analysis.horizon / analysis.step <= 1e7) {
+        return Err(format!(
+            "analysis `{}`: horizon {} and step {} give no report times to plot",
+            analysis.name, analysis.horizon, analysis.step
+        ));
+    }
+    let states = select::pick_states(&info.states, &analysis.outputs, choice.states.as_deref())?;
+    let times = report_times(analysis);
+    let picked = select::pick_times(&times, choice.times.as_deref())?;
+    let plane = Plane::of_states(states);
+    let mut notes = Vec::new();
+    let regions = unsafe_regions(info, states, &mut notes);
+    let paths = sample(model, &times, None, choice)?;
+    let mut sets = scene::paths_scene(info, analysis, &plane, (&times, &picked), &paths, regions);
+    sets.notes.extend(notes);
+    write_all(
+        dir,
+        renderings(&sets, figures::SETS_SIZE, dir, &analysis.name, "sets"),
+    )
+}

@@ -1,0 +1,261 @@
+//! What the figures show, in plot coordinates: the sets at the chosen times as polygons, the
+//! nominal and the sample paths projected, the unsafe regions, the radii over time. Built from
+//! the inputs here, drawn by [`super::figures`], so that the geometry can be tested without
+//! pixels.
+
+use super::geometry::{Plane, Point, Projected};
+use super::input::{ResultFile, Step};
+use super::regions::Region;
+use reachc_runtime::system::{Analysis, ModelInfo};
+
+/// The sets figure: a 2-D projection.
+#[derive(Clone, Debug)]
+pub struct SetsScene {
+    /// Title (model and analysis).
+    pub title: String,
+    /// Axis labels (the plotted states).
+    pub axes: [String; 2],
+    /// The sets at the chosen times.
+    pub slices: Vec<Slice>,
+    /// The nominal trajectory (or the sets' centres), at every report time.
+    pub nominal: Vec<Point>,
+    /// What [`SetsScene::nominal`] is, for the legend.
+    pub nominal_label: String,
+    /// Sample paths, at every report time.
+    pub paths: Vec<Vec<Point>>,
+    /// Unsafe sets by name.
+    pub regions: Vec<(String, Region)>,
+    /// Lines for the legend panel: what is drawn and what is not.
+    pub notes: Vec<String>,
+}
+
+/// The sets at one report time.
+#[derive(Clone, Debug)]
+pub struct Slice {
+    /// Time.
+    pub t: f64,
+    /// Boundary of the deterministic set (counter-clockwise; empty when there is none).
+    pub det: Vec<Point>,
+    /// Boundary of the PRS (empty when there is none).
+    pub prs: Vec<Point>,
+    /// The sample paths' states at this time.
+    pub samples: Vec<Point>,
+    /// The nominal state (or the set's centre) at this time.
+    pub nominal: Option<Point>,
+}
+
+/// The radius figure: radii in the P-norm against time.
+#[derive(Clone, Debug)]
+pub struct RadiusScene {
+    /// Title.
+    pub title: String,
+    /// Report times.
+    pub times: Vec<f64>,
+    /// `r_t`.
+    pub r_t: Vec<f64>,
+    /// The PRS radius.
+    pub prs_radius: Vec<f64>,
+    /// What the PRS radius is, for the legend.
+    pub prs_label: String,
+    /// The empirical quantile per report time (`None` where not finite) and its legend label.
+    pub quantile: Option<(Vec<Option<f64>>, String)>,
+    /// Lines for the legend panel.
+    pub notes: Vec<String>,
+}
+
+/// The deterministic set of a step in the plane.
+fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
+    let d = &step.det_set;
+    // ResultFile::read checked the shapes: lo and hi exist for boxes and parallelotopes.
+    let corners = || {
+        (
+            d.lo.as_deref().unwrap_or(&[]),
+            d.hi.as_deref().unwrap_or(&[]),
+        )
+    };
+    match (d.shape.as_str(), &result.transform) {
+        ("box", _) => {
+            let (lo, hi) = corners();
+            plane.boxed(lo, hi)
+        }
+        ("parallelotope", Some(t)) => {
+            let (lo, hi) = corners();
+            plane.parallelotope(lo, hi, &t.inverse)
+        }
+        _ => plane.p_ball(&d.center, d.radius),
+    }
+}
+
+/// Projects each path (flat, `n` per report time) onto the plane.
+fn project_paths(plane: &Plane, n: usize, paths: &[Vec<f64>]) -> Vec<Vec<Point>> {
+    paths
+        .iter()
+        .map(|p| p.chunks_exact(n).map(|x| plane.point(x)).collect())
+        .collect()
+}
+
+/// The states of the paths at report step `k`, where finite.
+fn samples_at(paths: &[Vec<Point>], k: usize) -> Vec<Point> {
+    paths
+        .iter()
+        .filter_map(|p| p.get(k).copied())
+        .filter(|z| z[0].is_finite() && z[1].is_finite())
+        .collect()
+}
+
+/// The sets figure of a result: the sets at report steps `picked`, the nominal, the sample
+/// paths (flat states at every report time of the result) and the unsafe regions.
+pub fn sets_scene(
+    result: &ResultFile,
+    plane: &Plane,
+    picked: &[usize],
+    paths: &[Vec<f64>],
+    regions: Vec<(String, Region)>,
+) -> SetsScene {
+    let n = result.states.len();
+    let paths = project_paths(plane, n, paths);
+    let slices = picked
+        .iter()
+        .map(|&k| {
+            let step = &result.steps[k];
+            let det = det_set(result, plane, step);
+            let prs = det.plus_ellipse(plane.shape, step.r_t);
+            // A point deterministic set (a point initial set at t = 0) has no boundary.
+            let degenerate = det.support([1.0, 0.0]) + det.support([-1.0, 0.0]) <= 0.0
+                && det.support([0.0, 1.0]) + det.support([0.0, -1.0]) <= 0.0;
+            Slice {
+                t: step.t,
+                det: if degenerate {
+                    Vec::new()
+                } else {
+                    det.polygon()
+                },
+                prs: prs.polygon(),
+                samples: samples_at(&paths, k),
+                nominal: Some(plane.point(&step.nominal)),
+            }
+        })
+        .collect();
+    let contraction = result.method == "contraction";
+    let [a, b] = plane.states;
+    let shape = match result.transform {
+        Some(_) => "parallelotope",
+        None if contraction => "P-ball",
+        None => "box",
+    };
+    let notes = vec![
+        format!(
+            "PRS (solid) = deterministic {shape} (dashed) + B_P(r_t): holds X_t with \
+             probability ≥ 1 - δ, δ = {}",
+            result.delta
+        ),
+        "projections onto the plotted states: exact".into(),
+    ];
+    SetsScene {
+        title: format!("{} / {}: δ-PRS", result.model, result.analysis),
+        axes: [result.states[a].clone(), result.states[b].clone()],
+        slices,
+        nominal: result
+            .steps
+            .iter()
+            .map(|s| plane.point(&s.nominal))
+            .collect(),
+        nominal_label: if contraction {
+            "nominal x*_t".into()
+        } else {
+            "centre of the deterministic set".into()
+        },
+        paths,
+        regions,
+        notes,
+    }
+}
+
+/// The sets figure of an analysis that has no PRS (its constants could not be bounded): the
+/// sample paths (flat states at the report times `times`) with their states at report steps
+/// `picked`, and the unsafe regions.
+pub fn paths_scene(
+    info: &ModelInfo,
+    analysis: &Analysis,
+    plane: &Plane,
+    (times, picked): (&[f64], &[usize]),
+    paths: &[Vec<f64>],
+    regions: Vec<(String, Region)>,
+) -> SetsScene {
+    let paths = project_paths(plane, info.states.len(), paths);
+    let [a, b] = plane.states;
+    // The reason can be a long Jacobian entry: the warning printed with the spec shows it.
+    let why = match analysis.constants_error.as_deref() {
+        Some(e) if e.chars().count() <= 160 => e.to_string(),
+        _ => "the analysis' constants (c, sigma, rho) could not be bounded (see the warning)"
+            .to_string(),
+    };
+    SetsScene {
+        title: format!("{} / {}: sample paths", info.name, analysis.name),
+        axes: [info.states[a].clone(), info.states[b].clone()],
+        slices: picked
+            .iter()
+            .map(|&k| Slice {
+                t: times[k],
+                det: Vec::new(),
+                prs: Vec::new(),
+                samples: samples_at(&paths, k),
+                nominal: None,
+            })
+            .collect(),
+        nominal: Vec::new(),
+        nominal_label: String::new(),
+        paths,
+        regions,
+        notes: vec![format!("no PRS: {why}")],
+    }
+}
+
+/// The radius figure of a result, with the Monte Carlo quantile if given (`(values per report
+/// time, number of paths, where they come from)`).
+pub fn radius_scene(
+    result: &ResultFile,
+    quantile: Option<(Vec<Option<f64>>, u64, &str)>,
+) -> RadiusScene {
+    let contraction = result.method == "contraction";
+    let mut notes = vec![
+        format!(
+            "radii in the P-norm |v|_P = sqrt(v' P v), δ = {}",
+            result.delta
+        ),
+        "r_t = sqrt(Ψ_t κ(n, δ)): the stochastic part".into(),
+    ];
+    let quantile = quantile.map(|(values, paths, source)| {
+        notes.push(format!("quantile: {source}"));
+        (
+            values,
+            format!("empirical (1-δ) quantile of |X_t - x*_t|_P ({paths} paths)"),
+        )
+    });
+    if quantile.is_none() {
+        notes.push(
+            "no empirical quantile: run `reachc simulate` with -o into the result's directory"
+                .into(),
+        );
+    }
+    if !contraction {
+        notes.push(
+            "interval method: the PRS is a box or parallelotope + B_P(r_t); its P-radius \
+             bounds it coarsely, so the quantile is only indicative"
+                .into(),
+        );
+    }
+    RadiusScene {
+        title: format!("{} / {}: radii", result.model, result.analysis),
+        times: result.times(),
+        r_t: result.steps.iter().map(|s| s.r_t).collect(),
+        prs_radius: result.steps.iter().map(|s| s.prs_radius).collect(),
+        prs_label: if contraction {
+            "PRS radius R_t + r_t".into()
+        } else {
+            "P-radius of a ball containing the PRS".into()
+        },
+        quantile,
+        notes,
+    }
+}

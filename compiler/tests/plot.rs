@@ -1,0 +1,363 @@
+//! `reachc plot` and `reachc run --plot` (interpreter backend): the files written, that they are
+//! SVG and PNG pictures of the right size, the error cases and their exit codes; and that the
+//! plotted sample paths are the Monte Carlo check's paths.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use reachc::backend::interp::Interpreter;
+use reachc::backend::prepare;
+use reachc_runtime::engine;
+use reachc_runtime::simulate::{self, Options};
+
+fn reachc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_reachc"))
+        .args(args)
+        .output()
+        .expect("the reachc binary runs")
+}
+
+fn spec(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../specs")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+/// A fresh directory for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("reachc-plot-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// The files in `dir` (names, sorted).
+fn files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// A complete SVG document; its text.
+fn svg(path: &Path) -> String {
+    let s = std::fs::read_to_string(path).unwrap();
+    assert!(s.starts_with("<svg "), "{}", path.display());
+    assert!(s.trim_end().ends_with("</svg>"), "{}", path.display());
+    s
+}
+
+/// A PNG's width and height (from its IHDR chunk).
+fn png_size(path: &Path) -> (u32, u32) {
+    let b = std::fs::read(path).unwrap();
+    assert_eq!(&b[..8], b"\x89PNG\r\n\x1a\n", "{}", path.display());
+    assert_eq!(&b[12..16], b"IHDR");
+    let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    (be(16), be(20))
+}
+
+#[test]
+fn run_plot_writes_both_figures_for_each_analysis() {
+    let dir = temp_dir("run");
+    let out = dir.join("out");
+    let plots = dir.join("plots");
+    let o = reachc(&[
+        "run",
+        &spec("pendulum.sde"),
+        "--backend",
+        "interp",
+        "-o",
+        out.to_str().unwrap(),
+        "--plot",
+        plots.to_str().unwrap(),
+        "--plot-paths",
+        "5",
+        "--plot-times",
+        "1,4",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let expected: Vec<String> = ["contraction", "interval"]
+        .iter()
+        .flat_map(|a| {
+            ["radius.png", "radius.svg", "sets.png", "sets.svg"].map(|f| format!("{a}_{f}"))
+        })
+        .collect();
+    // Exactly the pictures: no temporary files left behind.
+    assert_eq!(files(&plots), expected);
+    for a in ["contraction", "interval"] {
+        let sets = svg(&plots.join(format!("{a}_sets.svg")));
+        assert!(sets.contains(&format!("pendulum / {a}")), "{a}");
+        assert!(
+            sets.contains(">\ntheta\n<") && sets.contains(">\nomega\n<"),
+            "{a}"
+        );
+        assert!(
+            sets.contains("5 sample paths") && sets.contains("t = 4: PRS"),
+            "{a}"
+        );
+        assert!(!sets.contains("t = 2: PRS"), "{a}: only the chosen times");
+        let radius = svg(&plots.join(format!("{a}_radius.svg")));
+        // No report beside the results: the run simulated the quantile itself.
+        assert!(radius.contains("2000 paths"), "{a}");
+        assert_eq!(png_size(&plots.join(format!("{a}_sets.png"))), (1100, 780));
+        assert_eq!(
+            png_size(&plots.join(format!("{a}_radius.png"))),
+            (1100, 560)
+        );
+    }
+    let interval = svg(&plots.join("interval_sets.svg"));
+    assert!(interval.contains("deterministic parallelotope"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn plot_reads_a_result_with_or_without_the_spec() {
+    let dir = temp_dir("plot");
+    let d = dir.to_str().unwrap();
+    let run = reachc(&[
+        "run",
+        &spec("linear.sde"),
+        "--backend",
+        "interp",
+        "--analysis",
+        "amgf_rule",
+        "-o",
+        d,
+    ]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run));
+    let result = dir.join("amgf_rule.json");
+    let r = result.to_str().unwrap();
+
+    // Without the spec: sets and radii only, next to the result.
+    let o = reachc(&["plot", r]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let sets = svg(&dir.join("amgf_rule_sets.svg"));
+    assert!(!sets.contains("sample paths (Euler"));
+    assert!(sets.contains("no sample paths or unsafe sets"));
+    assert!(!svg(&dir.join("amgf_rule_radius.svg")).contains("quantile of"));
+
+    // With the spec, chosen states (swapped) and a Monte Carlo report beside the result.
+    let sim = reachc(&[
+        "simulate",
+        &spec("linear.sde"),
+        "--backend",
+        "interp",
+        "--analysis",
+        "amgf_rule",
+        "--paths",
+        "300",
+        "-q",
+        "-o",
+        d,
+    ]);
+    assert_eq!(sim.status.code(), Some(0), "{}", text(&sim));
+    let pics = dir.join("pics");
+    let o = reachc(&[
+        "plot",
+        r,
+        "--spec",
+        &spec("linear.sde"),
+        "--states",
+        "x2,x1",
+        "--paths",
+        "7",
+        "-o",
+        pics.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let sets = svg(&pics.join("amgf_rule_sets.svg"));
+    assert!(sets.contains("7 sample paths"));
+    // The vertical axis is x1 now: its label is the rotated one.
+    let label = |name: &str| {
+        let at = sets.find(&format!(">\n{name}\n<")).unwrap();
+        let start = sets[..at].rfind("<text").unwrap();
+        sets[start..at].contains("rotate(270")
+    };
+    assert!(label("x1") && !label("x2"));
+    let radius = svg(&pics.join("amgf_rule_radius.svg"));
+    assert!(radius.contains("(300 paths)") && radius.contains("amgf_rule.sim.json"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn plot_errors_are_usage_errors_and_write_nothing() {
+    let dir = temp_dir("errors");
+    let d = dir.to_str().unwrap();
+    let missing = reachc(&["plot", &format!("{d}/none.json")]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(text(&missing).contains("cannot read"), "{}", text(&missing));
+
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{\"model\": \"m\", \"steps\": [").unwrap();
+    let o = reachc(&["plot", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).contains("is not a valid result of `reachc run`"),
+        "{}",
+        text(&o)
+    );
+
+    let run = reachc(&[
+        "run",
+        &spec("linear.sde"),
+        "--backend",
+        "interp",
+        "--analysis",
+        "amgf_rule",
+        "-o",
+        d,
+    ]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run));
+    let r = dir.join("amgf_rule.json");
+    let r = r.to_str().unwrap();
+    let o = reachc(&["plot", r, "--states", "x1,vx"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).contains("no state `vx` (the states are: x1, x2)"),
+        "{}",
+        text(&o)
+    );
+    let o = reachc(&["plot", r, "--times", "0.5,7"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("time 7 is outside"), "{}", text(&o));
+    let o = reachc(&["plot", r, "--spec", &spec("pendulum.sde")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).contains("is not the result's model"),
+        "{}",
+        text(&o)
+    );
+    // A result whose metric is not square is refused, not drawn.
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(r).unwrap()).unwrap();
+    json["constants"]["metric"] = serde_json::json!([[1.0]]);
+    std::fs::write(&bad, json.to_string()).unwrap();
+    let o = reachc(&["plot", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("the metric is not 2 x 2"), "{}", text(&o));
+    // An output directory that cannot be made: an I/O error.
+    let o = reachc(&["plot", r, "-o", bad.join("sub").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("cannot create"), "{}", text(&o));
+    // None of the failures wrote a picture (nor a temporary file).
+    assert!(
+        files(&dir)
+            .iter()
+            .all(|f| f.ends_with(".json") || f.ends_with(".csv")),
+        "{:?}",
+        files(&dir)
+    );
+
+    // run --plot checks the state names before running anything.
+    let o = reachc(&[
+        "run",
+        &spec("linear.sde"),
+        "--backend",
+        "interp",
+        "-o",
+        &format!("{d}/run"),
+        "--plot",
+        &format!("{d}/pics"),
+        "--plot-states",
+        "x1,y",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).contains("--plot-states: no state `y`"),
+        "{}",
+        text(&o)
+    );
+    assert!(!dir.join("run").exists() && !dir.join("pics").exists());
+    // The plot options need --plot.
+    let o = reachc(&["run", &spec("linear.sde"), "--plot-paths", "3"]);
+    assert_eq!(o.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_analysis_without_a_prs_gets_paths_and_unsafe_sets() {
+    let dir = temp_dir("unicycle");
+    let plots = dir.join("plots");
+    let o = reachc(&[
+        "run",
+        &spec("unicycle.sde"),
+        "--backend",
+        "interp",
+        "-o",
+        dir.join("out").to_str().unwrap(),
+        "--plot",
+        plots.to_str().unwrap(),
+        "--plot-paths",
+        "10",
+    ]);
+    // The analysis cannot run (exit 1), its picture is drawn all the same.
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("has no PRS: plotting its sample paths and unsafe sets only"));
+    assert_eq!(
+        files(&plots),
+        ["contraction_sets.png", "contraction_sets.svg"]
+    );
+    let sets = svg(&plots.join("contraction_sets.svg"));
+    for name in ["obs1", "obs2", "obs3", "10 sample paths", "no PRS"] {
+        assert!(sets.contains(name), "{name}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sample_paths_are_the_monte_carlo_paths() {
+    // Path p of sample_paths is path p of simulate: the largest distance from the nominal at
+    // each report time is the report's `max`.
+    let mut loaded = reachc::driver::load(Path::new(&spec("pendulum.sde"))).unwrap();
+    let prepared = prepare(&mut loaded.model);
+    let info = prepared.info.clone();
+    let interp = Interpreter::new(loaded.model, &prepared);
+    let analysis = info
+        .analyses
+        .iter()
+        .find(|a| a.name == "contraction")
+        .unwrap();
+    let result = engine::run(&interp, &info, analysis).unwrap();
+    let opts = Options {
+        paths: 64,
+        seed: 5,
+        ..Options::default()
+    };
+    let report = simulate::simulate(&interp, &info, &result, &opts, &mut |_, _| {}).unwrap();
+    let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
+    let paths = simulate::sample_paths(&interp, &info, &times, Some(&result.initial_center), &opts)
+        .unwrap();
+    assert_eq!(paths.len(), 64);
+    let p = &result.constants.metric;
+    for (k, step) in result.steps.iter().enumerate() {
+        let max = paths
+            .iter()
+            .map(|x| {
+                let d: Vec<f64> = (0..2).map(|i| x[2 * k + i] - step.nominal[i]).collect();
+                (0..2)
+                    .flat_map(|i| (0..2).map(move |j| (i, j)))
+                    .map(|(i, j)| p[i][j] * d[i] * d[j])
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max);
+        let expected = report.steps[k].max;
+        assert!(
+            (max - expected).abs() <= 1e-12 * expected.max(1e-300),
+            "t = {}: {max} vs {expected}",
+            step.t
+        );
+    }
+}

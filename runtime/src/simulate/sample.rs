@@ -1,0 +1,226 @@
+//! A few recorded sample paths, for plots: the Euler-Maruyama paths of [`simulate`](super::simulate)
+//! (same random streams, same initial states, inputs and noise, same steps), with the state
+//! kept at every report time instead of being reduced to statistics.
+
+use super::initial::InitialSampler;
+use super::inputs::InputSchedule;
+use super::noise::Noise;
+use super::normal::Ziggurat;
+use super::rng::{PathRng, DRAWS_PER_PATH, MAX_PATHS};
+use super::{Options, SimError};
+use crate::system::{ModelInfo, System};
+
+/// Most paths [`sample_paths`] records: they are all kept in memory.
+pub const MAX_SAMPLE_PATHS: u64 = 100_000;
+
+/// Simulates `opts.paths` sample paths of `sys` over the report times `times` (increasing,
+/// starting at 0) and returns, per path, its states at those times, flat: the state at
+/// `times[k]` is `path[k * n..(k + 1) * n]`. A path whose state became non-finite keeps the
+/// non-finite values.
+///
+/// Path `p` is path `p` of [`simulate`](super::simulate) with the same options (`opts.seed`,
+/// `opts.inputs`, `opts.dt`, `opts.hold`; `dt` and `hold` default to the largest interval
+/// between report times, which is the analysis' step) when `center` is the result's
+/// `initial_center`: the point where a constant diffusion is evaluated. `None` evaluates it at
+/// path 0's initial state (the same matrix up to rounding). `opts.confidence` and
+/// `opts.threads` are not used: the paths run on the calling thread.
+pub fn sample_paths<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    times: &[f64],
+    center: Option<&[f64]>,
+    opts: &Options,
+) -> Result<Vec<Vec<f64>>, SimError> {
+    let usage = |m: String| Err(SimError::Usage(m));
+    let (n, p, m) = (sys.n(), sys.p(), sys.m());
+    if opts.paths > MAX_SAMPLE_PATHS.min(MAX_PATHS) {
+        return usage(format!(
+            "at most {MAX_SAMPLE_PATHS} paths can be recorded, not {}",
+            opts.paths
+        ));
+    }
+    if times.first() != Some(&0.0)
+        || times
+            .windows(2)
+            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err(SimError::Invalid(
+            "the report times must start at 0 and increase".into(),
+        ));
+    }
+    let step = times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    let dt = opts.dt.unwrap_or(step);
+    let hold = opts.hold.unwrap_or(step);
+    if times.len() > 1 && !(dt > 0.0 && dt.is_finite() && hold > 0.0 && hold.is_finite()) {
+        return usage(format!(
+            "dt = {dt} and the hold time {hold} must be positive and finite"
+        ));
+    }
+    if info.input_box.len() != p
+        || info
+            .input_box
+            .iter()
+            .any(|r| !(r.0.is_finite() && r.1.is_finite() && r.0 <= r.1))
+    {
+        return Err(SimError::Invalid(
+            "the input box must be bounded, one range per input".into(),
+        ));
+    }
+    // The same split of each report interval as `simulate` (equal steps of at most dt; the
+    // slack keeps a step of exactly dt from being split in two).
+    let substeps: Vec<u32> = times
+        .windows(2)
+        .map(|w| ((w[1] - w[0]) / dt * (1.0 - 1e-12)).ceil().max(1.0))
+        .map(|s| if s <= 1e9 { s as u32 } else { u32::MAX })
+        .collect();
+    let per_path: u64 = substeps.iter().map(|&s| u64::from(s)).sum();
+    if per_path.saturating_mul(2 * (m + p + 1) as u64) >= DRAWS_PER_PATH {
+        return usage(format!("dt = {dt} gives too many Euler steps"));
+    }
+    let initial = InitialSampler::new(&info.initial, n).map_err(SimError::Invalid)?;
+    let inputs = InputSchedule::new(&info.input_box, opts.inputs, hold);
+    let zig = Ziggurat::get();
+    let (mut x, mut f, mut u) = (vec![0.0; n], vec![0.0; n], vec![0.0; p]);
+    let mut scratch = vec![0.0; initial.scratch_len()];
+    let mut noise = None;
+    let (mut z, mut g) = (vec![0.0; m], Vec::new());
+    let mut paths = Vec::with_capacity(usize::try_from(opts.paths).unwrap_or(0));
+    for path in 0..opts.paths {
+        let mut rng = PathRng::new(opts.seed, path);
+        initial.sample(&mut rng, zig, &mut x, &mut scratch);
+        let noise = noise.get_or_insert_with(|| {
+            let nz = Noise::new(sys, *times.last().unwrap_or(&0.0), center.unwrap_or(&x));
+            if nz.needs_matrix() {
+                g = vec![0.0; n * m];
+            }
+            nz
+        });
+        let mut record = Vec::with_capacity(times.len() * n);
+        record.extend_from_slice(&x);
+        let mut interval = None;
+        for (k, &nsub) in substeps.iter().enumerate() {
+            let (t0, t1) = (times[k], times[k + 1]);
+            let h = (t1 - t0) / f64::from(nsub);
+            for i in 0..nsub {
+                let t = t0 + f64::from(i) * h;
+                if p > 0 {
+                    inputs.update(t, &mut interval, &mut rng, &mut u);
+                }
+                sys.drift(&x, &u, t, &mut f);
+                noise.step(sys, &mut x, &f, t, h, zig, &mut rng, &mut z, &mut g);
+            }
+            record.extend_from_slice(&x);
+        }
+        paths.push(record);
+    }
+    Ok(paths)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interval::Interval;
+    use crate::system::{InitialSet, ModelInfo};
+
+    /// `dx = -x dt + 0.5 dW`, x(0) uniform in [1, 2]; input-free.
+    struct Ou;
+
+    impl System for Ou {
+        fn n(&self) -> usize {
+            1
+        }
+        fn p(&self) -> usize {
+            0
+        }
+        fn m(&self) -> usize {
+            1
+        }
+        fn drift(&self, x: &[f64], _: &[f64], _: f64, out: &mut [f64]) {
+            out[0] = -x[0];
+        }
+        fn drift_interval(
+            &self,
+            x: &[Interval],
+            _: &[Interval],
+            _: Interval,
+            out: &mut [Interval],
+        ) {
+            out[0] = -x[0];
+        }
+        fn jac_x(&self, _: &[f64], _: &[f64], _: f64, out: &mut [f64]) {
+            out[0] = -1.0;
+        }
+        fn jac_x_interval(
+            &self,
+            _: &[Interval],
+            _: &[Interval],
+            _: Interval,
+            out: &mut [Interval],
+        ) {
+            out[0] = Interval::point(-1.0);
+        }
+        fn jac_u(&self, _: &[f64], _: &[f64], _: f64, _: &mut [f64]) {}
+        fn jac_u_interval(&self, _: &[Interval], _: &[Interval], _: Interval, _: &mut [Interval]) {}
+        fn diffusion(&self, _: &[f64], _: f64, out: &mut [f64]) {
+            out[0] = 0.5;
+        }
+        fn diffusion_interval(&self, _: &[Interval], _: Interval, out: &mut [Interval]) {
+            out[0] = Interval::point(0.5);
+        }
+    }
+
+    fn info() -> ModelInfo {
+        ModelInfo {
+            name: "ou".into(),
+            states: vec!["x".into()],
+            inputs: vec![],
+            noises: vec!["w".into()],
+            input_box: vec![],
+            initial: InitialSet {
+                boxes: vec![Some((1.0, 2.0))],
+                balls: vec![],
+            },
+            domain: vec![(f64::NEG_INFINITY, f64::INFINITY)],
+            has_domain: false,
+            unsafe_sets: vec![],
+            analyses: vec![],
+        }
+    }
+
+    #[test]
+    fn paths_start_in_the_initial_set_and_have_the_ou_statistics() {
+        let times: Vec<f64> = (0..=10).map(|k| 0.1 * f64::from(k)).collect();
+        let opts = Options {
+            paths: 4000,
+            dt: Some(0.01),
+            ..Options::default()
+        };
+        let paths = sample_paths(&Ou, &info(), &times, None, &opts).unwrap();
+        assert_eq!(paths.len(), 4000);
+        assert!(paths.iter().all(|p| p.len() == 11));
+        assert!(paths.iter().all(|p| (1.0..=2.0).contains(&p[0])));
+        // X_1 = e^-1 X_0 + N(0, 0.25 (1 - e^-2) / 2): mean 1.5 e^-1 ~ 0.552, variance
+        // e^-2 / 12 + 0.108 ~ 0.1194 (Euler with h = 0.01 is within 1% of both).
+        let end: Vec<f64> = paths.iter().map(|p| p[10]).collect();
+        let mean = end.iter().sum::<f64>() / 4000.0;
+        let var = end.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3999.0;
+        assert!((mean - 0.552).abs() < 0.02, "{mean}");
+        assert!((var - 0.1194).abs() < 0.012, "{var}");
+    }
+
+    #[test]
+    fn the_same_seed_gives_the_same_paths_and_bad_times_are_refused() {
+        let times = [0.0, 0.5, 1.0];
+        let opts = Options {
+            paths: 3,
+            seed: 9,
+            ..Options::default()
+        };
+        let a = sample_paths(&Ou, &info(), &times, Some(&[1.5]), &opts).unwrap();
+        let b = sample_paths(&Ou, &info(), &times, None, &opts).unwrap();
+        assert_eq!(a, b);
+        assert_ne!(a[0], a[1]);
+        assert!(sample_paths(&Ou, &info(), &[0.5, 1.0], None, &opts).is_err());
+        assert!(sample_paths(&Ou, &info(), &[0.0, 1.0, 1.0], None, &opts).is_err());
+    }
+}

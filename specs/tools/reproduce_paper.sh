@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Regenerates docs/paper/ (figures and Monte Carlo reports of docs/paper-reproduction.md) from
+# the shipped specs: the paper's Fig. 4 (linear, 5000 paths) and Fig. 6 (pendulum, contraction
+# and interval, 2000 paths). Fig. 5 is `python3 specs/tools/linear_fig5.py` (longer).
+# Usage: bash specs/tools/reproduce_paper.sh [REACHC]   (default: cargo run --release)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+out=docs/paper
+reachc=${1:-}
+if [ -z "$reachc" ]; then
+    cargo build --release -q -p reachc
+    reachc=target/release/reachc
+fi
+# Fig. 4: linear, n = 2, delta = 1e-3, both radius rules; the quantile from 5000 paths.
+"$reachc" simulate specs/linear.sde --paths 5000 --seed 1 --backend interp -o "$out/linear" -q
+"$reachc" run specs/linear.sde --backend interp -o "$out/linear" > /dev/null
+for a in paper_rule amgf_rule; do
+    "$reachc" plot "$out/linear/$a.json" --spec specs/linear.sde --times 0.5,1,1.5 \
+        --paths 50 > /dev/null
+done
+
+# Fig. 6: pendulum, contraction (left) and interval in y = T x (right), t = 1, 2, 4, 2000 paths.
+"$reachc" simulate specs/pendulum.sde --paths 2000 --seed 1 --backend interp -o "$out/pendulum" -q
+"$reachc" run specs/pendulum.sde --backend interp -o "$out/pendulum" > /dev/null
+for a in contraction interval; do
+    "$reachc" plot "$out/pendulum/$a.json" --spec specs/pendulum.sde --times 1,2,4 \
+        --paths 50 > /dev/null
+done
+echo "wrote $out/linear and $out/pendulum"
