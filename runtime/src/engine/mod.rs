@@ -122,9 +122,9 @@ pub(crate) fn setup<'a>(
 
 /// Runs one analysis of the model.
 ///
-/// [`Method::Interval`] runs [`run_interval`] with the default [`Inclusion::Jacobian`] (an
-/// analysis with a coordinate transform gives [`RunError::Unsupported`]). The constants must be
-/// present ([`RunError::NoConstants`]).
+/// [`Method::Interval`] runs [`run_interval`] with the analysis' inclusion function (a
+/// coordinate transform needs the system's transformed frame, [`RunError::Unsupported`]
+/// otherwise). The constants must be present ([`RunError::NoConstants`]).
 pub fn run(
     sys: &dyn System,
     info: &ModelInfo,
