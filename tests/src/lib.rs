@@ -54,3 +54,26 @@ impl Rng {
         (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
     }
 }
+
+/// Advances `x` from time `*t` to `until` by Euler-Maruyama steps of `dt` of the SDE of `sys`
+/// (no inputs), drawing one normal per noise channel and step from `rng`.
+pub fn euler_maruyama(
+    sys: &dyn reachc_runtime::System,
+    x: &mut [f64],
+    t: &mut f64,
+    until: f64,
+    dt: f64,
+    rng: &mut Rng,
+) {
+    let (n, m) = (sys.n(), sys.m());
+    let (mut f, mut g) = (vec![0.0; n], vec![0.0; n * m]);
+    while *t < until - 1e-12 {
+        sys.drift(x, &[], *t, &mut f);
+        sys.diffusion(x, *t, &mut g);
+        let dw: Vec<f64> = (0..m).map(|_| rng.normal() * dt.sqrt()).collect();
+        for i in 0..n {
+            x[i] += f[i] * dt + (0..m).map(|j| g[i * m + j] * dw[j]).sum::<f64>();
+        }
+        *t += dt;
+    }
+}

@@ -4,7 +4,7 @@
 
 use reachc::backend::{interp::Interpreter, prepare};
 use reachc::driver::load;
-use reachc_e2e::{shipped_specs, workspace, Rng};
+use reachc_e2e::{euler_maruyama, shipped_specs, workspace, Rng};
 use reachc_runtime::engine::{self, AnalysisResult, RunError};
 use reachc_runtime::system::{Analysis, Constants, Inclusion, Method, ModelInfo};
 use reachc_runtime::System;
@@ -267,27 +267,17 @@ fn pendulum_in_transformed_coordinates() {
 #[test]
 fn transformed_pendulum_prs_covers_monte_carlo_paths() {
     let (r, sys, info) = pendulum_interval(Inclusion::Jacobian);
-    let (n, m) = (sys.n(), sys.m());
     let dt: f64 = 0.002;
     let checkpoints = [1.0, 2.0, 4.0];
     let step_of = |t: f64| r.steps.iter().position(|s| (s.t - t).abs() < 1e-9).unwrap();
     let mut rng = Rng(11);
     let paths = 1000;
     let mut outside = [0usize; 3];
-    let (mut f, mut g) = (vec![0.0; n], vec![0.0; n * m]);
     for _ in 0..paths {
         let mut x = initial_state(&info, &mut rng);
         let mut t = 0.0;
         for (k, &tc) in checkpoints.iter().enumerate() {
-            while t < tc - 1e-12 {
-                sys.drift(&x, &[], t, &mut f);
-                sys.diffusion(&x, t, &mut g);
-                let dw: Vec<f64> = (0..m).map(|_| rng.normal() * dt.sqrt()).collect();
-                for i in 0..n {
-                    x[i] += f[i] * dt + (0..m).map(|j| g[i * m + j] * dw[j]).sum::<f64>();
-                }
-                t += dt;
-            }
+            euler_maruyama(&sys, &mut x, &mut t, tc, dt, &mut rng);
             if !engine::contains(&r, step_of(tc), &x) {
                 outside[k] += 1;
             }

@@ -3,7 +3,7 @@
 
 use reachc::backend::{interp::Interpreter, prepare};
 use reachc::driver::load;
-use reachc_e2e::{workspace, Rng};
+use reachc_e2e::{euler_maruyama, workspace, Rng};
 use reachc_runtime::engine::{self, AnalysisResult};
 use reachc_runtime::System;
 
@@ -86,7 +86,7 @@ fn linear_constants_psi_and_radius_match_closed_forms_and_reference() {
 #[test]
 fn pendulum_prs_covers_monte_carlo_paths() {
     let (r, sys, info) = run("pendulum.sde", "contraction");
-    let (n, m) = (sys.n(), sys.m());
+    let n = sys.n();
     let dt: f64 = 0.002;
     let checkpoints = [1.0, 2.0, 4.0];
     let step_of = |t: f64| r.steps.iter().position(|s| (s.t - t).abs() < 1e-9).unwrap();
@@ -94,7 +94,6 @@ fn pendulum_prs_covers_monte_carlo_paths() {
     let paths = 1000;
     let mut outside = [0usize; 3];
     let mut max_ratio = [0.0f64; 3];
-    let (mut f, mut g) = (vec![0.0; n], vec![0.0; n * m]);
     for _ in 0..paths {
         let mut x: Vec<f64> = info
             .initial
@@ -107,15 +106,7 @@ fn pendulum_prs_covers_monte_carlo_paths() {
             .collect();
         let mut t = 0.0;
         for (k, &tc) in checkpoints.iter().enumerate() {
-            while t < tc - 1e-12 {
-                sys.drift(&x, &[], t, &mut f);
-                sys.diffusion(&x, t, &mut g);
-                let dw: Vec<f64> = (0..m).map(|_| rng.normal() * dt.sqrt()).collect();
-                for i in 0..n {
-                    x[i] += f[i] * dt + (0..m).map(|j| g[i * m + j] * dw[j]).sum::<f64>();
-                }
-                t += dt;
-            }
+            euler_maruyama(&sys, &mut x, &mut t, tc, dt, &mut rng);
             let s = &r.steps[step_of(tc)];
             let d: Vec<f64> = x.iter().zip(&s.nominal).map(|(a, b)| a - b).collect();
             let p = &r.constants.metric;
