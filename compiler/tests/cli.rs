@@ -158,12 +158,12 @@ fn run_with_the_interpreter_writes_results_and_reports_failures() {
         assert_eq!(v["constants"]["c"], -0.4);
         assert!(out.join(format!("{name}.csv")).is_file());
     }
-    // The unicycle's atan2 controller has no global contraction rate: a diagnostic, exit 1.
+    // atan2 at the origin admits no global contraction rate: a diagnostic, exit 1.
     let uni = reachc(&[
         "run",
         "--backend",
         "interp",
-        &spec("unicycle.sde"),
+        &spec("../tests/good/unbounded_rate.sde"),
         "-o",
         dir,
     ]);

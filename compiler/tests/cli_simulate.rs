@@ -61,7 +61,7 @@ fn simulate_skips_analyses_without_a_prs_and_reports_usage_errors() {
     let d = dir.to_str().unwrap();
     let o = reachc(&[
         "simulate",
-        &spec("unicycle.sde"),
+        &spec("../tests/good/unbounded_rate.sde"),
         "--backend",
         "interp",
         "--paths",

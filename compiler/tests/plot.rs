@@ -286,22 +286,33 @@ fn plot_errors_are_usage_errors_and_write_nothing() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-#[test]
-fn an_analysis_without_a_prs_gets_paths_and_unsafe_sets() {
-    let dir = temp_dir("unicycle");
-    let plots = dir.join("plots");
-    let o = reachc(&[
+/// `reachc run SPEC --backend interp -o DIR/out --plot DIR/plots EXTRA...`.
+fn run_and_plot(spec_name: &str, dir: &Path, extra: &[&str]) -> Output {
+    let (out, plots) = (dir.join("out"), dir.join("plots"));
+    let spec = spec(spec_name);
+    let mut args = vec![
         "run",
-        &spec("unicycle.sde"),
+        spec.as_str(),
         "--backend",
         "interp",
         "-o",
-        dir.join("out").to_str().unwrap(),
+        out.to_str().unwrap(),
         "--plot",
         plots.to_str().unwrap(),
-        "--plot-paths",
-        "10",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    reachc(&args)
+}
+
+#[test]
+fn an_analysis_without_a_prs_gets_paths_and_unsafe_sets() {
+    let dir = temp_dir("unbounded");
+    let plots = dir.join("plots");
+    let o = run_and_plot(
+        "../tests/good/unbounded_rate.sde",
+        &dir,
+        &["--plot-paths", "10"],
+    );
     // The analysis cannot run (exit 1), its picture is drawn all the same.
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("has no PRS: plotting its sample paths and unsafe sets only"));
@@ -310,7 +321,7 @@ fn an_analysis_without_a_prs_gets_paths_and_unsafe_sets() {
         ["contraction_sets.png", "contraction_sets.svg"]
     );
     let sets = svg(&plots.join("contraction_sets.svg"));
-    for name in ["obs1", "obs2", "obs3", "10 sample paths", "no PRS"] {
+    for name in ["far", "disc", "10 sample paths", "no PRS"] {
         assert!(sets.contains(name), "{name}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -360,4 +371,37 @@ fn sample_paths_are_the_monte_carlo_paths() {
             step.t
         );
     }
+}
+
+#[test]
+fn envelope_and_reference_trajectory_of_the_unicycle() {
+    // The paper's Fig. 7: the union of the PRS over the horizon, the plan from the spec's table.
+    let dir = temp_dir("envelope");
+    let plots = dir.join("plots");
+    let o = run_and_plot(
+        "unicycle.sde",
+        &dir,
+        &["--plot-paths", "5", "--plot-envelope"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    // The empirical rate is labelled in the summary.
+    assert!(text(&o).contains("rate: EMPIRICAL"), "{}", text(&o));
+    let sets = svg(&plots.join("empirical_sets.svg"));
+    // (The legend wraps the label after "report".)
+    assert!(sets.contains("union of the PRS over all 500 report"));
+    assert!(sets.contains("table `ref` (px, py): reference"));
+    // One filled polygon per report time at least (plus unsafe sets and the chosen times).
+    assert!(sets.matches("<polygon").count() >= 500);
+    // Without the flag: no envelope.
+    let o = reachc(&[
+        "plot",
+        dir.join("out/empirical.json").to_str().unwrap(),
+        "-o",
+        dir.join("plain").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let plain = svg(&dir.join("plain/empirical_sets.svg"));
+    assert!(!plain.contains("union of the PRS"));
+    assert!(plain.matches("<polygon").count() < 20);
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -87,6 +87,7 @@ fn info() -> ModelInfo {
             horizon: 1.5,
             step: 0.01,
             radius: RadiusRule::Amgf,
+            rate: Rate::Certified,
             integrator: Integrator::Rk4,
             inclusion: Inclusion::Jacobian,
             outputs: vec![0, 1],

@@ -210,12 +210,38 @@ pub struct Transform {
     pub frame: usize,
 }
 
+/// Where the contraction rate `c_t` of a contraction analysis comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Rate {
+    /// One rate for the whole run, certified by the compiler over the domain ([`Constants::c`]).
+    #[default]
+    Certified,
+    /// Estimated per report step from sample paths (the paper's approach for the unicycle):
+    /// the largest one-sided Lipschitz quotient between a sampled state and the nominal. Not a
+    /// guarantee, and labelled so.
+    Empirical {
+        /// Number of sample paths of the estimate.
+        paths: u64,
+    },
+}
+
+impl Rate {
+    /// Its name in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Rate::Certified => "certified",
+            Rate::Empirical { .. } => "empirical",
+        }
+    }
+}
+
 /// Constants of Assumption 1 for one metric, derived by the compiler.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Constants {
     /// The metric `P`, n x n row-major, symmetric positive definite.
     pub metric: Vec<f64>,
-    /// Contraction rate: `mu_P(D_x f) <= c` on the domain, for all inputs and times.
+    /// Contraction rate: `mu_P(D_x f) <= c` on the domain, for all inputs and times (`inf` for a
+    /// [`Rate::Empirical`] analysis: the compiler does not bound it then).
     pub c: f64,
     /// Noise level: `P^(1/2) G G' P^(1/2) <= sigma^2 I`.
     pub sigma: f64,
@@ -241,6 +267,8 @@ pub struct Analysis {
     pub step: f64,
     /// Radius rule.
     pub radius: RadiusRule,
+    /// Where the contraction rate comes from (contraction method).
+    pub rate: Rate,
     /// Integrator.
     pub integrator: Integrator,
     /// Inclusion function of the interval method.

@@ -3,7 +3,7 @@
 use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::system::{
-    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Transform,
+    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate, Transform,
 };
 use reachc_runtime::System;
 
@@ -57,6 +57,7 @@ fn analysis(name: &str, method: Method, constants: bool) -> Analysis {
         horizon: 1.0,
         step: 0.1,
         radius: RadiusRule::Amgf,
+        rate: Rate::Certified,
         integrator: Integrator::Rk4,
         inclusion: Default::default(),
         outputs: vec![],

@@ -5,7 +5,7 @@ use reachc_runtime::engine::{self, RunError, Verdict};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::kappa::kappa;
 use reachc_runtime::system::{
-    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Transform,
+    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate, Transform,
     UnsafeSet, UnsafeShape,
 };
 use reachc_runtime::System;
@@ -186,6 +186,7 @@ fn analysis(delta: f64, horizon: f64, step: f64, constants: Constants) -> Analys
         horizon,
         step,
         radius: RadiusRule::Amgf,
+        rate: Rate::Certified,
         integrator: Integrator::Rk4,
         inclusion: Default::default(),
         outputs: vec![],
@@ -736,4 +737,63 @@ fn euler_uneven_horizon_domain_and_ball() {
         .not_validated
         .iter()
         .any(|s| s.contains("domain")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Empirical rates
+// ---------------------------------------------------------------------------------------------
+
+/// On a linear drift `a x` every sampled quotient `(X - x*)' (f(X) - f(x*)) / |X - x*|^2` is
+/// exactly `a`, so the empirical rate is the certified one and so are the radii; the result
+/// says that it is an estimate.
+#[test]
+fn empirical_rate_of_a_linear_drift_is_its_rate() {
+    for (sys, inf, certified) in [
+        {
+            let (s, i, a) = linear_setup(1e-3, 2.0, 0.05);
+            (Box::new(s) as Box<dyn System>, i, a)
+        },
+        {
+            let (s, i, a) = input_setup();
+            (Box::new(s) as Box<dyn System>, i, a)
+        },
+    ] {
+        let exact = certified.constants.as_ref().unwrap().c;
+        let mut empirical = certified.clone();
+        empirical.rate = Rate::Empirical { paths: 50 };
+        // The compiler leaves c unbounded for an empirical analysis.
+        empirical.constants.as_mut().unwrap().c = f64::INFINITY;
+        let want = engine::run(sys.as_ref(), &inf, &certified).unwrap();
+        let got = engine::run(sys.as_ref(), &inf, &empirical).unwrap();
+        assert_eq!(got.rate.kind, "empirical");
+        assert_eq!(got.rate.paths, Some(50));
+        assert!(got.rate.note.contains("not a guarantee"));
+        assert!(got.validated.not_validated[0].starts_with("EMPIRICAL"));
+        assert!(got.summary().contains("rate: EMPIRICAL"));
+        assert!((got.rate.max_c - exact).abs() < 1e-12, "{}", got.rate.max_c);
+        for (a, b) in want.steps.iter().zip(&got.steps) {
+            assert!((b.c - exact).abs() < 1e-12, "t = {}: c = {}", b.t, b.c);
+            let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(1e-12);
+            assert!(close(a.r_t, b.r_t), "t = {}: {} vs {}", a.t, a.r_t, b.r_t);
+            assert!(close(a.det_set.radius, b.det_set.radius), "t = {}", a.t);
+        }
+    }
+}
+
+/// An empirical analysis does not need a certified c, and the interval method refuses it.
+#[test]
+fn empirical_rate_needs_no_certified_c_and_not_the_interval_method() {
+    let (sys, inf, mut an) = linear_setup(1e-3, 1.0, 0.1);
+    an.constants.as_mut().unwrap().c = f64::NAN;
+    assert!(matches!(
+        engine::run(&sys, &inf, &an),
+        Err(RunError::NoConstants(_))
+    ));
+    an.rate = Rate::Empirical { paths: 20 };
+    assert!(engine::run(&sys, &inf, &an).is_ok());
+    an.method = Method::Interval;
+    assert!(matches!(
+        engine::run(&sys, &inf, &an),
+        Err(RunError::Unsupported(_))
+    ));
 }

@@ -5,7 +5,7 @@
 use reachc_runtime::engine::{self, RunError, Verdict};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::system::{
-    Analysis, Constants, Inclusion, InitialSet, Integrator, Method, ModelInfo, RadiusRule,
+    Analysis, Constants, Inclusion, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate,
     Transform, UnsafeSet, UnsafeShape,
 };
 use reachc_runtime::System;
@@ -114,6 +114,7 @@ fn analysis(horizon: f64, step: f64, integrator: Integrator, constants: Constant
         horizon,
         step,
         radius: RadiusRule::Amgf,
+        rate: Rate::Certified,
         integrator,
         inclusion: Default::default(),
         outputs: vec![],

@@ -116,6 +116,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
             horizon: 1.5,
             step: 0.01,
             radius: RadiusRule::Amgf,
+            rate: Rate::Certified,
             integrator: Integrator::Rk4,
             inclusion: Inclusion::Jacobian,
             outputs: vec![],

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Regenerates docs/paper/ (figures and Monte Carlo reports of docs/paper-reproduction.md) from
-# the shipped specs: the paper's Fig. 4 (linear, 5000 paths) and Fig. 6 (pendulum, contraction
-# and interval, 2000 paths). Fig. 5 is `python3 specs/tools/linear_fig5.py` (longer).
+# the shipped specs: the paper's Fig. 4 (linear, 5000 paths), Fig. 6 (pendulum, contraction
+# and interval, 2000 paths) and Fig. 7 (unicycle: the paper's empirical rate, and the rigorous
+# look-ahead controller next to it, 200 paths). Fig. 5 is `python3 specs/tools/linear_fig5.py`
+# (longer).
 # Usage: bash specs/tools/reproduce_paper.sh [REACHC]   (default: cargo run --release)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -26,4 +28,17 @@ for a in contraction interval; do
     "$reachc" plot "$out/pendulum/$a.json" --spec specs/pendulum.sde --times 1,2,4 \
         --paths 50 > /dev/null
 done
-echo "wrote $out/linear and $out/pendulum"
+
+# Fig. 7: unicycle with the paper's controller and its empirical c_t (NOT a guarantee), and the
+# look-ahead controller, empirical and certified (rigorous). Sets at t = 1, 2.5, 4 and the union
+# of the PRS over [0, 5], 200 sample paths; the rigorous PRS only at t = 0.03, 0.06, 0.09 (it is
+# vacuous later).
+for spec in unicycle unicycle_lookahead; do
+    "$reachc" simulate "specs/$spec.sde" --paths 2000 --seed 1 --backend interp -o "$out/$spec" -q
+    "$reachc" run "specs/$spec.sde" --backend interp -o "$out/$spec" > /dev/null
+    "$reachc" plot "$out/$spec/empirical.json" --spec "specs/$spec.sde" --times 1,2.5,4 \
+        --paths 200 --envelope > /dev/null
+done
+"$reachc" plot "$out/unicycle_lookahead/contraction.json" --spec specs/unicycle_lookahead.sde \
+    --times 0.03,0.06,0.09 --paths 200 > /dev/null
+echo "wrote $out/linear, $out/pendulum, $out/unicycle and $out/unicycle_lookahead"

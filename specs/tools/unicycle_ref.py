@@ -13,8 +13,9 @@ Usage:
     python3 specs/tools/unicycle_ref.py            # writes specs/unicycle_ref.csv, prints a summary
     python3 specs/tools/unicycle_ref.py --check    # also simulates the paper's tracking controller
 
-Standard library only. Output: header `t,px,py,theta`, one row every 0.05 s for t in [0, 5],
-6 significant digits.
+Standard library only. Output: header `t,px,py,theta,qx,qy,qvx,qvy`, one row every 0.05 s for t in
+[0, 5], 6 significant digits. `(qx, qy)` is the plan's look-ahead point p + L_Q (cos theta, sin theta)
+(L_Q = 0.3) and `(qvx, qvy)` its velocity, the feedforward of specs/unicycle_lookahead.sde.
 """
 
 import math
@@ -25,17 +26,29 @@ T_END = 5.0
 SAMPLE = 0.05
 DT = 1e-3  # RK4 step of the integration
 
-START = (5.0, 5.0, -2.0 * math.pi / 3.0)
+START = (5.0, 5.0, -2.0 * math.pi / 3.0)  # the vehicle's x0 (the spec's initial state)
+# The plan starts LEAD ahead of the vehicle along its heading. Starting exactly on the vehicle
+# would put the controller's atan2 at its singular point (zero position error) at t = 0, where
+# the nominal trajectory depends on the convention atan2(0, 0) = 0 and sample paths turn in
+# random directions: a discontinuity no contraction argument covers.
+LEAD = 0.25
+PLAN_START = (
+    START[0] + LEAD * math.cos(START[2]),
+    START[1] + LEAD * math.sin(START[2]),
+    START[2],
+)
 # Waypoints of the plan: leave (5, 5) along the initial heading, pass left of obs2, then between
 # obs3 (above) and obs1 (below), and come into the origin.
 WAYPOINTS = [(5.0, 5.0), (4.15, 3.5), (3.1, 2.0), (1.5, 0.75), (0.0, 0.0)]
 LOOKAHEAD = 0.8  # pure-pursuit look-ahead distance
+V_START = 0.4  # speed at t = 0 and t = 5, relative to the peak
+L_Q = 0.3  # look-ahead of the tracking point of specs/unicycle_lookahead.sde (its const l)
 
 # Obstacles, mirrored in specs/unicycle.sde (keep the two in sync).
 OBSTACLES = [
     ("obs1", "box", (2.4, 3.4, -0.3, 0.5)),  # px in [2.4, 3.4], py in [-0.3, 0.5]
     ("obs2", "ball", (4.4, 1.9, 0.5)),  # centre (4.4, 1.9), radius 0.5
-    ("obs3", "box", (0.0, 0.8, 1.4, 2.2)),  # px in [0, 0.8], py in [1.4, 2.2]
+    ("obs3", "box", (0.0, 0.8, 1.2, 2.0)),  # px in [0, 0.8], py in [1.2, 2.0]
 ]
 
 
@@ -83,7 +96,9 @@ def wrap(a):
 
 def plan_rhs(t, st, vpeak):
     x, y, th = st
-    v = vpeak * math.sin(math.pi * t / T_END) ** 2  # bell-shaped speed, 0 at both ends
+    # Already moving at t = 0: a plan starting at rest leaves the tracking error, the argument
+    # of the controller's atan2, at the noise level for the first second (see the spec).
+    v = vpeak * (V_START + (1 - V_START) * math.sin(math.pi * t / T_END) ** 2)
     tx, ty = point_at(project(x, y) + LOOKAHEAD)
     eta = wrap(math.atan2(ty - y, tx - x) - th)
     w = v * 2.0 * math.sin(eta) / LOOKAHEAD  # pure pursuit: curvature 2 sin(eta) / L
@@ -98,9 +113,9 @@ def rk4(rhs, t, st, h, *args):
     return [s + h / 6 * (a + 2 * b + 2 * c + d) for s, a, b, c, d in zip(st, k1, k2, k3, k4)]
 
 
-def simulate(rhs, *args):
-    """Samples (t, state) every SAMPLE seconds on [0, T_END]."""
-    st = list(START)
+def simulate(rhs, start, *args):
+    """Samples (t, state) every SAMPLE seconds on [0, T_END] from `start`."""
+    st = list(start)
     per = round(SAMPLE / DT)
     n = round(T_END / DT)
     out = [(0.0, st)]
@@ -114,17 +129,18 @@ def simulate(rhs, *args):
 def make_plan():
     # The speed peak is tuned (secant method) so that the plan ends at the origin at t = 5.
     def miss(vpeak):
-        x, y, _ = simulate(plan_rhs, vpeak)[-1][1]
+        x, y, _ = simulate(plan_rhs, PLAN_START, vpeak)[-1][1]
         return project(x, y) - PATH_LEN
 
-    a, b = PATH_LEN / (T_END / 2) * 0.9, PATH_LEN / (T_END / 2) * 1.1
+    mean = V_START + (1 - V_START) / 2  # mean speed over [0, T_END], relative to the peak
+    a, b = PATH_LEN / (T_END * mean) * 0.9, PATH_LEN / (T_END * mean) * 1.1
     fa, fb = miss(a), miss(b)
     for _ in range(30):
         if abs(fb) < 1e-9 or fa == fb:
             break
         a, b, fa = b, b - fb * (b - a) / (fb - fa), fb
         fb = miss(b)
-    return simulate(plan_rhs, b), b
+    return simulate(plan_rhs, PLAN_START, b), b
 
 
 def clearance(x, y, obs):
@@ -180,15 +196,24 @@ def tracking_rhs(t, st, table):
     return (v * math.cos(th), v * math.sin(th), w)
 
 
+def lookahead_columns(t, st, vpeak):
+    """The look-ahead point q = p + L_Q (cos theta, sin theta) of the plan and its velocity."""
+    x, y, th = st
+    dx, dy, w = plan_rhs(t, st, vpeak)
+    c, s = math.cos(th), math.sin(th)
+    return [x + L_Q * c, y + L_Q * s, dx - L_Q * w * s, dy + L_Q * w * c]
+
+
 def main():
     samples, vpeak = make_plan()
     table = [(t, [float("%.6g" % c) for c in s]) for t, s in samples]
     here = os.path.dirname(os.path.abspath(__file__))
     out = os.path.join(here, "..", "unicycle_ref.csv")
     with open(out, "w") as f:
-        f.write("t,px,py,theta\n")
-        for t, s in table:
-            f.write(",".join("%.6g" % c for c in [round(t, 10)] + s) + "\n")
+        f.write("t,px,py,theta,qx,qy,qvx,qvy\n")
+        for (t, s), (_, exact) in zip(table, samples):
+            row = [round(t, 10)] + s + lookahead_columns(t, exact, vpeak)
+            f.write(",".join("%.6g" % (c + 0.0) for c in row) + "\n")  # no "-0"
     print("wrote %s (%d rows), peak speed %.4f" % (os.path.normpath(out), len(table), vpeak))
     x, y, th = samples[-1][1]
     print("end state at t = 5: (%.4f, %.4f, %.4f), distance to origin %.2e"
@@ -198,7 +223,7 @@ def main():
     for name, (d, t) in min_clearance(table).items():
         print("reference: min clearance to %s = %.3f at t = %.2f" % (name, d, t))
     if "--check" in sys.argv:
-        closed = simulate(tracking_rhs, table)
+        closed = simulate(tracking_rhs, START, table)
         err = max(math.hypot(s[0] - r[0], s[1] - r[1]) for (_, s), (_, r) in zip(closed, table))
         print("closed loop (u = 0, no noise): max position error to reference %.4f" % err)
         for name, (d, t) in min_clearance(closed).items():

@@ -323,6 +323,7 @@ fn generated_code_agrees_with_the_interpreter() {
         "linear_n",
         "pendulum",
         "unicycle",
+        "unicycle_lookahead",
         "vanderpol",
     ];
     let keywords = workspace().join("tests/good/rust_keywords.sde");

@@ -696,13 +696,40 @@ pub fn constants(
 ) -> Result<Constants, ConstantsError> {
     let n = model.states.len();
     let p = check_metric(metric, n)?;
-    let time = time_range(model);
-    let jac = decompose(model, &d.jac_x, "D_x f", time)?;
-    let diffusion = matrix_set(model, &model.diffusion, "G", time)?;
-    let jac_u = matrix_set(model, &d.jac_u, "D_u f", time)?;
+    let jac = decompose(model, &d.jac_x, "D_x f", time_range(model))?;
     let jac = jacobian_set(&jac, &p);
     let c = contraction_rate(&jac, &p, metric)?;
-    let sigma = noise_level(&diffusion, &p)?;
+    let mut consts = noise_and_input(model, d, metric, &p)?;
+    consts.c = c;
+    consts.how = format!("c: {}; {}", jac.describe(), consts.how);
+    Ok(consts)
+}
+
+/// The constants of Assumption 1 without the contraction rate, for analyses whose rate is
+/// estimated at run time ([`Rate::Empirical`](reachc_runtime::system::Rate::Empirical)):
+/// `sigma` and `rho` as in [`constants`], `c` infinite (not bounded here).
+pub fn constants_without_rate(
+    model: &Model,
+    d: &Derivatives,
+    metric: &[f64],
+) -> Result<Constants, ConstantsError> {
+    let p = check_metric(metric, model.states.len())?;
+    let mut consts = noise_and_input(model, d, metric, &p)?;
+    consts.how = format!("c: not bounded by the compiler; {}", consts.how);
+    Ok(consts)
+}
+
+/// `sigma` and `rho` (with `c` infinite) and how they were obtained.
+fn noise_and_input(
+    model: &Model,
+    d: &Derivatives,
+    metric: &[f64],
+    p: &IMat,
+) -> Result<Constants, ConstantsError> {
+    let time = time_range(model);
+    let diffusion = matrix_set(model, &model.diffusion, "G", time)?;
+    let jac_u = matrix_set(model, &d.jac_u, "D_u f", time)?;
+    let sigma = noise_level(&diffusion, p)?;
     let h: Vec<Interval> = model
         .inputs
         .iter()
@@ -713,10 +740,9 @@ pub fn constants(
             _ => Interval::ENTIRE,
         })
         .collect();
-    let (rho, rho_how) = input_gain(&jac_u, &p, &h)?;
+    let (rho, rho_how) = input_gain(&jac_u, p, &h)?;
     let how = format!(
-        "c: {}; sigma: {}; rho: {}; certified by interval LDL'",
-        jac.describe(),
+        "sigma: {}; rho: {}; certified by interval LDL'",
         diffusion.describe(),
         if h.is_empty() {
             rho_how.to_string()
@@ -726,7 +752,7 @@ pub fn constants(
     );
     Ok(Constants {
         metric: metric.to_vec(),
-        c,
+        c: f64::INFINITY,
         sigma,
         rho,
         how,

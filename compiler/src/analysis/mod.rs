@@ -13,7 +13,9 @@ mod transform;
 
 pub use atoms::{split_atoms, Atom, AtomSplit};
 pub use bounds::{bound_matrix, eval_box, time_range};
-pub use contraction::{constants, ConstantsError, MAX_SIGN_INPUTS, MAX_VERTEX_ATOMS};
+pub use contraction::{
+    constants, constants_without_rate, ConstantsError, MAX_SIGN_INPUTS, MAX_VERTEX_ATOMS,
+};
 pub use derivatives::{Derivatives, GradEntry};
 pub use metric::{synthesize_metric, FULL_METRIC_MAX_DIM};
 pub use transform::Frame;

@@ -23,7 +23,7 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
 use reachc_runtime::system::{
     Analysis, Constants, Inclusion, InitialBall, InitialSet, Integrator, Method, ModelInfo,
-    RadiusRule, UnsafeSet, UnsafeShape,
+    RadiusRule, Rate, UnsafeSet, UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -874,6 +874,10 @@ impl InfoWriter {
             }
             RadiusRule::PaperOptimal => quote!(RadiusRule::PaperOptimal),
         };
+        let rate = match a.rate {
+            Rate::Certified => quote!(Rate::Certified),
+            Rate::Empirical { paths } => quote!(Rate::Empirical { paths: #paths }),
+        };
         let integrator = match a.integrator {
             Integrator::Rk4 => quote!(Integrator::Rk4),
             Integrator::Euler => quote!(Integrator::Euler),
@@ -902,6 +906,7 @@ impl InfoWriter {
                 horizon: #horizon,
                 step: #step,
                 radius: #radius,
+                rate: #rate,
                 integrator: #integrator,
                 inclusion: #inclusion,
                 outputs: #outputs,
@@ -931,7 +936,10 @@ fn info_doc(info: &ModelInfo) -> TokenStream {
         let what = match (&a.constants, &a.constants_error) {
             (Some(c), _) => format!(
                 "c = {}, sigma = {}, rho = {}\n    {}",
-                short(c.c),
+                match a.rate {
+                    Rate::Certified => short(c.c),
+                    Rate::Empirical { paths } => format!("empirical ({paths} paths)"),
+                },
                 short(c.sigma),
                 short(c.rho),
                 one_line(&c.how)

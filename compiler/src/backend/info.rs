@@ -3,7 +3,9 @@
 
 use reachc_runtime::system::{self as rt, ModelInfo};
 
-use crate::analysis::{constants, synthesize_metric, ConstantsError, Derivatives, Frame};
+use crate::analysis::{
+    constants, constants_without_rate, synthesize_metric, ConstantsError, Derivatives, Frame,
+};
 use crate::diagnostics::Diagnostic;
 use crate::ir::Names;
 use crate::model::{self, Bounds, Model};
@@ -44,7 +46,11 @@ pub fn prepare(model: &mut Model) -> Prepared {
             model::Metric::Matrix(m) => Ok(m.iter().flatten().copied().collect()),
             model::Metric::Auto => synthesize_metric(model, &derivatives),
         };
-        let derived = metric.and_then(|p| constants(model, &derivatives, &p));
+        // An empirical rate needs only sigma and rho from here.
+        let derived = metric.and_then(|p| match a.rate {
+            rt::Rate::Certified => constants(model, &derivatives, &p),
+            _ => constants_without_rate(model, &derivatives, &p),
+        });
         let (constants, constants_error) = match derived {
             Ok(c) => (Some(c), None),
             Err(e) => {
@@ -67,6 +73,7 @@ pub fn prepare(model: &mut Model) -> Prepared {
             horizon: a.horizon,
             step: a.step,
             radius: a.radius,
+            rate: a.rate,
             integrator: a.integrator,
             inclusion: a.inclusion,
             outputs: a.outputs.clone(),

@@ -51,6 +51,10 @@ pub struct PlotArgs {
     /// Monte Carlo report for the quantile (default: ANALYSIS.sim.json beside the result).
     #[arg(long)]
     pub sim: Option<PathBuf>,
+    /// Also fill the union of the PRS over all report times (an envelope, as the paper's
+    /// Fig. 7).
+    #[arg(long)]
+    pub envelope: bool,
     /// Directory for the pictures (default: the result's directory).
     #[arg(short, long)]
     pub out: Option<PathBuf>,
@@ -77,6 +81,9 @@ pub struct RunPlotArgs {
     /// Number of sample paths drawn.
     #[arg(long, default_value_t = plot::DEFAULT_PATHS, requires = "plot", value_name = "N")]
     pub plot_paths: u64,
+    /// Also fill the union of the PRS over all report times.
+    #[arg(long, requires = "plot")]
+    pub plot_envelope: bool,
 }
 
 /// Checks `--plot-states` against the spec's states before anything runs.
@@ -192,6 +199,7 @@ pub fn run_plot(args: &PlotArgs) -> Result<(), u8> {
         times: args.times.clone(),
         paths: args.paths,
         seed: args.seed,
+        envelope: args.envelope,
     };
     let dir = match &args.out {
         Some(d) => d.clone(),
@@ -200,7 +208,11 @@ pub fn run_plot(args: &PlotArgs) -> Result<(), u8> {
             .parent()
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
     };
-    let model = model.as_ref().map(|(sys, info)| Model { sys, info });
+    let model = model.as_ref().map(|(sys, info)| Model {
+        sys,
+        info,
+        tables: &sys.model().tables,
+    });
     let files = plot::plot_result(&result, model.as_ref(), quantile.as_ref(), &choice, &dir)
         .map_err(usage)?;
     report_written(&files);
@@ -271,12 +283,17 @@ pub(super) fn plot_after_run(
     let Some(dir) = &args.plot else {
         return Ok(());
     };
-    let model = Model { sys, info };
+    let model = Model {
+        sys,
+        info,
+        tables: &sys.model().tables,
+    };
     let choice = Choice {
         states: args.plot_states.clone(),
         times: args.plot_times.clone(),
         paths: args.plot_paths,
         seed: 0,
+        envelope: args.plot_envelope,
     };
     let mut status = Ok(());
     for a in info

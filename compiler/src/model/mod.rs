@@ -9,7 +9,7 @@ use crate::diagnostics::Span;
 use crate::ir::{ExprId, Pool, Table};
 
 // The analysis settings are the runtime's own types: the compiler hands them on unchanged.
-pub use reachc_runtime::system::{Inclusion, Integrator, Method, RadiusRule};
+pub use reachc_runtime::system::{Inclusion, Integrator, Method, RadiusRule, Rate};
 
 /// A checked spec, ready for analysis and code generation.
 #[derive(Clone, Debug)]
@@ -170,6 +170,8 @@ pub struct Analysis {
     pub metric: Metric,
     /// `radius` (default amgf).
     pub radius: RadiusRule,
+    /// `rate`: where the contraction rate comes from (default certified; contraction only).
+    pub rate: Rate,
     /// `inclusion` (default jacobian).
     pub inclusion: Inclusion,
     /// `integrator` (default rk4).

@@ -37,6 +37,8 @@ const PALETTE: [RGBColor; 7] = [
 ];
 const UNSAFE: RGBColor = RGBColor(214, 39, 40);
 const PATHS: RGBColor = RGBColor(100, 100, 100);
+/// Fill of the union of the PRS over the horizon (opaque, so overlaps do not darken).
+const ENVELOPE: RGBColor = RGBColor(178, 223, 138);
 const GRID: RGBColor = RGBColor(232, 232, 232);
 const NOTE: RGBColor = RGBColor(90, 90, 90);
 
@@ -212,6 +214,8 @@ impl Draw for SetsScene {
             self.slices
                 .iter()
                 .flat_map(|sl| sl.prs.iter().chain(&sl.det).chain(&sl.samples).copied())
+                .chain(self.envelope.iter().flatten().copied())
+                .chain(self.reference.iter().flat_map(|(_, p)| p.iter().copied()))
                 .chain(self.nominal.iter().copied())
                 .chain(self.paths.iter().flatten().copied())
                 .chain(bounded.flat_map(|(x, y)| [[x.0, y.0], [x.1, y.1]])),
@@ -277,6 +281,22 @@ impl Draw for SetsScene {
             ));
         }
 
+        if !self.envelope.is_empty() {
+            chart
+                .draw_series(
+                    self.envelope
+                        .iter()
+                        .map(|p| Polygon::new(closed(p), ENVELOPE.filled())),
+                )
+                .map_err(err)?;
+            entries.push((
+                Mark::Fill(ENVELOPE.to_rgba()),
+                format!(
+                    "union of the PRS over all {} report times",
+                    self.envelope.len()
+                ),
+            ));
+        }
         for (k, sl) in self.slices.iter().enumerate() {
             let c = PALETTE[k % PALETTE.len()];
             if sl.prs.len() >= 3 {
@@ -357,6 +377,17 @@ impl Draw for SetsScene {
                 Mark::Dot(PATHS.to_rgba()),
                 "dots: the paths' X_t at those times".into(),
             ));
+        }
+        if let Some((label, path)) = &self.reference {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    path.iter().map(|z| (z[0], z[1])),
+                    i(9),
+                    i(6),
+                    BLACK.mix(0.8).stroke_width(2 * s),
+                ))
+                .map_err(err)?;
+            entries.push((Mark::Dashed(BLACK.mix(0.8)), label.clone()));
         }
         if !self.nominal.is_empty() {
             chart

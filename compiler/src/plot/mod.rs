@@ -27,7 +27,8 @@ use std::path::{Path, PathBuf};
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::system::{Analysis, ModelInfo, System};
 
-use geometry::Plane;
+use crate::ir::Table;
+use geometry::{Plane, Point};
 use input::ResultFile;
 use output::Draw;
 use regions::Region;
@@ -46,14 +47,36 @@ pub struct Choice {
     pub paths: u64,
     /// Their random seed (path `p` is path `p` of `reachc simulate --seed S`).
     pub seed: u64,
+    /// Also fill the union of the PRS over all report times (the paper's Fig. 7 "envelope").
+    pub envelope: bool,
 }
 
-/// The spec's model, for sample paths and unsafe sets.
+/// The spec's model, for sample paths, unsafe sets and reference trajectories.
 pub struct Model<'a> {
     /// The system (the interpreter).
     pub sys: &'a (dyn System + Sync),
     /// Its sets and analyses.
     pub info: &'a ModelInfo,
+    /// Its tables: one with columns named as both plotted states is drawn as a reference.
+    pub tables: &'a [Table],
+}
+
+/// The first table with columns named as the two plotted states, as a path in the plane with
+/// its legend label (e.g. a reference trajectory `ref.px`, `ref.py`).
+fn reference(model: &Model<'_>, plane: [usize; 2]) -> Option<(String, Vec<Point>)> {
+    let names = plane.map(|i| model.info.states[i].as_str());
+    model.tables.iter().find_map(|t| {
+        let (a, b) = (t.column_index(names[0])?, t.column_index(names[1])?);
+        let path = t.values[a]
+            .iter()
+            .zip(&t.values[b])
+            .map(|(&x, &y)| [x, y])
+            .collect();
+        Some((
+            format!("table `{}` ({}, {}): reference", t.name, names[0], names[1]),
+            path,
+        ))
+    })
 }
 
 /// A Monte Carlo quantile for the radius figure.
@@ -180,6 +203,10 @@ pub fn plot_result(
         }
     };
     let mut sets = scene::sets_scene(result, &plane, &picked, &paths, regions);
+    if choice.envelope {
+        sets.envelope = scene::envelope(result, &plane);
+    }
+    sets.reference = model.and_then(|m| reference(m, states));
     sets.notes.extend(notes);
     let radius = scene::radius_scene(
         result,
@@ -230,6 +257,7 @@ pub fn plot_without_result(
     let regions = unsafe_regions(info, states, &mut notes);
     let paths = sample(model, &times, None, choice)?;
     let mut sets = scene::paths_scene(info, analysis, &plane, (&times, &picked), &paths, regions);
+    sets.reference = reference(model, states);
     sets.notes.extend(notes);
     write_all(
         dir,

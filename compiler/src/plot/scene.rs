@@ -17,6 +17,10 @@ pub struct SetsScene {
     pub axes: [String; 2],
     /// The sets at the chosen times.
     pub slices: Vec<Slice>,
+    /// The PRS at every report time, whose union is filled (empty: not drawn).
+    pub envelope: Vec<Vec<Point>>,
+    /// A reference trajectory from a table of the spec, with its legend label.
+    pub reference: Option<(String, Vec<Point>)>,
     /// The nominal trajectory (or the sets' centres), at every report time.
     pub nominal: Vec<Point>,
     /// What [`SetsScene::nominal`] is, for the legend.
@@ -103,6 +107,21 @@ fn samples_at(paths: &[Vec<Point>], k: usize) -> Vec<Point> {
         .collect()
 }
 
+/// The PRS of every report step of a result, as polygons (their union is the set of states the
+/// PRS hold at some time of the horizon).
+pub fn envelope(result: &ResultFile, plane: &Plane) -> Vec<Vec<Point>> {
+    result
+        .steps
+        .iter()
+        .map(|step| {
+            det_set(result, plane, step)
+                .plus_ellipse(plane.shape, step.r_t)
+                .polygon()
+        })
+        .filter(|p| p.len() >= 3)
+        .collect()
+}
+
 /// The sets figure of a result: the sets at report steps `picked`, the nominal, the sample
 /// paths (flat states at every report time of the result) and the unsafe regions.
 pub fn sets_scene(
@@ -155,6 +174,8 @@ pub fn sets_scene(
         title: format!("{} / {}: δ-PRS", result.model, result.analysis),
         axes: [result.states[a].clone(), result.states[b].clone()],
         slices,
+        envelope: Vec::new(),
+        reference: None,
         nominal: result
             .steps
             .iter()
@@ -203,6 +224,8 @@ pub fn paths_scene(
                 nominal: None,
             })
             .collect(),
+        envelope: Vec::new(),
+        reference: None,
         nominal: Vec::new(),
         nominal_label: String::new(),
         paths,

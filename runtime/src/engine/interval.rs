@@ -29,7 +29,7 @@ use super::embedding::Embedding;
 use super::result::{AnalysisResult, ConstantsReport, DetSet, StepRecord, Validation};
 use super::{integrator_name, nominal, radius, safety, transform, verdicts, RunError};
 use crate::interval::Interval;
-use crate::system::{Analysis, Inclusion, ModelInfo, System};
+use crate::system::{Analysis, Inclusion, ModelInfo, Rate, System};
 
 /// Runs an interval-method analysis with the given inclusion function.
 ///
@@ -193,6 +193,7 @@ pub fn run_interval(
         integrator: integrator_name(analysis.integrator).into(),
         states: info.states.clone(),
         outputs: analysis.outputs.clone(),
+        rate: super::rate_report(Rate::Certified, None, consts.c).0,
         constants: ConstantsReport {
             c: consts.c,
             sigma: consts.sigma,

@@ -17,6 +17,7 @@ mod interval;
 mod linalg;
 mod nominal;
 mod radius;
+mod rates;
 mod result;
 mod safety;
 mod transform;
@@ -24,12 +25,12 @@ mod transform;
 pub use interval::{reach, run_interval};
 pub use radius::MAX_VERTEX_COORDS;
 pub use result::{
-    AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, StepRecord, TransformReport,
-    UnsafeReport, Validation, Verdict,
+    AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, RateReport, StepRecord,
+    TransformReport, UnsafeReport, Validation, Verdict,
 };
 
 use crate::interval::Interval;
-use crate::system::{Analysis, Constants, Integrator, Method, ModelInfo, RadiusRule, System};
+use crate::system::{Analysis, Constants, Integrator, Method, ModelInfo, RadiusRule, Rate, System};
 use std::fmt;
 
 /// Why an analysis could not run.
@@ -124,13 +125,21 @@ pub(crate) fn setup<'a>(
 ///
 /// [`Method::Interval`] runs [`run_interval`] with the analysis' inclusion function (a
 /// coordinate transform needs the system's transformed frame, [`RunError::Unsupported`]
-/// otherwise). The constants must be present ([`RunError::NoConstants`]).
+/// otherwise). The constants must be present ([`RunError::NoConstants`]). The contraction
+/// rate comes from the analysis' [`Rate`]: certified by the compiler, or estimated from sample
+/// paths (labelled so in the result).
 pub fn run(
     sys: &dyn System,
     info: &ModelInfo,
     analysis: &Analysis,
 ) -> Result<AnalysisResult, RunError> {
     if analysis.method == Method::Interval {
+        if analysis.rate != Rate::Certified {
+            return Err(RunError::Unsupported(format!(
+                "a {} rate with the interval method (it uses the certified rate)",
+                analysis.rate.name()
+            )));
+        }
         return interval::run_interval(sys, info, analysis, analysis.inclusion);
     }
     let Setup {
@@ -139,7 +148,10 @@ pub fn run(
         p,
         chol,
         p_inv_diag,
-    } = setup(sys, info, analysis, &["c", "sigma", "rho"])?;
+    } = match analysis.rate {
+        Rate::Certified => setup(sys, info, analysis, &["c", "sigma", "rho"])?,
+        Rate::Empirical { .. } => setup(sys, info, analysis, &["sigma", "rho"])?,
+    };
     let metric = &consts.metric;
 
     // Initial set and inputs.
@@ -185,15 +197,29 @@ pub fn run(
     let checks =
         safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv_diag).map_err(RunError::Invalid)?;
 
+    // Per-step rates (None: the certified constant on every step).
+    let rates = match analysis.rate {
+        Rate::Certified => None,
+        Rate::Empirical { paths } => Some(rates::empirical(
+            sys, info, metric, &grid, &traj, &u_center, paths,
+        )?),
+    };
+    let det_radii = rates
+        .as_ref()
+        .map(|c| rates::det_radii(c, &grid, rho, r1, r2));
+
     let mut stochastic = radius::Stochastic::new(kappa);
     let mut steps = Vec::with_capacity(grid.len());
     for (k, (&t, x)) in grid.iter().zip(traj).enumerate() {
-        // c_t, sigma_t on the step ending at t: constant for now; the Psi recursion and the
-        // records are already per step so that piecewise-constant rates can be plugged in.
-        let (c_k, sigma_k) = (consts.c, consts.sigma);
+        // c_t, sigma_t on the step ending at t.
+        let c_k = rates.as_ref().map_or(consts.c, |c| c[k]);
+        let sigma_k = consts.sigma;
         let prev = k.checked_sub(1).map(|j| grid[j]);
         let (psi_hi, r_t) = stochastic.advance(prev, t, c_k, sigma_k);
-        let det = radius::det_radius(consts.c, rho, r1, r2, t);
+        let det = match &det_radii {
+            Some(radii) => radii[k],
+            None => radius::det_radius(consts.c, rho, r1, r2, t),
+        };
         let prs = (Interval::point(det) + Interval::point(r_t)).hi();
         let margins = checks.iter().map(|c| c.margin(&x, prs)).collect();
         steps.push(StepRecord {
@@ -231,6 +257,10 @@ pub fn run(
                 .into(),
         );
     }
+    let (rate, rate_rigorous) = rate_report(analysis.rate, rates.as_deref(), consts.c);
+    if let Rate::Empirical { .. } = analysis.rate {
+        not_validated.insert(0, rate.note.clone());
+    }
     Ok(AnalysisResult {
         model: info.name.clone(),
         analysis: analysis.name.clone(),
@@ -242,6 +272,7 @@ pub fn run(
         integrator: integrator_name(analysis.integrator).into(),
         states: info.states.clone(),
         outputs: analysis.outputs.clone(),
+        rate,
         constants: ConstantsReport {
             c: consts.c,
             sigma: consts.sigma,
@@ -262,7 +293,7 @@ pub fn run(
         verdict,
         validated: Validation {
             rigorous: vec![
-                format!("constants c, sigma, rho ({})", consts.how),
+                format!("{rate_rigorous} ({})", consts.how),
                 "kappa (rounded up)".into(),
                 "Psi_t (exact per-step integration in interval arithmetic, upper end)".into(),
                 "radii r1, R_t, r_t, PRS radius (interval arithmetic, rounded up)".into(),
@@ -274,6 +305,35 @@ pub fn run(
             conditional_on_domain: info.has_domain,
         },
     })
+}
+
+/// The report of the rate's source and the "rigorous" line for the constants.
+pub(crate) fn rate_report(rate: Rate, rates: Option<&[f64]>, c: f64) -> (RateReport, String) {
+    let max_c = rates.map_or(c, |r| r.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+    let (note, rigorous) = match rate {
+        Rate::Certified => (
+            "one rate c for the whole horizon, certified by the compiler over the domain".into(),
+            "constants c, sigma, rho",
+        ),
+        Rate::Empirical { paths } => (
+            format!(
+                "EMPIRICAL: c_t estimated from {paths} sample paths (largest one-sided Lipschitz \
+                 quotient between a sampled state and the nominal), not certified: the PRS is \
+                 an estimate, not a guarantee"
+            ),
+            "constants sigma, rho",
+        ),
+    };
+    let report = RateReport {
+        kind: rate.name().into(),
+        note,
+        paths: match rate {
+            Rate::Empirical { paths } => Some(paths),
+            Rate::Certified => None,
+        },
+        max_c,
+    };
+    (report, rigorous.to_string())
 }
 
 /// Whether `x` lies in the PRS `B_P(x*_t, R_t + r_t)` at report step `step_index` (for an

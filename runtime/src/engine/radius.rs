@@ -42,7 +42,7 @@ pub(crate) fn expm1(x: Interval) -> Interval {
 }
 
 /// `expm1(a h) / a`, the integral of `e^(a s)` over `[0, h]`; `h` itself at `a = 0`.
-fn expm1_over(a: f64, h: Interval) -> Interval {
+pub(crate) fn expm1_over(a: f64, h: Interval) -> Interval {
     if a == 0.0 {
         h
     } else {

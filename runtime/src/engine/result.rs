@@ -31,6 +31,8 @@ pub struct AnalysisResult {
     pub states: Vec<String>,
     /// Indices of the states the CSV and the summary report.
     pub outputs: Vec<usize>,
+    /// Where the contraction rate came from.
+    pub rate: RateReport,
     /// The constants of Assumption 1 used.
     pub constants: ConstantsReport,
     /// The stochastic radius rule.
@@ -74,6 +76,20 @@ pub struct ConstantsReport {
     pub how: String,
     /// The metric `P`, by rows.
     pub metric: Vec<Vec<f64>>,
+}
+
+/// Where the contraction rate `c_t` came from (see [`Rate`](crate::system::Rate)).
+#[derive(Clone, Debug, Serialize)]
+pub struct RateReport {
+    /// `"certified"` or `"empirical"`.
+    pub kind: String,
+    /// One sentence for the reader; an empirical rate says plainly that it is no guarantee.
+    pub note: String,
+    /// Number of sample paths of the estimate (empirical rates).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub paths: Option<u64>,
+    /// The largest rate used on any step (the certified `c` for a certified rate).
+    pub max_c: f64,
 }
 
 /// A coordinate transform `y = T x`, as used.
@@ -285,11 +301,23 @@ impl AnalysisResult {
             self.analysis, self.model, self.method, self.delta
         );
         let k = &self.constants;
+        let c = if self.rate.kind == "certified" {
+            format!("{:.6}", k.c)
+        } else {
+            format!(
+                "c_t ({} rate, at most {})",
+                self.rate.kind,
+                num(self.rate.max_c)
+            )
+        };
         let _ = writeln!(
             s,
-            "  constants: c = {:.6}, sigma = {:.6}, rho = {:.6} ({})",
-            k.c, k.sigma, k.rho, k.how
+            "  constants: c = {c}, sigma = {:.6}, rho = {:.6} ({})",
+            k.sigma, k.rho, k.how
         );
+        if self.rate.kind != "certified" {
+            let _ = writeln!(s, "  rate: {}", self.rate.note);
+        }
         let rows: Vec<String> = k
             .metric
             .iter()
@@ -327,8 +355,11 @@ impl AnalysisResult {
                 let st = &self.steps[i];
                 let _ = writeln!(
                     s,
-                    "  {:>10.4}  {:>12.6}  {:>12.6}  {:>12.6}",
-                    st.t, st.det_set.radius, st.r_t, st.prs_radius
+                    "  {:>10.4}  {:>12}  {:>12}  {:>12}",
+                    st.t,
+                    num(st.det_set.radius),
+                    num(st.r_t),
+                    num(st.prs_radius)
                 );
             }
         }
@@ -346,12 +377,21 @@ impl AnalysisResult {
                 };
                 let _ = writeln!(
                     s,
-                    "  unsafe set `{}` ({}): {status}; min margin {:.6} at t = {:.4} ({})",
-                    u.name, u.kind, u.min_margin, u.min_margin_t, u.margin_unit
+                    "  unsafe set `{}` ({}): {status}; min margin {} at t = {:.4} ({})",
+                    u.name,
+                    u.kind,
+                    num(u.min_margin),
+                    u.min_margin_t,
+                    u.margin_unit
                 );
             }
         }
         let verdict = match &self.verdict {
+            Verdict::Safe if self.rate.kind == "empirical" => {
+                "safe by the EMPIRICAL estimate (every estimated PRS misses every unsafe set; \
+                 not a guarantee)"
+                    .to_string()
+            }
             Verdict::Safe => "safe (every PRS misses every unsafe set)".to_string(),
             Verdict::NoUnsafeSets => "no unsafe sets to check".to_string(),
             Verdict::NotShownSafe { t, set, .. } => format!(
@@ -365,6 +405,15 @@ impl AnalysisResult {
             self.validated.not_validated.join("; ")
         );
         s
+    }
+}
+
+/// A number for the summary: 6 decimals, or scientific notation where that would be long.
+fn num(v: f64) -> String {
+    if v.is_finite() && v.abs() >= 1e6 {
+        format!("{v:.6e}")
+    } else {
+        format!("{v:.6}")
     }
 }
 

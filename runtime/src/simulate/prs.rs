@@ -291,6 +291,7 @@ mod tests {
             horizon: 1.0,
             step: 0.1,
             radius: RadiusRule::Amgf,
+            rate: Rate::Certified,
             integrator: Integrator::Rk4,
             inclusion: Inclusion::Jacobian,
             outputs: vec![],

@@ -5,8 +5,11 @@ use super::scope::did_you_mean;
 use super::sets::Fields;
 use super::Checker;
 use crate::diagnostics::{Diagnostic, Span};
-use crate::model::{Analysis, Inclusion, Integrator, Method, Metric, RadiusRule, Transform};
+use crate::model::{Analysis, Inclusion, Integrator, Method, Metric, RadiusRule, Rate, Transform};
 use crate::syntax::ast::{Block, Expr, ExprKind, Ident};
+
+/// Most sample paths of an empirical rate estimate (they are all kept in memory).
+const MAX_EMPIRICAL_PATHS: f64 = 20_000.0;
 
 const KEYS: &[&str] = &[
     "method",
@@ -15,6 +18,7 @@ const KEYS: &[&str] = &[
     "step",
     "metric",
     "radius",
+    "rate",
     "inclusion",
     "integrator",
     "transform",
@@ -114,6 +118,10 @@ impl Checker<'_> {
             None => Some(RadiusRule::Amgf),
             Some((e, _)) => self.radius_rule(e),
         };
+        let rate = match f.get("rate") {
+            None => Some(Rate::Certified),
+            Some((e, _)) => self.rate(e),
+        };
         let transform = match f.get("transform") {
             None => Some(None),
             Some((e, _)) => self.transform(e, n).map(Some),
@@ -133,11 +141,38 @@ impl Checker<'_> {
         else {
             return;
         };
-        let (Some(metric), Some(radius), Some(transform), Some(outputs)) =
-            (metric, radius, transform, outputs)
+        let (Some(metric), Some(radius), Some(rate), Some(transform), Some(outputs)) =
+            (metric, radius, rate, transform, outputs)
         else {
             return;
         };
+        if let (Rate::Empirical { .. }, Some((e, _))) = (rate, f.get("rate")) {
+            let conflict = if method != Method::Contraction {
+                Some((
+                    "needs `method = contraction`",
+                    "the interval method uses the certified rate",
+                ))
+            } else if metric == Metric::Auto {
+                Some((
+                    "cannot be combined with `metric = auto`",
+                    "the metric is synthesised from the certified (global) rate; give \
+                     `metric = identity` or a matrix",
+                ))
+            } else {
+                None
+            };
+            if let Some((what, help)) = conflict {
+                self.fail::<()>(
+                    Diagnostic::error(
+                        format!("`rate = {}` {what}", rate.name()),
+                        e.span.clone(),
+                        "here",
+                    )
+                    .with_help(help),
+                );
+                return;
+            }
+        }
         if let (Some(_), Some((e, _))) = (&transform, f.get("transform")) {
             if method != Method::Interval {
                 self.fail::<()>(
@@ -163,6 +198,7 @@ impl Checker<'_> {
             step,
             metric,
             radius,
+            rate,
             inclusion,
             integrator,
             transform,
@@ -258,6 +294,55 @@ impl Checker<'_> {
                         )),
                 )
             }
+        }
+    }
+
+    /// `certified` or `empirical(paths = N)`.
+    fn rate(&mut self, e: &Expr) -> Option<Rate> {
+        let help = "write `certified` or `empirical(paths = 2000)`";
+        let bad = |msg: &str, span: Span, label: &str| {
+            Diagnostic::error(msg, span, label).with_help(help)
+        };
+        match &e.kind {
+            ExprKind::Name(id) if id.name == "certified" => Some(Rate::Certified),
+            ExprKind::Call { func, args } if func.name == "empirical" => {
+                let key = "paths";
+                let [a] = args.as_slice() else {
+                    return self.fail(bad(
+                        &format!("`{}` takes one argument, `{key} = ...`", func.name),
+                        e.span.clone(),
+                        "here",
+                    ));
+                };
+                if a.name.as_ref().is_none_or(|n| n.name != key) {
+                    let (span, label) = match &a.name {
+                        Some(n) => (n.span.clone(), format!("unknown argument `{}`", n.name)),
+                        None => (a.value.span.clone(), "expected a named argument".into()),
+                    };
+                    return self.fail(bad(
+                        &format!("`{}` takes `{key} = ...`", func.name),
+                        span,
+                        &label,
+                    ));
+                }
+                let v = self.constant(&a.value, &[])?;
+                if (2.0..=MAX_EMPIRICAL_PATHS).contains(&v) && v.fract() == 0.0 {
+                    return Some(Rate::Empirical { paths: v as u64 });
+                }
+                self.fail(bad(
+                    &format!(
+                        "the number of paths must be a whole number in [2, {MAX_EMPIRICAL_PATHS}], \
+                         but it is {v}"
+                    ),
+                    a.value.span.clone(),
+                    "out of range",
+                ))
+            }
+            _ => self.fail(bad(
+                "unknown rate",
+                e.span.clone(),
+                "expected certified or empirical(...)",
+            )),
         }
     }
 
