@@ -262,6 +262,50 @@ fn results_do_not_depend_on_the_thread_count() {
     assert_ne!(other.to_json(), json(1, InputMode::Random));
 }
 
+/// `simulate` and `sample_paths` run the same paths: with one path, the quantile reported at
+/// each time is that path's distance to the nominal, which equals (to the bit) the distance of
+/// the recorded path. Covers the fast loop for additive noise (no inputs, no unsafe set) and the
+/// general one (inputs, an unsafe set, Euler steps finer than the report step).
+#[test]
+fn simulated_paths_are_the_recorded_sample_paths() {
+    let mut additive = info(&LINEAR, 0.3, 0.2, 0.0, 0.05, 1.0);
+    additive.unsafe_sets.clear();
+    let forced = Linear {
+        n: 2,
+        a: -1.0,
+        b: 1.0,
+        s: 0.5,
+    };
+    let general = info(&forced, 0.5, 0.2, 0.3, 0.05, 1.0);
+    for (sys, info, dt) in [(&LINEAR, &additive, None), (&forced, &general, Some(0.004))] {
+        let r = run(sys, info);
+        let times: Vec<f64> = r.steps.iter().map(|s| s.t).collect();
+        for seed in 0..10 {
+            let opts = Options {
+                paths: 1,
+                seed,
+                dt,
+                hold: Some(0.05),
+                ..Options::default()
+            };
+            let rep = simulate(sys, info, &r, &opts);
+            let sampled =
+                simulate::sample_paths(sys, info, &times, Some(&r.initial_center), &opts).unwrap();
+            for (k, (st, res)) in rep.steps.iter().zip(&r.steps).enumerate() {
+                let x = &sampled[0][k * sys.n..][..sys.n];
+                // The identity metric's distance, summed as the simulation sums it.
+                let q = x
+                    .iter()
+                    .zip(&res.nominal)
+                    .map(|(x, c)| (x - c) * (x - c))
+                    .reduce(|q, t| q + t)
+                    .unwrap();
+                assert_eq!(st.quantile, q.sqrt(), "seed {seed}, t = {}", st.t);
+            }
+        }
+    }
+}
+
 /// A PRS computed with half the true noise level is too small: the coverage check fails, and
 /// a PRS shrunk after the fact as well. The correct one passes.
 #[test]

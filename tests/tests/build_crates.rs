@@ -9,6 +9,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+use reachc::backend::codegen;
 use reachc::backend::crate_writer::{compile_crate_in, write_crate, CrateOptions, WrittenCrate};
 use reachc::backend::interp::Interpreter;
 use reachc::backend::prepare;
@@ -57,9 +58,15 @@ fn spec(name: &str) -> PathBuf {
 
 /// Loads `spec` and writes its crate to `out`.
 fn write(spec: &Path, out: &Path) -> WrittenCrate {
+    write_with(spec, out, codegen::Options::default())
+}
+
+/// Loads `spec` and writes its crate to `out`, generating code with `codegen`.
+fn write_with(spec: &Path, out: &Path, codegen: codegen::Options) -> WrittenCrate {
     let mut loaded = load(spec).unwrap_or_else(|e| panic!("{}:\n{e}", relative(spec)));
     let options = CrateOptions {
         spec_label: Some(format!("`{}`", relative(spec))),
+        codegen,
         ..CrateOptions::default()
     };
     write_crate(&mut loaded, out, &options)
@@ -149,9 +156,20 @@ fn cargo(subcommand: &str, manifest: &Path, args: &[&str]) -> std::process::Outp
 fn small_crates_compile_clippy_clean_and_run() {
     let _cargo = cargo_lock();
     let scratch = Scratch::new("compile");
-    for name in ["pendulum", "linear"] {
+    // The pendulum also with its methods split into helper functions (clippy-clean too).
+    let chunked = codegen::Options {
+        split_above: 3,
+        chunk_size: 3,
+    };
+    for (stem, name, options) in [
+        ("pendulum", "pendulum", codegen::Options::default()),
+        ("linear", "linear", codegen::Options::default()),
+        ("pendulum", "pendulum-chunked", chunked),
+    ] {
         let dir = scratch.0.join(name);
-        let written = write(&spec(&format!("{name}.sde")), &dir);
+        let written = write_with(&spec(&format!("{stem}.sde")), &dir, options);
+        let lib = std::fs::read_to_string(dir.join("src/lib.rs")).unwrap();
+        assert_eq!(lib.contains("_part0("), options == chunked, "{name}");
         let binary = compile_crate_in(&dir, false, &target_dir())
             .unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
         assert!(binary.is_file(), "{}", binary.display());
@@ -202,8 +220,9 @@ fn small_crates_compile_clippy_clean_and_run() {
 
 /// The program replacing a generated crate's `src/main.rs`: for each line of stdin (a point
 /// `x, u, t` then a box `(lo, hi)` per state, input and time, as f64 bit patterns in hex), it
-/// prints drift, `D_x f`, `D_u f`, `G` at the point, then their interval versions on the box
-/// (`lo hi` per entry), all as hex bit patterns on one line.
+/// prints, for the model and then each of its frames, drift, `D_x f`, `D_u f`, `G` at the point,
+/// then their interval versions and the sparse `D_x f` on the box (`lo hi` per entry), all as
+/// hex bit patterns on one line.
 fn probe_main(crate_ident: &str, type_name: &str) -> String {
     format!(
         r#"use std::io::{{BufRead, Write}};
@@ -214,9 +233,43 @@ fn parse(s: &str) -> f64 {{
     f64::from_bits(u64::from_str_radix(s, 16).expect("hex"))
 }}
 
+fn dump(
+    sys: &dyn System,
+    (x, u, t): (&[f64], &[f64], f64),
+    (xi, ui, ti): (&[Interval], &[Interval], Interval),
+    words: &mut Vec<String>,
+) {{
+    let (n, p, m) = (sys.n(), sys.p(), sys.m());
+    let mut f = vec![0.0; n];
+    let mut jx = vec![0.0; n * n];
+    let mut ju = vec![0.0; n * p];
+    let mut g = vec![0.0; n * m];
+    sys.drift(x, u, t, &mut f);
+    sys.jac_x(x, u, t, &mut jx);
+    sys.jac_u(x, u, t, &mut ju);
+    sys.diffusion(x, t, &mut g);
+    let mut fi = vec![Interval::ZERO; n];
+    let mut jxi = vec![Interval::ZERO; n * n];
+    let mut jui = vec![Interval::ZERO; n * p];
+    let mut gi = vec![Interval::ZERO; n * m];
+    let mut si = vec![Interval::ZERO; sys.jac_x_pattern().len()];
+    sys.drift_interval(xi, ui, ti, &mut fi);
+    sys.jac_x_interval(xi, ui, ti, &mut jxi);
+    sys.jac_u_interval(xi, ui, ti, &mut jui);
+    sys.diffusion_interval(xi, ti, &mut gi);
+    sys.jac_x_sparse_interval(xi, ui, ti, &mut si);
+    for v in f.iter().chain(&jx).chain(&ju).chain(&g) {{
+        words.push(format!("{{:016x}}", v.to_bits()));
+    }}
+    for v in fi.iter().chain(&jxi).chain(&jui).chain(&gi).chain(&si) {{
+        words.push(format!("{{:016x}}", v.lo().to_bits()));
+        words.push(format!("{{:016x}}", v.hi().to_bits()));
+    }}
+}}
+
 fn main() {{
     let sys = {crate_ident}::{type_name};
-    let (n, p, m) = (sys.n(), sys.p(), sys.m());
+    let (n, p) = (sys.n(), sys.p());
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     for line in std::io::stdin().lock().lines() {{
@@ -227,35 +280,66 @@ fn main() {{
         let xi: Vec<Interval> = (0..n).map(iv).collect();
         let ui: Vec<Interval> = (n..n + p).map(iv).collect();
         let ti = iv(n + p);
-        let mut f = vec![0.0; n];
-        let mut jx = vec![0.0; n * n];
-        let mut ju = vec![0.0; n * p];
-        let mut g = vec![0.0; n * m];
-        sys.drift(x, u, t, &mut f);
-        sys.jac_x(x, u, t, &mut jx);
-        sys.jac_u(x, u, t, &mut ju);
-        sys.diffusion(x, t, &mut g);
-        let mut fi = vec![Interval::ZERO; n];
-        let mut jxi = vec![Interval::ZERO; n * n];
-        let mut jui = vec![Interval::ZERO; n * p];
-        let mut gi = vec![Interval::ZERO; n * m];
-        sys.drift_interval(&xi, &ui, ti, &mut fi);
-        sys.jac_x_interval(&xi, &ui, ti, &mut jxi);
-        sys.jac_u_interval(&xi, &ui, ti, &mut jui);
-        sys.diffusion_interval(&xi, ti, &mut gi);
         let mut words: Vec<String> = Vec::new();
-        for v in f.iter().chain(&jx).chain(&ju).chain(&g) {{
-            words.push(format!("{{:016x}}", v.to_bits()));
-        }}
-        for v in fi.iter().chain(&jxi).chain(&jui).chain(&gi) {{
-            words.push(format!("{{:016x}}", v.lo().to_bits()));
-            words.push(format!("{{:016x}}", v.hi().to_bits()));
+        dump(&sys, (x, u, t), (&xi, &ui, ti), &mut words);
+        let mut k = 0;
+        while let Some(frame) = sys.frame(k) {{
+            dump(frame, (x, u, t), (&xi, &ui, ti), &mut words);
+            k += 1;
         }}
         writeln!(out, "{{}}", words.join(" ")).expect("stdout");
     }}
 }}
 "#
     )
+}
+
+/// What the probe prints for one system at a sample, computed by the interpreter, each entry
+/// with its name: the point values of drift, `D_x f`, `D_u f`, `G`, then the box values of the
+/// same and of the sparse `D_x f`.
+struct Values {
+    points: Vec<(String, f64)>,
+    boxes: Vec<(String, Interval)>,
+}
+
+fn evaluate(sys: &dyn System, s: &Sample) -> Values {
+    let (n, p, m) = (sys.n(), sys.p(), sys.m());
+    let sizes = [n, n * n, n * p, n * m, sys.jac_x_pattern().len()];
+    let mut points: Vec<Vec<f64>> = sizes[..4].iter().map(|&len| vec![0.0; len]).collect();
+    sys.drift(&s.x, &s.u, s.t, &mut points[0]);
+    sys.jac_x(&s.x, &s.u, s.t, &mut points[1]);
+    sys.jac_u(&s.x, &s.u, s.t, &mut points[2]);
+    sys.diffusion(&s.x, s.t, &mut points[3]);
+    let mut boxes: Vec<Vec<Interval>> =
+        sizes.iter().map(|&len| vec![Interval::ZERO; len]).collect();
+    sys.drift_interval(&s.xi, &s.ui, s.ti, &mut boxes[0]);
+    sys.jac_x_interval(&s.xi, &s.ui, s.ti, &mut boxes[1]);
+    sys.jac_u_interval(&s.xi, &s.ui, s.ti, &mut boxes[2]);
+    sys.diffusion_interval(&s.xi, s.ti, &mut boxes[3]);
+    sys.jac_x_sparse_interval(&s.xi, &s.ui, s.ti, &mut boxes[4]);
+    fn named<T: Copy>(parts: &[Vec<T>], names: &[&str]) -> Vec<(String, T)> {
+        parts
+            .iter()
+            .zip(names)
+            .flat_map(|(part, name)| {
+                part.iter()
+                    .enumerate()
+                    .map(move |(e, &v)| (format!("{name}[{e}]"), v))
+            })
+            .collect()
+    }
+    let names = ["drift", "jac_x", "jac_u", "diffusion"];
+    let interval_names = [
+        "drift_interval",
+        "jac_x_interval",
+        "jac_u_interval",
+        "diffusion_interval",
+        "jac_x_sparse_interval",
+    ];
+    Values {
+        points: named(&points, &names),
+        boxes: named(&boxes, &interval_names),
+    }
 }
 
 /// A point and a box around it: states near their initial set, inputs in their box, time in
@@ -314,7 +398,7 @@ fn generated_code_agrees_with_the_interpreter() {
     let _cargo = cargo_lock();
     let scratch = Scratch::new("interp");
     // Every shipped spec but chain1000 (chain10 has the same equations; the big crate alone
-    // takes minutes to compile).
+    // takes a minute to compile).
     // Plus a spec whose names are Rust keywords (`fn`, `type`, `impl`, `self`, ...).
     let shipped = [
         "chain10",
@@ -327,15 +411,33 @@ fn generated_code_agrees_with_the_interpreter() {
         "vanderpol",
     ];
     let keywords = workspace().join("tests/good/rust_keywords.sde");
-    for path in shipped
+    // Then specs whose methods (of more than 3 operands) are split into helper functions that
+    // pass values through scratch arrays: chain10 (chain1000's equations, which are split at the
+    // default size), the pendulum (a frame) and the unicycle (a table, inputs and time).
+    let chunked = codegen::Options {
+        split_above: 3,
+        chunk_size: 3,
+    };
+    let default = codegen::Options::default();
+    let cases = shipped
         .iter()
-        .map(|n| spec(&format!("{n}.sde")))
-        .chain([keywords])
-    {
+        .map(|n| (spec(&format!("{n}.sde")), default))
+        .chain([(keywords, default)])
+        .chain(
+            ["chain10", "pendulum", "unicycle"]
+                .iter()
+                .map(|n| (spec(&format!("{n}.sde")), chunked)),
+        );
+    for (path, options) in cases {
         let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let name = stem.as_str();
+        let name = if options == chunked {
+            format!("{stem}-chunked")
+        } else {
+            stem
+        };
+        let name = name.as_str();
         let dir = scratch.0.join(name);
-        let written = write(&path, &dir);
+        let written = write_with(&path, &dir, options);
         let ident = written.crate_name.replace('-', "_");
         std::fs::write(
             dir.join("src/main.rs"),
@@ -348,7 +450,6 @@ fn generated_code_agrees_with_the_interpreter() {
         let mut model = load(&path).unwrap().model;
         let prepared = prepare(&mut model);
         let interp = Interpreter::new(model.clone(), &prepared);
-        let (n, p, m) = (interp.n(), interp.p(), interp.m());
 
         let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ name.len() as u64);
         let samples: Vec<Sample> = (0..50).map(|_| sample(&model, &mut rng)).collect();
@@ -386,58 +487,55 @@ fn generated_code_agrees_with_the_interpreter() {
         let lines: Vec<&str> = stdout.lines().collect();
         assert_eq!(lines.len(), samples.len());
 
-        let sizes = [n, n * n, n * p, n * m];
-        let what = ["drift", "jac_x", "jac_u", "diffusion"];
+        // The interpreter and its frames, in the probe's order.
+        let mut systems: Vec<&dyn System> = vec![&interp];
+        while let Some(frame) = interp.frame(systems.len() - 1) {
+            systems.push(frame);
+        }
         for (k, (s, line)) in samples.iter().zip(&lines).enumerate() {
             let words: Vec<f64> = line
                 .split_whitespace()
                 .map(|w| f64::from_bits(u64::from_str_radix(w, 16).unwrap()))
                 .collect();
-            let total: usize = sizes.iter().sum();
-            assert_eq!(words.len(), 3 * total, "{name}: sample {k}");
-            // The interpreter, in the same order.
-            let mut points: Vec<Vec<f64>> = sizes.iter().map(|&len| vec![0.0; len]).collect();
-            interp.drift(&s.x, &s.u, s.t, &mut points[0]);
-            interp.jac_x(&s.x, &s.u, s.t, &mut points[1]);
-            interp.jac_u(&s.x, &s.u, s.t, &mut points[2]);
-            interp.diffusion(&s.x, s.t, &mut points[3]);
-            let mut boxes: Vec<Vec<Interval>> =
-                sizes.iter().map(|&len| vec![Interval::ZERO; len]).collect();
-            interp.drift_interval(&s.xi, &s.ui, s.ti, &mut boxes[0]);
-            interp.jac_x_interval(&s.xi, &s.ui, s.ti, &mut boxes[1]);
-            interp.jac_u_interval(&s.xi, &s.ui, s.ti, &mut boxes[2]);
-            interp.diffusion_interval(&s.xi, s.ti, &mut boxes[3]);
-
-            let (gen_points, gen_boxes) = words.split_at(total);
             let mut at = 0;
-            for (part, len) in sizes.iter().enumerate() {
-                for e in 0..*len {
-                    let (g, i) = (gen_points[at + e], points[part][e]);
-                    // Same operations in the same order: bit for bit.
+            for (j, sys) in systems.iter().enumerate() {
+                let what = if j == 0 {
+                    format!("{name}: sample {k}")
+                } else {
+                    format!("{name}: frame {}: sample {k}", j - 1)
+                };
+                let want = evaluate(*sys, s);
+                let (np, nb) = (want.points.len(), want.boxes.len());
+                assert!(words.len() >= at + np + 2 * nb, "{what}: too few values");
+                let points = &words[at..at + np];
+                let boxes: Vec<Interval> = words[at + np..at + np + 2 * nb]
+                    .chunks(2)
+                    .map(|w| Interval::new(w[0], w[1]))
+                    .collect();
+                at += np + 2 * nb;
+                // Same operations in the same order: bit for bit.
+                for (&g, (entry, i)) in points.iter().zip(&want.points) {
                     assert!(
-                        same(g, i),
-                        "{name}: sample {k}: {}[{e}]: generated {g:e}, interpreter {i:e}",
-                        what[part]
-                    );
-                    let gi = Interval::new(gen_boxes[2 * (at + e)], gen_boxes[2 * (at + e) + 1]);
-                    let ii = boxes[part][e];
-                    assert!(
-                        same(gi.lo(), ii.lo()) && same(gi.hi(), ii.hi()),
-                        "{name}: sample {k}: {}_interval[{e}]: generated {gi:?}, interpreter \
-                         {ii:?}",
-                        what[part]
+                        same(g, *i),
+                        "{what}: {entry}: generated {g:e}, interpreter {i:e}"
                     );
                 }
-                at += len;
+                for (g, (entry, i)) in boxes.iter().zip(&want.boxes) {
+                    assert!(
+                        same(g.lo(), i.lo()) && same(g.hi(), i.hi()),
+                        "{what}: {entry}: generated {g:?}, interpreter {i:?}"
+                    );
+                }
+                // Enclosure: the point lies in the box, so the box results hold the point
+                // results (the dense parts come first, in the same order).
+                for (&v, (g, (entry, _))) in points.iter().zip(boxes.iter().zip(&want.boxes)) {
+                    assert!(
+                        v.is_nan() || g.contains(v),
+                        "{what}: {entry} = {g:?} misses {v:e}"
+                    );
+                }
             }
-            // Enclosure: the point lies in the box, so the box results hold the point results.
-            for (e, &v) in gen_points.iter().enumerate() {
-                let gi = Interval::new(gen_boxes[2 * e], gen_boxes[2 * e + 1]);
-                assert!(
-                    v.is_nan() || gi.contains(v),
-                    "{name}: sample {k}: interval entry {e} = {gi:?} misses {v:e}"
-                );
-            }
+            assert_eq!(at, words.len(), "{name}: sample {k}: too many values");
         }
     }
 }

@@ -13,11 +13,18 @@
 //! enclosures. `sinc`, `sign`, `sinc'` and table interpolation call the same
 //! `reachc_runtime::{func, table}` functions the interpreter uses.
 //!
+//! A method larger than [`Options::split_above`] (a model with hundreds of states) is split into
+//! `#[inline(never)]` helper functions of bounded size in private modules, called in sequence,
+//! values crossing from one to a later one passing through a scratch array; its dense interval
+//! Jacobian is then scattered from the sparse one. rustc compiles that in a minute where it
+//! never finished one giant function; the results are the same, bit for bit.
+//!
 //! The text has no inner attributes and no `//!` comments, so it can also be `include!`d. Spec
-//! names never become Rust identifiers (except the mangled struct name): they appear only in
-//! string literals and doc comments, escaped. The output is deterministic.
+//! names never become Rust identifiers (except the mangled struct name, also lowercased in the
+//! names of helper modules): they appear only in string literals and doc comments, escaped. The
+//! output is deterministic.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
@@ -34,6 +41,38 @@ use crate::model::Model;
 /// When an output has at least this many zero entries, it is cleared with one `fill` instead
 /// of one assignment per zero.
 const FILL_THRESHOLD: usize = 8;
+
+/// The default [`Options::split_above`]: every shipped spec but specs/chain1000.sde stays below
+/// (the largest method of the others costs 140), so their code is one function per method.
+pub const SPLIT_ABOVE: usize = 500;
+
+/// The default [`Options::chunk_size`]: at most about 100 lines of generated code per function.
+/// rustc's optimiser is superlinear in the size of a function, and the interval arithmetic it
+/// inlines makes the code it sees much larger than the source (docs/benchmarks.md, "Large
+/// generated crates").
+pub const CHUNK_SIZE: usize = 100;
+
+/// How [`generate_with`] writes code.
+///
+/// The cost of a method body is one unit per operand of each node it computes and one per
+/// output it writes. Results are the same whatever the options, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// A method whose body would cost more than this is split into helper functions, called in
+    /// sequence; a smaller one is a single function.
+    pub split_above: usize,
+    /// The largest cost of one helper function of a split method.
+    pub chunk_size: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            split_above: SPLIT_ABOVE,
+            chunk_size: CHUNK_SIZE,
+        }
+    }
+}
 
 /// Lints generated code may trip over without being wrong: literals that happen to be close to
 /// `std` constants (`pi / 2` folded by the compiler), long exact literals, and (pedantic) the
@@ -59,29 +98,36 @@ fn allow_lints() -> TokenStream {
 /// Panics only on a malformed model (a noise variable inside the drift or a diffusion
 /// coefficient, or a table index out of range), which the checker rules out.
 pub fn generate(model: &Model, prepared: &Prepared) -> String {
+    generate_with(model, prepared, &Options::default())
+}
+
+/// [`generate`] with explicit [`Options`].
+pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> String {
     let name = format_ident!("{}", mangle::type_name(&model.name));
     let n = int(model.states.len());
     let p = int(model.inputs.len());
     let m = int(model.noises.len());
 
     let mut tables = Tables::default();
-    let bodies = system_bodies(
+    let (bodies, helpers) = system_bodies(
         &model.pool,
         &mut tables,
-        &model.drift,
-        &model.diffusion,
+        &name,
+        (&model.drift, &model.diffusion),
         &prepared.derivatives,
+        options,
     );
     let mut frame_items = TokenStream::new();
     let mut frame_arms = TokenStream::new();
     for (k, frame) in prepared.frames.iter().enumerate() {
         let frame_name = format_ident!("{name}Frame{k}");
-        let frame_bodies = system_bodies(
+        let (frame_bodies, frame_helpers) = system_bodies(
             &model.pool,
             &mut tables,
-            &frame.drift,
-            &frame.diffusion,
+            &frame_name,
+            (&frame.drift, &frame.diffusion),
             &frame.derivatives,
+            options,
         );
         let doc = format!(
             " `{name}` in the coordinates `y = T x`, `T = {}`: drift `T f(T^-1 y, u, t)`, \
@@ -109,6 +155,8 @@ pub fn generate(model: &Model, prepared: &Prepared) -> String {
                 }
                 #frame_bodies
             }
+
+            #frame_helpers
         });
     }
     let frame_fn = if prepared.frames.is_empty() {
@@ -158,6 +206,8 @@ pub fn generate(model: &Model, prepared: &Prepared) -> String {
             #frame_fn
         }
 
+        #helpers
+
         #frame_items
 
         #statics
@@ -167,14 +217,16 @@ pub fn generate(model: &Model, prepared: &Prepared) -> String {
     format_file(file)
 }
 
-/// The `System` methods (f64 and interval) of a drift, diffusion and their Jacobians.
+/// The `System` methods (f64 and interval) of a drift, diffusion and their Jacobians, and the
+/// modules of helper functions of those split into chunks (see [`chunked_method`]).
 fn system_bodies(
     pool: &Pool,
     tables: &mut Tables,
-    drift: &[ExprId],
-    diffusion: &[Vec<ExprId>],
+    owner: &Ident,
+    (drift, diffusion): (&[ExprId], &[Vec<ExprId>]),
     d: &Derivatives,
-) -> TokenStream {
+    options: &Options,
+) -> (TokenStream, TokenStream) {
     let flat = |m: &[Vec<ExprId>]| -> Vec<ExprId> { m.iter().flatten().copied().collect() };
     let (jac_x, jac_u, diffusion) = (flat(&d.jac_x), flat(&d.jac_u), flat(diffusion));
     let methods = [
@@ -183,22 +235,67 @@ fn system_bodies(
         ("jac_u", &jac_u[..], true),
         ("diffusion", &diffusion[..], false),
     ];
-    let mut bodies = TokenStream::new();
-    for (method, roots, with_u) in methods {
-        for kind in [Kind::F64, Kind::Interval] {
-            bodies.extend(method_fn(pool, tables, method, kind, roots, with_u));
-        }
-    }
     let nonzeros = d.jac_x_dependencies(pool, drift);
     let sparse: Vec<ExprId> = nonzeros.iter().map(|&(_, _, e)| e).collect();
-    bodies.extend(method_fn(
-        pool,
-        tables,
-        "jac_x_sparse",
-        Kind::Interval,
-        &sparse,
-        true,
-    ));
+    let def = MethodDef {
+        name: "jac_x_sparse",
+        kind: Kind::Interval,
+        roots: &sparse,
+        with_u: true,
+        owner,
+    };
+    let (sparse_fn, sparse_helpers) = method_fn(pool, tables, &def, options);
+    // A sparse Jacobian large enough to be split: the dense one is scattered from it rather
+    // than computed by as much code again (its other entries are the constant 0).
+    let scatter = (!sparse_helpers.is_empty()).then(|| {
+        let n = drift.len();
+        let index = nonzeros.iter().map(|&(i, j, _)| int(i * n + j));
+        let nonzeros = scratch_array(
+            "nonzeros",
+            &quote!(reachc_runtime::Interval::ZERO),
+            sparse.len(),
+        );
+        quote! {
+            fn jac_x_interval(
+                &self,
+                x: &[reachc_runtime::Interval],
+                u: &[reachc_runtime::Interval],
+                t: reachc_runtime::Interval,
+                out: &mut [reachc_runtime::Interval],
+            ) {
+                const INDEX: &[usize] = &[#(#index),*];
+                out.fill(reachc_runtime::Interval::ZERO);
+                #nonzeros
+                self.jac_x_sparse_interval(x, u, t, &mut nonzeros);
+                for (&k, &v) in INDEX.iter().zip(&nonzeros) {
+                    out[k] = v;
+                }
+            }
+        }
+    });
+
+    let mut bodies = TokenStream::new();
+    let mut helpers = TokenStream::new();
+    for (name, roots, with_u) in methods {
+        for kind in [Kind::F64, Kind::Interval] {
+            if let (Some(method), ("jac_x", Kind::Interval)) = (&scatter, (name, kind)) {
+                bodies.extend(method.clone());
+                continue;
+            }
+            let def = MethodDef {
+                name,
+                kind,
+                roots,
+                with_u,
+                owner,
+            };
+            let (method, parts) = method_fn(pool, tables, &def, options);
+            bodies.extend(method);
+            helpers.extend(parts);
+        }
+    }
+    bodies.extend(sparse_fn);
+    helpers.extend(sparse_helpers);
     let pattern = nonzeros.iter().map(|&(i, j, _)| {
         let (i, j) = (int(i), int(j));
         quote!((#i, #j))
@@ -209,7 +306,7 @@ fn system_bodies(
             PATTERN.to_vec()
         }
     });
-    bodies
+    (bodies, helpers)
 }
 
 /// `[[a, b], [c, d]]`, for docs.
@@ -350,12 +447,39 @@ struct Emitter<'a> {
     kind: Kind,
     /// Whether the body names `Interval` (then it gets a local `use`).
     uses_interval: bool,
-    uses_x: bool,
-    uses_u: bool,
+    /// One past the largest index of `x` read (0: `x` is not read).
+    x_len: usize,
+    /// One past the largest index of `u` read (0: `u` is not read).
+    u_len: usize,
     uses_t: bool,
+    /// The path of the file's top level, where the tables are (`super::` in a helper module).
+    top: TokenStream,
 }
 
-impl Emitter<'_> {
+impl<'a> Emitter<'a> {
+    fn new(pool: &'a Pool, kind: Kind) -> Self {
+        Emitter {
+            pool,
+            kind,
+            uses_interval: false,
+            x_len: 0,
+            u_len: 0,
+            uses_t: false,
+            top: TokenStream::new(),
+        }
+    }
+
+    /// `use reachc_runtime::Interval;` if the body names `Interval`.
+    fn use_interval(&self) -> TokenStream {
+        if self.uses_interval {
+            quote!(
+                use reachc_runtime::Interval;
+            )
+        } else {
+            TokenStream::new()
+        }
+    }
+
     /// A constant in the method's arithmetic.
     fn constant(&mut self, v: f64) -> TokenStream {
         let lit = float(v);
@@ -374,12 +498,12 @@ impl Emitter<'_> {
             Node::Const(c) => self.constant(c.get()),
             Node::Var(v) => match *v {
                 Var::State(i) => {
-                    self.uses_x = true;
+                    self.x_len = self.x_len.max(i as usize + 1);
                     let i = int(i as usize);
                     quote!(x[#i])
                 }
                 Var::Input(j) => {
-                    self.uses_u = true;
+                    self.u_len = self.u_len.max(j as usize + 1);
                     let j = int(j as usize);
                     quote!(u[#j])
                 }
@@ -499,9 +623,13 @@ impl Emitter<'_> {
             Node::Call2(f, a, b) => self.call2(*f, *a, *b),
             Node::Table { table, column, arg } => {
                 tables.note(*table, *column);
-                let times = times_ident(*table);
-                let values = column_ident(*table, *column);
                 let a = self.operand(*arg);
+                let (top, times, values) = (
+                    &self.top,
+                    times_ident(*table),
+                    column_ident(*table, *column),
+                );
+                let (times, values) = (quote!(#top #times), quote!(#top #values));
                 match self.kind {
                     Kind::F64 => quote!(reachc_runtime::table::eval(&#times, &#values, #a)),
                     Kind::Interval => {
@@ -561,24 +689,98 @@ impl Emitter<'_> {
     }
 }
 
+/// What one generated `System` method computes.
+struct MethodDef<'a> {
+    /// `drift`, `jac_x`, ... (`_interval` is appended for [`Kind::Interval`]).
+    name: &'a str,
+    kind: Kind,
+    /// The outputs, row-major.
+    roots: &'a [ExprId],
+    /// Whether the method takes the inputs `u` (all but the diffusion do).
+    with_u: bool,
+    /// The type implementing the method (for its helpers' module names).
+    owner: &'a Ident,
+}
+
+impl MethodDef<'_> {
+    fn fn_name(&self) -> Ident {
+        match self.kind {
+            Kind::F64 => format_ident!("{}", self.name),
+            Kind::Interval => format_ident!("{}_interval", self.name),
+        }
+    }
+
+    fn scalar(&self) -> TokenStream {
+        match self.kind {
+            Kind::F64 => quote!(f64),
+            Kind::Interval => quote!(reachc_runtime::Interval),
+        }
+    }
+
+    /// `0.0` or `Interval::ZERO` as the method body can name it.
+    fn zero(&self) -> TokenStream {
+        match self.kind {
+            Kind::F64 => quote!(0.0),
+            Kind::Interval => quote!(reachc_runtime::Interval::ZERO),
+        }
+    }
+}
+
+/// `x`, or `_x` when the body does not read it.
+fn param_name(used: bool, name: &str) -> Ident {
+    if used {
+        format_ident!("{}", name)
+    } else {
+        format_ident!("_{}", name)
+    }
+}
+
+/// Whether `id` is a leaf (constant or variable), written inline rather than as a `let`.
+fn is_leaf(pool: &Pool, id: ExprId) -> bool {
+    matches!(pool.node(id), Node::Const(_) | Node::Var(_))
+}
+
+/// The operands of a node, in the order [`Emitter::node_expr`] reads them.
+fn children(node: &Node) -> Vec<ExprId> {
+    match node {
+        Node::Const(_) | Node::Var(_) => Vec::new(),
+        Node::Sum { terms, .. } => terms.iter().map(|&(t, _)| t).collect(),
+        Node::Product { factors } => factors.iter().map(|&(b, _)| b).collect(),
+        Node::Call1(_, a) | Node::Table { arg: a, .. } => vec![*a],
+        Node::Call2(_, a, b) => vec![*a, *b],
+    }
+}
+
+/// The size of a node's `let`, for splitting methods: its number of operands (at least 1).
+fn node_cost(pool: &Pool, id: ExprId) -> usize {
+    children(pool.node(id)).len().max(1)
+}
+
+/// The statement writing output `k`, `roots[k] = r`; `None` for a zero already written by
+/// `out.fill`.
+fn output(e: &mut Emitter, k: usize, r: ExprId, fill: bool) -> Option<TokenStream> {
+    let value = match e.pool.as_const(r) {
+        Some(c) if c == 0.0 && fill => return None,
+        Some(c) if c == 0.0 && e.kind == Kind::Interval => {
+            e.uses_interval = true;
+            quote!(Interval::ZERO)
+        }
+        _ => e.operand(r),
+    };
+    let k = int(k);
+    Some(quote!(out[#k] = #value;))
+}
+
 /// One `System` method (`drift`, `jac_x`, ... with `_interval` for [`Kind::Interval`]) writing
-/// `roots` (row-major) to `out`.
+/// its roots (row-major) to `out`, and the helper functions it calls: none unless its body
+/// would cost more than [`Options::split_above`] (see [`chunked_method`]).
 fn method_fn(
     pool: &Pool,
     tables: &mut Tables,
-    method: &str,
-    kind: Kind,
-    roots: &[ExprId],
-    with_u: bool,
-) -> TokenStream {
-    let mut e = Emitter {
-        pool,
-        kind,
-        uses_interval: false,
-        uses_x: false,
-        uses_u: false,
-        uses_t: false,
-    };
+    def: &MethodDef,
+    options: &Options,
+) -> (TokenStream, TokenStream) {
+    let (kind, roots) = (def.kind, def.roots);
     let zeros = roots
         .iter()
         .filter(|&&r| pool.as_const(r) == Some(0.0))
@@ -589,12 +791,24 @@ fn method_fn(
         .copied()
         .filter(|&r| !matches!(pool.node(r), Node::Const(_)))
         .collect();
+    let lets: Vec<ExprId> = pool
+        .reachable(&live)
+        .into_iter()
+        .filter(|&id| !is_leaf(pool, id))
+        .collect();
+    let writes = if fill {
+        roots.len() - zeros
+    } else {
+        roots.len()
+    };
+    let cost = lets.iter().map(|&id| node_cost(pool, id)).sum::<usize>() + writes;
+    if cost > options.split_above {
+        return chunked_method(pool, tables, def, fill, options.chunk_size);
+    }
 
+    let mut e = Emitter::new(pool, kind);
     let mut body = TokenStream::new();
-    for id in pool.reachable(&live) {
-        if matches!(pool.node(id), Node::Const(_) | Node::Var(_)) {
-            continue;
-        }
+    for id in lets {
         let v = value_ident(id);
         let expr = e.node_expr(id, tables);
         body.extend(quote!(let #v = #expr;));
@@ -610,54 +824,297 @@ fn method_fn(
         body.extend(quote!(out.fill(#zero);));
     }
     for (k, &r) in roots.iter().enumerate() {
-        let value = match pool.as_const(r) {
-            Some(c) if c == 0.0 && fill => continue,
-            Some(c) if c == 0.0 && kind == Kind::Interval => {
-                e.uses_interval = true;
-                quote!(Interval::ZERO)
-            }
-            _ => e.operand(r),
-        };
-        let k = int(k);
-        body.extend(quote!(out[#k] = #value;));
+        body.extend(output(&mut e, k, r, fill));
     }
 
-    let name_for = |used: bool, name: &str| {
-        if used {
-            format_ident!("{}", name)
-        } else {
-            format_ident!("_{}", name)
-        }
-    };
-    let x = name_for(e.uses_x, "x");
-    let u = name_for(e.uses_u, "u");
-    let t = name_for(e.uses_t, "t");
-    let out = name_for(!roots.is_empty(), "out");
-    let (fn_name, scalar) = match kind {
-        Kind::F64 => (format_ident!("{}", method), quote!(f64)),
-        Kind::Interval => (
-            format_ident!("{}_interval", method),
-            quote!(reachc_runtime::Interval),
-        ),
-    };
-    let use_interval = if e.uses_interval {
-        quote!(
-            use reachc_runtime::Interval;
-        )
-    } else {
-        TokenStream::new()
-    };
-    let u_param = if with_u {
+    let x = param_name(e.x_len > 0, "x");
+    let u = param_name(e.u_len > 0, "u");
+    let t = param_name(e.uses_t, "t");
+    let out = param_name(!roots.is_empty(), "out");
+    let (fn_name, scalar) = (def.fn_name(), def.scalar());
+    let use_interval = e.use_interval();
+    let u_param = if def.with_u {
         quote!(#u: &[#scalar],)
     } else {
         TokenStream::new()
     };
-    quote! {
+    let method = quote! {
         fn #fn_name(&self, #x: &[#scalar], #u_param #t: #scalar, #out: &mut [#scalar]) {
             #use_interval
             #body
         }
+    };
+    (method, TokenStream::new())
+}
+
+/// One step of a chunked method: a node's `let` or the assignment of output `k`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Step {
+    Let(ExprId),
+    Out(usize),
+}
+
+/// The steps of a chunked method: for each output in turn, the nodes it needs that are not
+/// computed yet (depth first, operands in order), then its assignment; zeros written by
+/// `out.fill` are left out. A topological order in which a node is computed close to where it
+/// is read, so few values cross from one chunk to another.
+fn steps(pool: &Pool, roots: &[ExprId], fill: bool) -> Vec<Step> {
+    let mut seen = vec![false; pool.len()];
+    let mut steps = Vec::new();
+    // (node, its operands, how many of them were visited)
+    let mut stack: Vec<(ExprId, Vec<ExprId>, usize)> = Vec::new();
+    for (k, &r) in roots.iter().enumerate() {
+        if fill && pool.as_const(r) == Some(0.0) {
+            continue;
+        }
+        if !is_leaf(pool, r) && !seen[r.index()] {
+            seen[r.index()] = true;
+            stack.push((r, children(pool.node(r)), 0));
+            while let Some((id, operands, next)) = stack.last_mut() {
+                if let Some(&c) = operands.get(*next) {
+                    *next += 1;
+                    if !is_leaf(pool, c) && !seen[c.index()] {
+                        seen[c.index()] = true;
+                        stack.push((c, children(pool.node(c)), 0));
+                    }
+                } else {
+                    steps.push(Step::Let(*id));
+                    stack.pop();
+                }
+            }
+        }
+        steps.push(Step::Out(k));
     }
+    steps
+}
+
+/// Scratch arrays of up to this many values live on the stack (64 KiB of intervals); longer
+/// ones are allocated.
+const STACK_SCRATCH: usize = 4096;
+
+/// `let mut NAME = [zero; len];`, or a `Vec` when longer than [`STACK_SCRATCH`].
+fn scratch_array(name: &str, zero: &TokenStream, len: usize) -> TokenStream {
+    let (name, n) = (format_ident!("{name}"), int(len));
+    if len <= STACK_SCRATCH {
+        quote!(let mut #name = [#zero; #n];)
+    } else {
+        quote! {
+            #[allow(clippy::useless_vec)]
+            let mut #name = vec![#zero; #n];
+        }
+    }
+}
+
+/// The helper functions of a chunked method are grouped in modules of this many: rustc compiles
+/// each module as its own codegen unit, in parallel.
+const PARTS_PER_MODULE: usize = 8;
+
+/// A method too large for one function (rustc's optimiser is superlinear in the size of a
+/// function: a 1000-state chain did not compile in 16 minutes): its [`steps`] are cut into
+/// chunks of cost at most `chunk_size` (see [`node_cost`]), each an `#[inline(never)]` function
+/// `NAME_partK`, called in order by the method. The functions are grouped in private modules
+/// `OWNER_NAME_G` (the owner's type name in lowercase), [`PARTS_PER_MODULE`] to a module. A
+/// value computed in one chunk and read in later ones goes through a scratch array `s` the
+/// method owns (a slot is reused once its last reader has loaded it). Every node is still
+/// computed by [`Emitter::node_expr`], so results stay bit-identical to the single-function
+/// form.
+fn chunked_method(
+    pool: &Pool,
+    tables: &mut Tables,
+    def: &MethodDef,
+    fill: bool,
+    chunk_size: usize,
+) -> (TokenStream, TokenStream) {
+    let mut chunks: Vec<Vec<Step>> = Vec::new();
+    let mut current: Vec<Step> = Vec::new();
+    let mut cost = 0;
+    for step in steps(pool, def.roots, fill) {
+        let c = match step {
+            Step::Let(id) => node_cost(pool, id),
+            Step::Out(_) => 1,
+        };
+        if cost + c > chunk_size && !current.is_empty() {
+            chunks.push(std::mem::take(&mut current));
+            cost = 0;
+        }
+        current.push(step);
+        cost += c;
+    }
+    if !current.is_empty() {
+        chunks.push(current);
+    }
+
+    // Where each value is computed, which earlier values each chunk reads, and the last chunk
+    // reading each value that crosses chunks.
+    let mut defined: BTreeMap<ExprId, usize> = BTreeMap::new();
+    let mut imports: Vec<BTreeSet<ExprId>> = vec![BTreeSet::new(); chunks.len()];
+    let mut last_read: BTreeMap<ExprId, usize> = BTreeMap::new();
+    for (c, chunk) in chunks.iter().enumerate() {
+        for &step in chunk {
+            let reads = match step {
+                Step::Let(id) => {
+                    defined.insert(id, c);
+                    children(pool.node(id))
+                }
+                Step::Out(k) => vec![def.roots[k]],
+            };
+            for r in reads {
+                if let Some(&d) = defined.get(&r).filter(|&&d| d != c) {
+                    debug_assert!(d < c, "steps are topologically ordered");
+                    imports[c].insert(r);
+                    last_read.insert(r, c);
+                }
+            }
+        }
+    }
+    let mut slots: BTreeMap<ExprId, usize> = BTreeMap::new();
+    let mut free: Vec<usize> = Vec::new();
+    let mut len = 0;
+    for (c, chunk) in chunks.iter().enumerate() {
+        // Loads come first in a chunk, so a slot read for the last time is free for the
+        // chunk's own stores.
+        free.extend(
+            imports[c]
+                .iter()
+                .filter(|id| last_read[id] == c)
+                .map(|id| slots[id]),
+        );
+        for &step in chunk {
+            if let Step::Let(id) = step {
+                if last_read.contains_key(&id) {
+                    let slot = free.pop().unwrap_or_else(|| {
+                        len += 1;
+                        len - 1
+                    });
+                    slots.insert(id, slot);
+                }
+            }
+        }
+    }
+
+    let (fn_name, scalar) = (def.fn_name(), def.scalar());
+    let owner = def.owner.to_string().to_ascii_lowercase();
+    let (mut uses_x, mut uses_u, mut uses_t) = (false, false, false);
+    let mut helpers = TokenStream::new();
+    let mut module = TokenStream::new();
+    let mut calls = TokenStream::new();
+    for (c, chunk) in chunks.iter().enumerate() {
+        let mut e = Emitter::new(pool, def.kind);
+        e.top = quote!(super::);
+        let mut body = TokenStream::new();
+        // One past the largest index of `s` and of `out` used.
+        let (mut s_len, mut out_len) = (0, 0);
+        for id in &imports[c] {
+            s_len = s_len.max(slots[id] + 1);
+            let (v, slot) = (value_ident(*id), int(slots[id]));
+            body.extend(quote!(let #v = s[#slot];));
+        }
+        let mut stores = false;
+        for &step in chunk {
+            match step {
+                Step::Let(id) => {
+                    let v = value_ident(id);
+                    let expr = e.node_expr(id, tables);
+                    body.extend(quote!(let #v = #expr;));
+                    if let Some(&slot) = slots.get(&id) {
+                        s_len = s_len.max(slot + 1);
+                        let slot = int(slot);
+                        body.extend(quote!(s[#slot] = #v;));
+                        stores = true;
+                    }
+                }
+                Step::Out(k) => {
+                    body.extend(output(&mut e, k, def.roots[k], fill));
+                    out_len = k + 1;
+                }
+            }
+        }
+        uses_x |= e.x_len > 0;
+        uses_u |= e.u_len > 0;
+        uses_t |= e.uses_t;
+        // Parameters, and each slice cut to the prefix the chunk indexes, so that the bounds
+        // checks of its constant indices fold into one per slice.
+        let (mut params, mut args, mut prefixes) =
+            (TokenStream::new(), TokenStream::new(), TokenStream::new());
+        if e.uses_t {
+            params.extend(quote!(t: #scalar,));
+            args.extend(quote!(t,));
+        }
+        // `arg` passes the slice: `x`, `out` (the method's parameters) or `&mut s` (its array).
+        let mut slice = |name: &str, len: usize, mutable: bool, arg: TokenStream| {
+            if len == 0 {
+                return;
+            }
+            let (ident, len) = (format_ident!("{name}"), int(len));
+            args.extend(quote!(#arg,));
+            if mutable {
+                params.extend(quote!(#ident: &mut [#scalar],));
+                prefixes.extend(quote!(let #ident = &mut #ident[..#len];));
+            } else {
+                params.extend(quote!(#ident: &[#scalar],));
+                prefixes.extend(quote!(let #ident = &#ident[..#len];));
+            }
+        };
+        slice("x", e.x_len, false, quote!(x));
+        slice("u", e.u_len, false, quote!(u));
+        let s_arg = if stores { quote!(&mut s) } else { quote!(&s) };
+        slice("s", s_len, stores, s_arg);
+        slice("out", out_len, true, quote!(out));
+        let part = format_ident!("{fn_name}_part{c}");
+        let doc = format!(" Part {} of {} of `{fn_name}`.", c + 1, chunks.len());
+        let use_interval = e.use_interval();
+        module.extend(quote! {
+            #[doc = #doc]
+            #[inline(never)]
+            pub(super) fn #part(#params) {
+                #use_interval
+                #prefixes
+                #body
+            }
+        });
+        let group = c / PARTS_PER_MODULE;
+        let module_name = format_ident!("{owner}_{fn_name}_{group}");
+        calls.extend(quote!(#module_name::#part(#args);));
+        if (c + 1) % PARTS_PER_MODULE == 0 || c + 1 == chunks.len() {
+            let doc = format!(" Helpers of `{}::{fn_name}` (group {group}).", def.owner);
+            let lints = allow_lints();
+            helpers.extend(quote! {
+                #[doc = #doc]
+                #lints
+                mod #module_name {
+                    #module
+                }
+            });
+            module = TokenStream::new();
+        }
+    }
+
+    let zero = def.zero();
+    let fill = if fill {
+        quote!(out.fill(#zero);)
+    } else {
+        TokenStream::new()
+    };
+    let scratch = match len {
+        0 => TokenStream::new(),
+        len => scratch_array("s", &zero, len),
+    };
+    let x = param_name(uses_x, "x");
+    let u = param_name(uses_u, "u");
+    let t = param_name(uses_t, "t");
+    let u_param = if def.with_u {
+        quote!(#u: &[#scalar],)
+    } else {
+        TokenStream::new()
+    };
+    let method = quote! {
+        fn #fn_name(&self, #x: &[#scalar], #u_param #t: #scalar, out: &mut [#scalar]) {
+            #fill
+            #scratch
+            #calls
+        }
+    };
+    (method, helpers)
 }
 
 /// One line of text made safe for a `///` comment: control characters (a bare carriage return
@@ -761,9 +1218,9 @@ fn option<T>(v: &Option<T>, f: impl FnOnce(&T) -> TokenStream) -> TokenStream {
     }
 }
 
-/// Lists of floats longer than this (metrics are n x n) become `static` arrays inside `info()`
-/// instead of temporaries (a million-entry array on the stack would overflow it); mostly-zero
-/// ones are stored as `(index, value)` pairs.
+/// Lists of floats (and of names) longer than this (metrics are n x n) become `static` arrays
+/// inside `info()` instead of temporaries (a million-entry array on the stack would overflow
+/// it); mostly-zero float lists are stored as `(index, value)` pairs.
 const STATIC_FLOATS: usize = 64;
 
 /// Builds the `info()` expression; long float lists go to `statics`.
@@ -776,6 +1233,20 @@ struct InfoWriter {
 }
 
 impl InfoWriter {
+    /// A list of names; longer than [`STATIC_FLOATS`], a `static` array `IDENT` of `&str`
+    /// turned into `String`s (one `String::from` per name in one expression, with its unwinding
+    /// paths, cost rustc's optimiser about 40 s for the 2000 names of specs/chain1000.sde).
+    fn names(&mut self, ident: &str, names: &[String]) -> TokenStream {
+        if names.len() <= STATIC_FLOATS {
+            return list(names.iter().map(|s| string(s)));
+        }
+        let ident = format_ident!("{ident}");
+        let k = int(names.len());
+        self.statics
+            .extend(quote!(static #ident: [&str; #k] = [#(#names),*];));
+        quote!(#ident.iter().map(|&s| String::from(s)).collect())
+    }
+
     fn floats(&mut self, vs: &[f64]) -> TokenStream {
         if vs.len() <= STATIC_FLOATS {
             return list(vs.iter().map(|&v| float(v)));
@@ -962,11 +1433,10 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
     let lints = allow_lints();
     let mut w = InfoWriter::default();
     let name = string(&info.name);
-    let names = |v: &[String]| list(v.iter().map(|s| string(s)));
     let (states, inputs, noises) = (
-        names(&info.states),
-        names(&info.inputs),
-        names(&info.noises),
+        w.names("STATES", &info.states),
+        w.names("INPUTS", &info.inputs),
+        w.names("NOISES", &info.noises),
     );
     let input_box = list(info.input_box.iter().map(|&r| range(r)));
     let initial = w.initial_set(&info.initial);
@@ -1052,6 +1522,168 @@ mod tests {
         assert!(!text.contains('\r') && !text.contains('\u{202E}'));
         let file = syn::parse_file(&text).unwrap();
         assert_eq!(file.items.len(), 1);
+    }
+
+    /// A chain of `n` units as in specs/chain1000.sde, every unit also pulled by one shared
+    /// value `c`, so some values are read by every chunk; prepared.
+    fn big_chain(n: usize) -> (Model, Prepared) {
+        let source = format!(
+            "model big\n\
+             const N = {n}\n\
+             state x[1..N] in [-0.1, 0.1]\n\
+             noise w[1..N]\n\
+             let c = sin(x[1])\n\
+             for i in 1..N-1 {{ let d[i] = tanh(x[i + 1] - x[i]) }}\n\
+             drift {{\n\
+                 x[1]' = -2 * x[1] + d[1] + c\n\
+                 for i in 2..N-1 {{ x[i]' = -2 * x[i] + d[i] - d[i - 1] + c }}\n\
+                 x[N]' = -2 * x[N] - d[N - 1] + c\n\
+             }}\n\
+             diffusion {{ for i in 1..N {{ x[i]: 0.05 * w[i] }} }}\n"
+        );
+        let (model, diagnostics) = crate::driver::check_source(&source, std::path::Path::new("."));
+        let mut model = model.unwrap_or_else(|| panic!("{diagnostics:?}"));
+        let prepared = crate::backend::prepare(&mut model);
+        (model, prepared)
+    }
+
+    /// The functions of a generated file (methods, and helpers in modules): name and statement
+    /// count.
+    fn functions(code: &str) -> Vec<(String, usize)> {
+        fn walk(items: &[syn::Item], out: &mut Vec<(String, usize)>) {
+            for item in items {
+                match item {
+                    syn::Item::Impl(i) => {
+                        for f in &i.items {
+                            if let syn::ImplItem::Fn(f) = f {
+                                out.push((f.sig.ident.to_string(), f.block.stmts.len()));
+                            }
+                        }
+                    }
+                    syn::Item::Fn(f) => out.push((f.sig.ident.to_string(), f.block.stmts.len())),
+                    syn::Item::Mod(m) => walk(&m.content.as_ref().unwrap().1, out),
+                    _ => {}
+                }
+            }
+        }
+        let mut out = Vec::new();
+        walk(&syn::parse_file(code).unwrap().items, &mut out);
+        out
+    }
+
+    #[test]
+    fn large_methods_are_split_into_bounded_functions() {
+        let (model, prepared) = big_chain(600);
+        let small = Options {
+            split_above: 40,
+            chunk_size: 40,
+        };
+        for options in [Options::default(), small] {
+            let chunk_size = options.chunk_size;
+            let code = generate_with(&model, &prepared, &options);
+            let fns = functions(&code);
+            let methods = [
+                "drift",
+                "drift_interval",
+                "jac_x",
+                "jac_x_sparse_interval",
+                "diffusion",
+                "diffusion_interval",
+            ];
+            for name in methods {
+                let parts = fns
+                    .iter()
+                    .filter(|(f, _)| f.starts_with(&format!("{name}_part")))
+                    .count();
+                assert!(parts >= 2, "{name} in {parts} parts at {chunk_size}");
+                // The method only calls its parts (after out.fill and the scratch array).
+                let calls = code.matches(&format!("::{name}_part")).count();
+                assert_eq!(calls, parts, "{name}");
+                let stmts = fns.iter().find(|(f, _)| *f == name).unwrap().1;
+                assert!(stmts <= parts + 2, "{name}: {stmts} statements");
+            }
+            // The dense interval Jacobian is scattered from the sparse one.
+            assert!(code.contains("self.jac_x_sparse_interval(x, u, t, &mut nonzeros);"));
+            assert!(!fns
+                .iter()
+                .any(|(f, _)| f.starts_with("jac_x_interval_part")));
+            // Each part: at most `chunk_size` steps (lets and outputs, each costing at least 1),
+            // as many loads and stores, and a few slice prefixes.
+            for (name, stmts) in fns.iter().filter(|(f, _)| f.contains("_part")) {
+                assert!(*stmts <= 3 * chunk_size + 5, "{name}: {stmts} statements");
+            }
+            assert!(code.contains("#[inline(never)]"));
+            // Grouped in modules (codegen units).
+            let groups = code.matches("mod big_drift_interval_").count();
+            let parts = fns
+                .iter()
+                .filter(|(f, _)| f.starts_with("drift_interval_part"));
+            assert_eq!(groups, parts.count().div_ceil(PARTS_PER_MODULE));
+            // Depth-first order keeps few values live across chunks (`c`, a neighbour's
+            // coupling), and slots are reused: the scratch arrays stay tiny.
+            for len in code.split("let mut s = [").skip(1) {
+                let len: usize = len
+                    .split(';')
+                    .nth(1)
+                    .and_then(|l| l.split(']').next())
+                    .and_then(|l| l.trim().parse().ok())
+                    .unwrap();
+                assert!(len <= 4, "scratch of {len} at {chunk_size}");
+            }
+        }
+        // A small model stays one function per method (at the default options).
+        let (model, prepared) = big_chain(30);
+        let code = generate(&model, &prepared);
+        assert!(!code.contains("_part0"), "{code}");
+        assert!(functions(&code)
+            .iter()
+            .all(|(name, _)| !name.contains("_part")));
+    }
+
+    #[test]
+    fn chunk_steps_are_topological_and_complete() {
+        let (model, prepared) = big_chain(50);
+        let pool = &model.pool;
+        let roots: Vec<ExprId> = prepared
+            .derivatives
+            .jac_x
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        let steps = steps(pool, &roots, true);
+        let mut done = vec![false; pool.len()];
+        let mut outputs = Vec::new();
+        for step in &steps {
+            match *step {
+                Step::Let(id) => {
+                    assert!(!done[id.index()], "{id:?} computed twice");
+                    for c in children(pool.node(id)) {
+                        assert!(is_leaf(pool, c) || done[c.index()], "{c:?} before {id:?}");
+                    }
+                    done[id.index()] = true;
+                }
+                Step::Out(k) => {
+                    let r = roots[k];
+                    assert!(is_leaf(pool, r) || done[r.index()]);
+                    outputs.push(k);
+                }
+            }
+        }
+        // Every output but the zeros (written by `out.fill`), in order.
+        let nonzero: Vec<usize> = (0..roots.len())
+            .filter(|&k| pool.as_const(roots[k]) != Some(0.0))
+            .collect();
+        assert_eq!(outputs, nonzero);
+        let live: Vec<ExprId> = roots
+            .iter()
+            .copied()
+            .filter(|&r| !is_leaf(pool, r))
+            .collect();
+        let needed = pool.reachable(&live);
+        assert!(needed
+            .iter()
+            .all(|&id| is_leaf(pool, id) || done[id.index()]));
     }
 
     #[test]

@@ -56,6 +56,8 @@ pub struct CrateOptions {
     pub runtime: Option<PathBuf>,
     /// The spec as named in the README (e.g. `specs/pendulum.sde`); the model name if `None`.
     pub spec_label: Option<String>,
+    /// How `src/lib.rs` is generated (how large methods are split).
+    pub codegen: codegen::Options,
 }
 
 /// The files of a generated crate, in memory: `(path relative to the crate root, contents)`,
@@ -202,7 +204,7 @@ pub fn generate_files(
         .spec_label
         .clone()
         .unwrap_or_else(|| format!("model `{}`", model.name));
-    let lib = codegen::generate(model, &prepared);
+    let lib = codegen::generate_with(model, &prepared, &options.codegen);
     let main = codegen::main_rs(&crate_ident, &type_name);
     let analyses: Vec<&str> = prepared
         .info

@@ -62,7 +62,7 @@ impl InputSchedule {
     /// Sets `u` for the Euler step starting at `t` (models with inputs only). `interval` is the
     /// path's current hold interval (start a path with `None`); the input is redrawn when it
     /// changes.
-    #[inline]
+    #[inline(always)] // keeps the path's stream in registers in the caller's loop
     pub(crate) fn update(
         &self,
         t: f64,

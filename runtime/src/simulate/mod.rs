@@ -37,7 +37,7 @@ pub use sample::{sample_paths, MAX_SAMPLE_PATHS};
 
 use crate::engine::AnalysisResult;
 use crate::system::{ModelInfo, System, UnsafeShape};
-use paths::{ChunkStats, Plan};
+use paths::{ChunkStats, Plan, Span};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -148,7 +148,10 @@ pub fn simulate<S: System + Sync + ?Sized>(
     let mut total = ChunkStats::new(steps, plan.unsafe_sets.len());
     let mut done = 0;
     while done < n_paths {
-        let end = (done + batch).min(n_paths);
+        // Small batches first: the thresholds are -inf until a step has `j` values, and every
+        // path-step is a candidate until then; doubling keeps the number of batches
+        // logarithmic.
+        let end = (done + done.clamp(4 * CHUNK, batch)).min(n_paths);
         let thresholds = topk.thresholds().to_vec();
         let chunks: Vec<(u64, u64)> = (done..end)
             .step_by(CHUNK as usize)
@@ -170,6 +173,7 @@ pub fn simulate<S: System + Sync + ?Sized>(
                 topk.push(k as usize, d);
             }
         }
+        topk.tighten();
         done = end;
         progress(done, n_paths);
     }
@@ -231,16 +235,16 @@ fn make_plan<'a, S: System + ?Sized>(
         return invalid(format!("the input box [{lo}, {hi}] is not bounded"));
     }
     let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
-    let mut substeps = Vec::with_capacity(times.len().saturating_sub(1));
+    let mut spans = Vec::with_capacity(times.len().saturating_sub(1));
     for w in times.windows(2) {
         // The slack keeps a step of exactly dt (up to rounding) from being split in two.
         let s = ((w[1] - w[0]) / dt * (1.0 - 1e-12)).ceil().max(1.0);
         if s.is_nan() || s > 1e9 {
             return usage(format!("dt = {dt} gives too many Euler steps"));
         }
-        substeps.push(s as u32);
+        spans.push(Span::new(w[0], w[1], s as u32));
     }
-    let per_path: u64 = substeps.iter().map(|&s| u64::from(s)).sum();
+    let per_path: u64 = spans.iter().map(|s| u64::from(s.steps)).sum();
     // Draws per Euler step: m normals (about 1% need a second draw), p inputs at most.
     if per_path.saturating_mul(2 * (m + p + 1) as u64) >= rng::DRAWS_PER_PATH {
         return usage(format!(
@@ -265,7 +269,7 @@ fn make_plan<'a, S: System + ?Sized>(
     Ok(Plan {
         sys,
         seed: opts.seed,
-        substeps,
+        spans,
         nominal,
         membership: prs::Membership::new(result, &metric),
         metric,
@@ -277,6 +281,7 @@ fn make_plan<'a, S: System + ?Sized>(
             .has_domain
             .then(|| regions::Region::domain(&info.domain)),
         zig: normal::Ziggurat::get(),
+        avx2: has_avx2(),
         times,
     })
 }
@@ -353,12 +358,7 @@ fn report<S: System + ?Sized>(
             hold.unwrap_or(result.step)
         ),
     };
-    let dt = plan
-        .times
-        .windows(2)
-        .zip(&plan.substeps)
-        .map(|(w, &s)| (w[1] - w[0]) / f64::from(s))
-        .fold(0.0, f64::max);
+    let dt = plan.spans.iter().map(|s| s.h).fold(0.0, f64::max);
     SimReport {
         model: result.model.clone(),
         analysis: result.analysis.clone(),
@@ -419,5 +419,160 @@ fn report<S: System + ?Sized>(
             worst_outside,
             worst_cp_lower,
         },
+    }
+}
+
+/// Whether the processor has AVX2, BMI1 and BMI2 (see `Plan::avx2`).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::is_x86_feature_detected as has;
+        has!("avx2") && has!("bmi1") && has!("bmi2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine;
+    use crate::interval::Interval;
+    use crate::system::*;
+
+    /// `dx = (-x + b u) dt + 0.3 dW` per state, two states and one input (unused if `b = 0`).
+    struct Sys {
+        b: f64,
+    }
+
+    impl System for Sys {
+        fn n(&self) -> usize {
+            2
+        }
+        fn p(&self) -> usize {
+            usize::from(self.b != 0.0)
+        }
+        fn m(&self) -> usize {
+            2
+        }
+        fn drift(&self, x: &[f64], u: &[f64], _t: f64, out: &mut [f64]) {
+            for i in 0..2 {
+                out[i] = -x[i] + u.first().map_or(0.0, |u| self.b * u);
+            }
+        }
+        fn drift_interval(&self, x: &[Interval], u: &[Interval], _t: Interval, o: &mut [Interval]) {
+            for i in 0..2 {
+                o[i] = -x[i]
+                    + u.first()
+                        .map_or(Interval::ZERO, |&u| Interval::point(self.b) * u);
+            }
+        }
+        fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+            out.copy_from_slice(&[-1.0, 0.0, 0.0, -1.0]);
+        }
+        fn jac_x_interval(
+            &self,
+            _x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            o: &mut [Interval],
+        ) {
+            for (o, v) in o.iter_mut().zip([-1.0, 0.0, 0.0, -1.0]) {
+                *o = Interval::point(v);
+            }
+        }
+        fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+            out.fill(self.b);
+        }
+        fn jac_u_interval(
+            &self,
+            _x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            o: &mut [Interval],
+        ) {
+            o.fill(Interval::point(self.b));
+        }
+        fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
+            out.copy_from_slice(&[0.3, 0.0, 0.0, 0.3]);
+        }
+        fn diffusion_interval(&self, _x: &[Interval], _t: Interval, o: &mut [Interval]) {
+            for (o, v) in o.iter_mut().zip([0.3, 0.0, 0.0, 0.3]) {
+                *o = Interval::point(v);
+            }
+        }
+    }
+
+    /// With `b != 0`: an input in `[-0.5, 0.5]` and an unsafe half-space `x1 >= 0.4`.
+    fn info(b: f64) -> ModelInfo {
+        let inputs = b != 0.0;
+        ModelInfo {
+            name: "m".into(),
+            states: vec!["x1".into(), "x2".into()],
+            inputs: if inputs { vec!["u".into()] } else { vec![] },
+            noises: vec!["w1".into(), "w2".into()],
+            input_box: if inputs { vec![(-0.5, 0.5)] } else { vec![] },
+            initial: InitialSet {
+                boxes: vec![Some((0.1, 0.3)), Some((-0.1, 0.1))],
+                balls: vec![],
+            },
+            domain: vec![(f64::NEG_INFINITY, f64::INFINITY); 2],
+            has_domain: false,
+            unsafe_sets: if inputs {
+                vec![UnsafeSet {
+                    name: "far".into(),
+                    shape: UnsafeShape::HalfSpace {
+                        normal: vec![1.0, 0.0],
+                        offset: 0.4,
+                    },
+                }]
+            } else {
+                vec![]
+            },
+            analyses: vec![Analysis {
+                name: "a".into(),
+                method: Method::Contraction,
+                delta: 0.05,
+                horizon: 0.5,
+                step: 0.01,
+                radius: RadiusRule::Amgf,
+                rate: Rate::Certified,
+                integrator: Integrator::Rk4,
+                inclusion: Inclusion::Jacobian,
+                outputs: vec![],
+                transform: None,
+                constants: Some(Constants {
+                    metric: vec![1.0, 0.0, 0.0, 1.0],
+                    c: -1.0,
+                    sigma: 0.3,
+                    // |(b u, b u)| <= sqrt(2) |b| / 2 over the input box.
+                    rho: b.abs(),
+                    how: "exact".into(),
+                }),
+                constants_error: None,
+            }],
+        }
+    }
+
+    /// The loops compiled for AVX2 and BMI2 (when the processor has them) and the
+    /// baseline loops give the same statistics, in the fast loop for additive noise (`b = 0`)
+    /// and in the general one (an input, an unsafe set, Euler steps finer than the report step).
+    #[test]
+    fn the_extensions_do_not_change_the_paths() {
+        for b in [0.0, 1.0] {
+            let (sys, info) = (Sys { b }, info(b));
+            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let opts = Options {
+                dt: Some(0.004),
+                ..Options::default()
+            };
+            let mut plan = make_plan(&sys, &info, &r, &opts).unwrap();
+            let thresholds = vec![f64::NEG_INFINITY; plan.times.len()];
+            let detected = plan.run_chunk(0..300, &thresholds);
+            plan.avx2 = false;
+            let baseline = plan.run_chunk(0..300, &thresholds);
+            assert_eq!(detected, baseline, "b = {b}");
+            assert_eq!(baseline.candidates.len(), 300 * plan.times.len());
+        }
     }
 }

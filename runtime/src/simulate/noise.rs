@@ -7,8 +7,6 @@
 //! (additive noise) and evaluated once instead of at every step. Both facts are proven by the
 //! enclosure, not guessed from samples, so the simulated increments are those of the model.
 
-use super::normal::Ziggurat;
-use super::rng::PathRng;
 use crate::interval::Interval;
 use crate::system::System;
 
@@ -94,42 +92,45 @@ impl Noise {
         }
     }
 
-    /// Whether `G` is evaluated at every step (then [`step`](Self::step) needs `g` of n x m).
+    /// Whether `G` is evaluated at every step (then [`apply`](Self::apply) needs `g` of n x m).
     pub(crate) fn needs_matrix(&self) -> bool {
         !self.constant
     }
 
-    /// The Euler-Maruyama update `x += f h + G(x, t) sqrt(h) z`, `z` standard normal (`m`
-    /// draws, in channel order), given the drift `f` at `x`. `z` has length `m`; `g` is
-    /// scratch of `n * m` when [`needs_matrix`](Self::needs_matrix).
+    /// The diagonal of a constant diagonal `G` (then `m == n` and state `i` gets channel `i`).
+    pub(crate) fn diagonal(&self) -> Option<&[f64]> {
+        self.diagonal.as_deref()
+    }
+
+    /// The Euler-Maruyama update `x += f h + G(x, t) sqrt(h) z` given the drift `f` at `x` and
+    /// `m` standard normal draws `z` (in channel order). `z` is overwritten (scaled by
+    /// `sqrt_h = sqrt(h)`); `g` is scratch of `n * m` when [`needs_matrix`](Self::needs_matrix).
     ///
     /// Every loop reads `f` and writes `x` one element at a time, fused row by row: the drift
     /// was just stored element by element, and a vector load of those fresh stores would stall
     /// on store forwarding (measured: a quarter of the step time for n = 2).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)] // all scratch and state of the hot loop, no allocation
-    pub(crate) fn step<S: System + ?Sized>(
+    pub(crate) fn apply<S: System + ?Sized>(
         &self,
         sys: &S,
         x: &mut [f64],
         f: &[f64],
         t: f64,
         h: f64,
-        zig: &Ziggurat,
-        rng: &mut PathRng,
+        sqrt_h: f64,
         z: &mut [f64],
         g: &mut [f64],
     ) {
-        let sqrt_h = h.sqrt();
         if let Some(d) = &self.diagonal {
-            let (d, f) = (&d[..x.len()], &f[..x.len()]);
+            let (d, f, z) = (&d[..x.len()], &f[..x.len()], &z[..x.len()]);
             for i in 0..x.len() {
-                x[i] += f[i] * h + d[i] * sqrt_h * zig.sample(rng);
+                x[i] += f[i] * h + d[i] * sqrt_h * z[i];
             }
             return;
         }
         for zj in z.iter_mut().take(self.m) {
-            *zj = zig.sample(rng) * sqrt_h;
+            *zj *= sqrt_h;
         }
         if !self.constant {
             sys.diffusion(x, t, g);

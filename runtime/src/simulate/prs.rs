@@ -5,16 +5,19 @@
 //! shortcuts answer the clear cases first, each only where it provably agrees with `contains`:
 //!
 //! * outside: `|x - x*_t|_P` clearly above the PRS radius. For the shapes whose PRS lies in the
-//!   P-ball `B_P(x*_t, prs_radius)` (`"p_ball"`, and `"box"` with `x*_t` its centre), a point
-//!   outside that ball is outside the PRS;
+//!   P-ball `B_P(x*_t, prs_radius)` (`"p_ball"`, and `"box"` and `"parallelotope"` with `x*_t`
+//!   the centre of the box or of the parallelotope's hull), a point outside that ball is
+//!   outside the PRS;
 //! * inside: for `"p_ball"`, `|x - x*_t|_P` clearly below the radius; for `"box"`, `x` in the
-//!   box (a subset of the PRS `box (+) B_P(r_t)`).
+//!   box (a subset of the PRS `box (+) B_P(r_t)`); for `"parallelotope"`, `T x` clearly in the
+//!   box `[lo, hi]` of `y = T x` (where `contains` also answers at once).
 //!
 //! "Clearly" means by more than a bound on the rounding errors of both computations:
 //! `|q_computed - q| <= gamma * sum |w_ij d_i d_j|` with `gamma` a generous multiple of the unit
-//! roundoff times the number of terms. Points in that band, and every point for other shapes,
-//! go to `contains`.
+//! roundoff times the number of terms, and likewise for `T x`. Points in those bands, and every
+//! point for other shapes, go to `contains`.
 
+use super::paths::SMALL;
 use crate::engine::{self, AnalysisResult};
 
 /// The quadratic form `d' P d` as a list of terms.
@@ -63,17 +66,30 @@ impl Metric {
         }
     }
 
+    /// The diagonal `w` of `P` when `P` is diagonal and non-negative: then
+    /// [`quad`](Self::quad) returns `(q, q)` with `q = diag_quad(w, x, c)`, which callers may
+    /// compute themselves, to the same bits.
+    pub(crate) fn nonneg_diagonal(&self) -> Option<&[f64]> {
+        self.nonneg.then_some(&self.diag[..])
+    }
+
+    /// The terms as a dense upper triangle for models with at most [`SMALL`] states: `w[i *
+    /// SMALL + j]` for `i <= j`, zero for the dropped terms (see [`quad_small`]).
+    pub(crate) fn upper(&self) -> [f64; SMALL * SMALL] {
+        let mut w = [0.0; SMALL * SMALL];
+        for &(i, j, v) in &self.terms {
+            if i < SMALL && j < SMALL {
+                w[i * SMALL + j] = v;
+            }
+        }
+        w
+    }
+
     /// `(q, a)`: `q = (x - c)' P (x - c)` and `a = sum |w_ij d_i d_j|` (for the error bound).
     #[inline(always)]
     pub(crate) fn quad(&self, x: &[f64], c: &[f64]) -> (f64, f64) {
         if self.nonneg {
-            // By state (not by term) so that a constant dimension unrolls the loop.
-            let (w, c) = (&self.diag[..x.len()], &c[..x.len()]);
-            let mut q = 0.0;
-            for i in 0..x.len() {
-                let d = x[i] - c[i];
-                q += w[i] * d * d;
-            }
+            let q = diag_quad(&self.diag, x, c);
             return (q, q);
         }
         let (mut q, mut a) = (0.0, 0.0);
@@ -86,12 +102,54 @@ impl Metric {
     }
 }
 
+/// `sum_i w_i (x_i - c_i)^2` over the states of `x` in order, starting from the first term:
+/// [`Metric::quad`] with a non-negative diagonal metric `w` (by state rather than by term, so
+/// that a constant dimension unrolls the loop).
+#[inline(always)]
+pub(crate) fn diag_quad(w: &[f64], x: &[f64], c: &[f64]) -> f64 {
+    let (w, c) = (&w[..x.len()], &c[..x.len()]);
+    (0..x.len())
+        .map(|i| {
+            let d = x[i] - c[i];
+            w[i] * d * d
+        })
+        .reduce(|q, t| q + t)
+        .unwrap_or(0.0)
+}
+
+/// [`Metric::quad`] for at most [`SMALL`] states (`x.len()`), with `w` from [`Metric::upper`]:
+/// the same terms in the same order, plus the zero ones, which add `+-0` to finite sums (and
+/// cannot make a non-finite sum finite), so `(q, a)` is `quad`'s to the bit when finite and
+/// non-finite when it is. Fixed-size weights let a small model's loops unroll.
+#[inline(always)]
+pub(crate) fn quad_small(w: &[f64; SMALL * SMALL], x: &[f64], c: &[f64]) -> (f64, f64) {
+    let n = x.len().min(SMALL);
+    let (x, c) = (&x[..n], &c[..n]);
+    let (mut q, mut a) = (0.0, 0.0);
+    for i in 0..n {
+        let di = x[i] - c[i];
+        for j in i..n {
+            let t = w[i * SMALL + j] * di * (x[j] - c[j]);
+            q += t;
+            a += t.abs();
+        }
+    }
+    (q, a)
+}
+
 /// The PRS shapes the shortcuts know.
 #[derive(Clone, Debug)]
 enum Shape {
     PBall,
     /// Per report step, the box's corners (flat, n per step).
     Box {
+        lo: Vec<f64>,
+        hi: Vec<f64>,
+    },
+    /// `{x : lo <= T x <= hi}`: `T` (n x n, row-major) and, per report step, the corners of the
+    /// box in `y = T x` (flat, n per step).
+    Parallelotope {
+        t: Vec<f64>,
         lo: Vec<f64>,
         hi: Vec<f64>,
     },
@@ -118,20 +176,34 @@ impl<'a> Membership<'a> {
     /// For `result` (its steps), with `metric` built from its metric.
     pub(crate) fn new(result: &'a AnalysisResult, metric: &Metric) -> Self {
         let n = result.states.len();
-        let shape = match result.steps.first().map(|s| s.det_set.shape) {
-            Some("p_ball") if result.steps.iter().all(|s| s.det_set.lo.is_none()) => Shape::PBall,
-            Some("box") => {
-                let corners = |f: fn(&engine::DetSet) -> &Option<Vec<f64>>| {
-                    result
-                        .steps
-                        .iter()
-                        .map(|s| f(&s.det_set).as_ref().filter(|v| v.len() == n))
-                        .collect::<Option<Vec<_>>>()
-                        .map(|v| v.into_iter().flatten().copied().collect::<Vec<f64>>())
-                };
-                match (corners(|d| &d.lo), corners(|d| &d.hi)) {
-                    (Some(lo), Some(hi)) => Shape::Box { lo, hi },
-                    _ => Shape::Other,
+        let corners = |f: fn(&engine::DetSet) -> &Option<Vec<f64>>| {
+            result
+                .steps
+                .iter()
+                .map(|s| f(&s.det_set).as_ref().filter(|v| v.len() == n))
+                .collect::<Option<Vec<_>>>()
+                .map(|v| v.into_iter().flatten().copied().collect::<Vec<f64>>())
+        };
+        let shapes = |name| result.steps.iter().all(|s| s.det_set.shape == name);
+        let transform = result
+            .transform
+            .as_ref()
+            .filter(|tr| n > 0 && tr.matrix.len() == n && tr.matrix.iter().all(|r| r.len() == n));
+        let shape = match (corners(|d| &d.lo), corners(|d| &d.hi)) {
+            _ if shapes("p_ball") && result.steps.iter().all(|s| s.det_set.lo.is_none()) => {
+                Shape::PBall
+            }
+            (Some(lo), Some(hi)) if shapes("box") && result.transform.is_none() => {
+                Shape::Box { lo, hi }
+            }
+            (Some(lo), Some(hi)) if shapes("parallelotope") && transform.is_some() => {
+                Shape::Parallelotope {
+                    t: transform
+                        .into_iter()
+                        .flat_map(|tr| tr.matrix.iter().flatten().copied())
+                        .collect(),
+                    lo,
+                    hi,
                 }
             }
             _ => Shape::Other,
@@ -163,9 +235,94 @@ impl<'a> Membership<'a> {
         }
     }
 
+    /// `Some(b)`: a squared distance `q < b` (from [`Metric::quad`]) means `x` is in the PRS of
+    /// step `k`, found with one comparison (what [`inside`](Self::inside) answers). `None` when
+    /// no such bound holds (shapes other than the P-ball, metrics with off-diagonal or negative
+    /// terms: see [`inside_by_shortcut`](Self::inside_by_shortcut)).
+    pub(crate) fn inside_below(&self, k: usize) -> Option<f64> {
+        match self.shape {
+            Shape::PBall if self.nonneg => Some(self.q_in[k]),
+            _ => None,
+        }
+    }
+
+    /// Whether [`inside_by_shortcut`](Self::inside_by_shortcut) can ever answer `true`.
+    pub(crate) fn has_shortcuts(&self) -> bool {
+        !matches!(self.shape, Shape::Other)
+    }
+
+    /// `(clearly outside, clearly inside)` the P-ball of step `k` (see the module's notes).
+    #[inline(always)]
+    fn clearly(&self, metric: &Metric, k: usize, q: f64, a: f64) -> (bool, bool) {
+        if self.nonneg {
+            (q > self.q_out[k], q < self.q_in[k])
+        } else {
+            let (r2, err) = (
+                self.r2[k],
+                metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k],
+            );
+            (q - err > r2, q + err < r2)
+        }
+    }
+
+    /// Whether `x` is, by one of the shortcuts alone, in the PRS of step `k` (then
+    /// [`inside`](Self::inside) is `true`; `false` says nothing). Arguments as for `inside`.
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[f64],
+        q: f64,
+        a: f64,
+    ) -> bool {
+        let (clearly_out, clearly_in) = self.clearly(metric, k, q, a);
+        match &self.shape {
+            Shape::PBall => clearly_in,
+            Shape::Box { lo, hi } => !clearly_out && self.in_box(lo, hi, k, x),
+            Shape::Parallelotope { t, lo, hi } => {
+                !clearly_out && self.in_parallelotope(t, lo, hi, k, x)
+            }
+            Shape::Other => false,
+        }
+    }
+
+    /// `T x` clearly in the box `[lo, hi]` of step `k`: then the outward-rounded `T x` that
+    /// `contains` computes is in it too. Both that enclosure and the rounded sum here lie
+    /// within `(5 n + 1) eps s` of the exact `T x` (`s = sum_j |t_ij x_j|`; one ulp per
+    /// operation), so a margin of `16 (n + 2) eps s` covers both and the rounding of the
+    /// comparison itself; the smallest normal number covers the subnormal steps of sums near 0.
+    #[inline(always)]
+    fn in_parallelotope(&self, t: &[f64], lo: &[f64], hi: &[f64], k: usize, x: &[f64]) -> bool {
+        let n = self.n;
+        let (lo, hi, x) = (&lo[k * n..][..n], &hi[k * n..][..n], &x[..n]);
+        let rel = 16.0 * (n as f64 + 2.0) * f64::EPSILON;
+        t.chunks_exact(n)
+            .zip(lo.iter().zip(hi))
+            .all(|(row, (&a, &b))| {
+                let (mut y, mut s) = (0.0, 0.0);
+                for (tij, xj) in row.iter().zip(x) {
+                    let p = tij * xj;
+                    y += p;
+                    s += p.abs();
+                }
+                let margin = rel * s + f64::MIN_POSITIVE;
+                a <= y - margin && y + margin <= b
+            })
+    }
+
+    /// `x` in the box `[lo, hi]` of step `k`.
+    #[inline(always)]
+    fn in_box(&self, lo: &[f64], hi: &[f64], k: usize, x: &[f64]) -> bool {
+        let (lo, hi) = (&lo[k * self.n..][..self.n], &hi[k * self.n..][..self.n]);
+        x.iter()
+            .zip(lo.iter().zip(hi))
+            .all(|(v, (l, h))| l <= v && v <= h)
+    }
+
     /// Whether `x` is in the PRS of step `k`, given the centre `c = x*_k` and
     /// `(q, a) = metric.quad(x, c)`.
-    #[inline(always)]
+    #[inline]
     pub(crate) fn inside(
         &self,
         metric: &Metric,
@@ -175,15 +332,7 @@ impl<'a> Membership<'a> {
         q: f64,
         a: f64,
     ) -> bool {
-        let (clearly_out, clearly_in) = if self.nonneg {
-            (q > self.q_out[k], q < self.q_in[k])
-        } else {
-            let (r2, err) = (
-                self.r2[k],
-                metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k],
-            );
-            (q - err > r2, q + err < r2)
-        };
+        let (clearly_out, clearly_in) = self.clearly(metric, k, q, a);
         match &self.shape {
             Shape::PBall => {
                 if clearly_out {
@@ -199,11 +348,15 @@ impl<'a> Membership<'a> {
                 if clearly_out {
                     return false;
                 }
-                let (lo, hi) = (&lo[k * self.n..][..self.n], &hi[k * self.n..][..self.n]);
-                if x.iter()
-                    .zip(lo.iter().zip(hi))
-                    .all(|(v, (l, h))| l <= v && v <= h)
-                {
+                if self.in_box(lo, hi, k, x) {
+                    return true;
+                }
+            }
+            Shape::Parallelotope { t, lo, hi } => {
+                if clearly_out {
+                    return false;
+                }
+                if self.in_parallelotope(t, lo, hi, k, x) {
                     return true;
                 }
             }
@@ -216,6 +369,7 @@ impl<'a> Membership<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::TransformReport;
     use crate::interval::Interval;
     use crate::simulate::rng::PathRng;
     use crate::system::*;
@@ -324,6 +478,71 @@ mod tests {
         engine::run(&Sys, &info, &analysis).unwrap()
     }
 
+    /// The interval method's box result turned into a parallelotope `{x : lo <= T x <= hi}`
+    /// inside each box (the pendulum's `T`), so that the box's enclosing P-ball still holds it.
+    fn parallelotope(metric: Vec<f64>) -> AnalysisResult {
+        let mut r = result(Method::Interval, metric);
+        let t = [[1.0, 0.2], [1.0, 0.0]];
+        r.transform = Some(TransformReport {
+            matrix: t.iter().map(|row| row.to_vec()).collect(),
+            inverse: vec![vec![0.0, 1.0], vec![5.0, -5.0]],
+            inverse_error: 1e-15,
+        });
+        for st in &mut r.steps {
+            let d = &mut st.det_set;
+            let (lo, hi) = (d.lo.clone().unwrap(), d.hi.clone().unwrap());
+            // T^-1 = [[0, 1], [5, -5]] maps a y-box of half-width e into x within 10 e.
+            let e = (0..2).map(|i| hi[i] - lo[i]).fold(f64::INFINITY, f64::min) / 40.0;
+            let c = &st.nominal;
+            let y: Vec<f64> = t.iter().map(|row| row[0] * c[0] + row[1] * c[1]).collect();
+            d.shape = "parallelotope";
+            d.lo = Some(y.iter().map(|v| v - e).collect());
+            d.hi = Some(y.iter().map(|v| v + e).collect());
+        }
+        r
+    }
+
+    /// Points near the faces of the parallelotopes, just inside and just outside: the
+    /// shortcut's "inside" always agrees with `engine::contains`.
+    #[test]
+    fn the_parallelotope_shortcut_agrees_with_contains() {
+        let mut rng = PathRng::new(6, 0);
+        let mut shortcut = 0;
+        for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
+            let r = parallelotope(metric);
+            let m = Metric::new(&r.constants.metric);
+            let mem = Membership::new(&r, &m);
+            assert!(mem.has_shortcuts());
+            for (k, st) in r.steps.iter().enumerate() {
+                let (lo, hi) = (
+                    st.det_set.lo.as_ref().unwrap(),
+                    st.det_set.hi.as_ref().unwrap(),
+                );
+                for i in 0..400 {
+                    // y uniform in the box, then one coordinate moved to a face, off by a few
+                    // ulps to a relative 1e-6 either way.
+                    let mut y: Vec<f64> = (0..2)
+                        .map(|j| lo[j] + (hi[j] - lo[j]) * rng.uniform())
+                        .collect();
+                    let j = i % 2;
+                    let face = if rng.uniform() < 0.5 { lo[j] } else { hi[j] };
+                    let off = (rng.uniform() - 0.5) * [1e-15, 1e-12, 1e-6, 0.0][i / 2 % 4];
+                    y[j] = face * (1.0 + off);
+                    let x = [y[1], 5.0 * (y[0] - y[1])];
+                    let (q, a) = m.quad(&x, &st.nominal);
+                    let exact = engine::contains(&r, k, &x);
+                    assert_eq!(mem.inside(&m, k, &x, &st.nominal, q, a), exact, "k = {k}");
+                    if mem.inside_by_shortcut(&m, k, &x, q, a) {
+                        assert!(exact, "k = {k}: shortcut");
+                        shortcut += 1;
+                    }
+                }
+            }
+        }
+        // Not vacuous: points off the faces by 1e-6 are decided by the shortcut.
+        assert!(shortcut > 500, "{shortcut}");
+    }
+
     /// Points at relative P-distances from far inside to far outside, many within rounding of
     /// the boundary: the shortcuts never disagree with `engine::contains`.
     #[test]
@@ -353,12 +572,15 @@ mod tests {
                     let scale = s * st.prs_radius / q1.sqrt();
                     let x = [c[0] + scale * dir[0], c[1] + scale * dir[1]];
                     let (q, a) = m.quad(&x, c);
+                    assert_eq!((q, a), quad_small(&m.upper(), &x, c));
                     let fast = mem.inside(&m, k, &x, c, q, a);
-                    assert_eq!(
-                        fast,
-                        engine::contains(&r, k, &x),
-                        "{method:?} k = {k} s = {s}"
-                    );
+                    let exact = engine::contains(&r, k, &x);
+                    assert_eq!(fast, exact, "{method:?} k = {k} s = {s}");
+                    if mem.inside_by_shortcut(&m, k, &x, q, a)
+                        || mem.inside_below(k).is_some_and(|b| q < b)
+                    {
+                        assert!(exact, "{method:?} k = {k} s = {s}: shortcut");
+                    }
                 }
             }
         }

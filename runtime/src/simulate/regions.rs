@@ -76,7 +76,7 @@ impl Region {
     }
 
     /// Whether `x` is in the region.
-    #[inline]
+    #[inline(always)] // called for every path and Euler step of models with sets
     pub(crate) fn contains(&self, x: &[f64]) -> bool {
         match self {
             Region::Box(r) => r.iter().all(|&(i, lo, hi)| lo <= x[i] && x[i] <= hi),

@@ -26,7 +26,7 @@ fn splitmix64(mut z: u64) -> u64 {
 }
 
 /// The random stream of one path (wyrand).
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct PathRng {
     state: u64,
 }

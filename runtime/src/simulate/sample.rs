@@ -101,13 +101,18 @@ pub fn sample_paths<S: System + ?Sized>(
         for (k, &nsub) in substeps.iter().enumerate() {
             let (t0, t1) = (times[k], times[k + 1]);
             let h = (t1 - t0) / f64::from(nsub);
+            let sqrt_h = h.sqrt();
             for i in 0..nsub {
                 let t = t0 + f64::from(i) * h;
+                // The draws in `simulate`'s order: inputs, then the normals in channel order.
                 if p > 0 {
                     inputs.update(t, &mut interval, &mut rng, &mut u);
                 }
+                for zj in &mut z {
+                    *zj = zig.sample(&mut rng);
+                }
                 sys.drift(&x, &u, t, &mut f);
-                noise.step(sys, &mut x, &f, t, h, zig, &mut rng, &mut z, &mut g);
+                noise.apply(sys, &mut x, &f, t, h, sqrt_h, &mut z, &mut g);
             }
             record.extend_from_slice(&x);
         }

@@ -37,6 +37,18 @@ impl TopK {
         &self.thresholds
     }
 
+    /// Sets the threshold of every step that has `j` values but no threshold yet (`push` sets
+    /// one only when a buffer reaches `2 j`), so that the next batch's workers drop more.
+    pub(crate) fn tighten(&mut self) {
+        for (buf, thr) in self.bufs.iter_mut().zip(&mut self.thresholds) {
+            if *thr == f64::NEG_INFINITY && buf.len() >= self.j {
+                buf.select_nth_unstable_by(self.j - 1, descending);
+                buf.truncate(self.j);
+                *thr = buf.iter().copied().fold(f64::INFINITY, f64::min);
+            }
+        }
+    }
+
     /// Adds a value of step `k`.
     pub(crate) fn push(&mut self, k: usize, v: f64) {
         if v <= self.thresholds[k] {
@@ -85,6 +97,15 @@ mod tests {
             }
             let want = Some((sorted[j - 1], sorted[0]));
             assert_eq!(fwd.result(0), want, "j = {j}");
+            // Tightening between pushes (as between batches) keeps the result.
+            let mut tight = TopK::new(1, j);
+            for (i, &v) in values.iter().enumerate() {
+                tight.push(0, v);
+                if i % 1000 == 999 {
+                    tight.tighten();
+                }
+            }
+            assert_eq!(tight.result(0), want, "j = {j}");
             assert_eq!(rev.result(0), want, "j = {j}");
             assert!(fwd.bufs[0].len() < 2 * j);
         }
