@@ -1,22 +1,11 @@
 //! The `reachc` binary: exit codes, diagnostics on stderr, and `inspect --json` values.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn reachc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_reachc"))
-        .args(args)
-        .output()
-        .expect("the reachc binary runs")
-}
+use std::path::PathBuf;
+use std::process::Output;
 
-fn spec(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../specs")
-        .join(name)
-        .display()
-        .to_string()
-}
+use common::{reachc, spec};
 
 fn temp_spec(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("reachc-cli-{}", std::process::id()));

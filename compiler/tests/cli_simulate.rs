@@ -1,23 +1,9 @@
 //! `reachc simulate` with the interpreter backend: exit codes, the report file, skipped
 //! analyses and usage errors.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn reachc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_reachc"))
-        .args(args)
-        .output()
-        .expect("the reachc binary runs")
-}
-
-fn spec(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../specs")
-        .join(name)
-        .display()
-        .to_string()
-}
+use common::{reachc, spec};
 
 #[test]
 fn simulate_linear_writes_a_passing_report() {

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use reachc::backend::codegen::{generate, main_rs};
+use reachc::backend::codegen::{generate, generate_with, main_rs, Options, LANES_MAX_STATES};
 use reachc::backend::{mangle, prepare};
 use reachc::model::Model;
 
@@ -58,6 +58,9 @@ fn every_shipped_spec_generates_parsable_deterministic_code() {
         ] {
             assert!(code.contains(&format!("fn {method}(")), "{name}: {method}");
         }
+        // The drift in lanes exactly for small models without inputs.
+        let lanes = model.inputs.is_empty() && model.states.len() <= LANES_MAX_STATES;
+        assert_eq!(code.contains("fn drift_x8("), lanes, "{name}: drift_x8");
         assert!(code.contains("pub fn info() -> reachc_runtime::system::ModelInfo"));
         assert!(code.contains(&format!("pub const N: usize = {};", model.states.len())));
         if !model.tables.is_empty() {
@@ -173,6 +176,95 @@ fn every_node_kind_generates() {
     }
     // column 1 (ref.py) is never read, so it is not embedded
     assert!(!code.contains("T0_C1"));
+}
+
+/// The text of the generated method `name` (from its `fn` to the next method).
+fn method_text<'a>(code: &'a str, name: &str) -> &'a str {
+    let start = code
+        .find(&format!("fn {name}("))
+        .unwrap_or_else(|| panic!("no {name}:\n{code}"));
+    let rest = &code[start..];
+    let end = rest[1..].find("\n    fn ").map_or(rest.len(), |e| e + 1);
+    &rest[..end]
+}
+
+#[test]
+fn small_models_without_inputs_get_a_drift_in_lanes() {
+    // tests/good/lanes.sde: no inputs, four states, every function of lanes and of `t` alone.
+    let lanes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/good/lanes.sde");
+    let (model, code, _) = generate_for(&lanes);
+    assert!(model.inputs.is_empty() && model.states.len() == LANES_MAX_STATES);
+    let x8 = method_text(&code, "drift_x8");
+    assert!(
+        x8.starts_with(
+            "fn drift_x8(\n        &self,\n        x: &[reachc_runtime::X8],\n        t: f64,\n        \
+             out: &mut [reachc_runtime::X8],\n    )"
+        ),
+        "{x8}"
+    );
+    for snippet in [
+        // functions of lanes: methods and maps of the runtime's functions
+        "x[1].tan()",
+        ".map(reachc_runtime::func::sinc)",
+        ".map(reachc_runtime::func::sign)",
+        // `t` alone stays f64
+        "reachc_runtime::func::sinc(t)",
+        "t.sin()",
+        // an f64 receiver of an argument in lanes is widened
+        "reachc_runtime::X8::splat(2.0).atan2(x[0])",
+        "reachc_runtime::X8::splat(t).atan2(x[0])",
+        "reachc_runtime::X8::splat(2.0).powf(x[0])",
+        "x[0].atan2(t)",
+        "x[0].powf(t)",
+        "t.atan2(2.0)",
+        "reachc_runtime::X8::max(x[0], t)",
+        "reachc_runtime::X8::min(-1.0, ",
+        "reachc_runtime::X8::max(0.5, x[0])",
+        "f64::max(1.0, t)",
+        "reachc_runtime::table::eval(&T0_TIMES, &T0_C0, t)",
+        // an output of `t` alone and a constant one, in every lane
+        "out[3] = reachc_runtime::X8::splat(3.0);",
+    ] {
+        assert!(x8.contains(snippet), "missing {snippet:?}:\n{x8}");
+    }
+    assert!(x8.contains("out[2] = reachc_runtime::X8::splat(v"), "{x8}");
+    // The scalar drift is the same text over f64.
+    let drift = method_text(&code, "drift");
+    assert!(drift.contains("f64::atan2(2.0, x[0])") && drift.contains("out[3] = 3.0;"));
+    assert!(!drift.contains("X8") && !method_text(&code, "drift_interval").contains("X8"));
+
+    // Entries that are leaves: zero, `t`, a state.
+    let leaves = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/good/lanes_leaves.sde");
+    let x8 = method_text(&generate_for(&leaves).1, "drift_x8").to_string();
+    for snippet in [
+        "out[0] = reachc_runtime::X8::splat(0.0);",
+        "out[1] = reachc_runtime::X8::splat(t);",
+        "out[2] = x[1];",
+    ] {
+        assert!(x8.contains(snippet), "missing {snippet:?}:\n{x8}");
+    }
+
+    // With an input (the Rust keywords' `where`), more states (linear_n: 10) or a drift split
+    // into helpers: no drift_x8 (the trait's default, per lane).
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let (model, code, _) = generate_for(&root.join("tests/good/rust_keywords.sde"));
+    assert!(!model.inputs.is_empty() && !code.contains("X8"), "{code}");
+    let (model, code, _) = generate_for(&root.join("specs/linear_n.sde"));
+    assert!(
+        model.states.len() > LANES_MAX_STATES && !code.contains("X8"),
+        "{code}"
+    );
+    let mut model = reachc::driver::load(&lanes).unwrap().model;
+    let prepared = prepare(&mut model);
+    let split = Options {
+        split_above: 3,
+        chunk_size: 3,
+    };
+    let code = generate_with(&model, &prepared, &split);
+    assert!(
+        code.contains("fn drift_part0(") && !code.contains("X8"),
+        "{code}"
+    );
 }
 
 #[test]

@@ -2,28 +2,17 @@
 //! SVG and PNG pictures of the right size, the error cases and their exit codes; and that the
 //! plotted sample paths are the Monte Carlo check's paths.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use reachc::backend::interp::Interpreter;
 use reachc::backend::prepare;
 use reachc_runtime::engine;
 use reachc_runtime::simulate::{self, Options};
 
-fn reachc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_reachc"))
-        .args(args)
-        .output()
-        .expect("the reachc binary runs")
-}
-
-fn spec(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../specs")
-        .join(name)
-        .display()
-        .to_string()
-}
+use common::{reachc, spec};
 
 /// A fresh directory for one test.
 fn temp_dir(name: &str) -> PathBuf {

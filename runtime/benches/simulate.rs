@@ -11,6 +11,7 @@ use reachc_runtime::engine;
 use reachc_runtime::interval::Interval;
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::system::*;
+use reachc_runtime::X8;
 
 /// Paths per iteration.
 const PATHS: u64 = 100_000;
@@ -35,6 +36,13 @@ impl System for Linear {
         2
     }
     fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+        let v6 = -(0.4 * x[0]);
+        let v8 = -(0.4 * x[1]);
+        out[0] = v6;
+        out[1] = v8;
+    }
+    #[inline]
+    fn drift_x8(&self, x: &[X8], _t: f64, out: &mut [X8]) {
         let v6 = -(0.4 * x[0]);
         let v8 = -(0.4 * x[1]);
         out[0] = v6;

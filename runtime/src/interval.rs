@@ -579,7 +579,7 @@ impl Interval {
             return self;
         }
         let k = n.unsigned_abs();
-        let pos = if k % 2 == 0 {
+        let pos = if k.is_multiple_of(2) {
             let hi = pow_ru(self.mag(), k);
             if self.contains_zero() {
                 Interval::from_raw(0.0, hi)

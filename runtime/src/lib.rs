@@ -7,9 +7,11 @@ pub mod func;
 mod include;
 pub mod interval;
 pub mod kappa;
+pub mod lanes;
 pub mod simulate;
 pub mod system;
 pub mod table;
 
 pub use interval::Interval;
+pub use lanes::X8;
 pub use system::System;

@@ -4,6 +4,7 @@
 //! Matrices are flat row-major slices: entry `(i, j)` of an `r x c` matrix is `[i * c + j]`.
 
 use crate::interval::Interval;
+use crate::lanes::X8;
 
 /// A stochastic system `dX = f(X, u, t) dt + G(X, t) dW` with its derivatives.
 ///
@@ -19,6 +20,30 @@ pub trait System {
     fn m(&self) -> usize;
     /// `out[i] = f_i(x, u, t)`; `out.len() == n`.
     fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]);
+    /// The drift of eight states at once, for models without inputs (`p == 0`): lane `l` of
+    /// `out[i]` is `f_i` at the state in lane `l` of `x`, bit for bit what
+    /// [`System::drift`] gives (the Monte Carlo simulator relies on it). The default calls
+    /// `drift` once per lane; generated code evaluates the same expressions over [`X8`].
+    fn drift_x8(&self, x: &[X8], t: f64, out: &mut [X8]) {
+        let n = x.len();
+        let (mut small, mut heap) = ([0.0; 16], Vec::new());
+        let buf = if 2 * n <= small.len() {
+            &mut small[..2 * n]
+        } else {
+            heap.resize(2 * n, 0.0);
+            &mut heap[..]
+        };
+        let (xs, fs) = buf.split_at_mut(n);
+        for l in 0..8 {
+            for (xi, x) in xs.iter_mut().zip(x) {
+                *xi = x.0[l];
+            }
+            self.drift(xs, &[], t, fs);
+            for (o, f) in out.iter_mut().zip(&*fs) {
+                o.0[l] = *f;
+            }
+        }
+    }
     /// Natural inclusion function of the drift.
     fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]);
     /// `D_x f`, n x n row-major.

@@ -219,15 +219,17 @@ fn small_crates_compile_clippy_clean_and_run() {
 }
 
 /// The program replacing a generated crate's `src/main.rs`: for each line of stdin (a point
-/// `x, u, t` then a box `(lo, hi)` per state, input and time, as f64 bit patterns in hex), it
-/// prints, for the model and then each of its frames, drift, `D_x f`, `D_u f`, `G` at the point,
-/// then their interval versions and the sparse `D_x f` on the box (`lo hi` per entry), all as
-/// hex bit patterns on one line.
+/// `x, u, t` then a box `(lo, hi)` per state, input and time, and for a model without inputs
+/// eight more states, the lanes, one after the other, as f64 bit patterns in hex), it prints,
+/// for the model and then each of its frames, drift, `D_x f`, `D_u f`, `G` at the point, then
+/// their interval versions and the sparse `D_x f` on the box (`lo hi` per entry), then (no
+/// inputs) `drift_x8` of the lanes at `t` (lane by lane for each entry), all as hex bit patterns
+/// on one line.
 fn probe_main(crate_ident: &str, type_name: &str) -> String {
     format!(
         r#"use std::io::{{BufRead, Write}};
 
-use reachc_runtime::{{Interval, System}};
+use reachc_runtime::{{Interval, System, X8}};
 
 fn parse(s: &str) -> f64 {{
     f64::from_bits(u64::from_str_radix(s, 16).expect("hex"))
@@ -237,6 +239,7 @@ fn dump(
     sys: &dyn System,
     (x, u, t): (&[f64], &[f64], f64),
     (xi, ui, ti): (&[Interval], &[Interval], Interval),
+    lanes: Option<&[X8]>,
     words: &mut Vec<String>,
 ) {{
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
@@ -265,6 +268,14 @@ fn dump(
         words.push(format!("{{:016x}}", v.lo().to_bits()));
         words.push(format!("{{:016x}}", v.hi().to_bits()));
     }}
+    if let Some(lanes) = lanes {{
+        // NaN where nothing is written: a missing store shows.
+        let mut f8 = vec![X8::splat(f64::NAN); n];
+        sys.drift_x8(lanes, t, &mut f8);
+        for v in f8.iter().flat_map(|v| v.0) {{
+            words.push(format!("{{:016x}}", v.to_bits()));
+        }}
+    }}
 }}
 
 fn main() {{
@@ -280,11 +291,15 @@ fn main() {{
         let xi: Vec<Interval> = (0..n).map(iv).collect();
         let ui: Vec<Interval> = (n..n + p).map(iv).collect();
         let ti = iv(n + p);
+        let l = &b[2 * (n + p + 1)..];
+        let lanes: Option<Vec<X8>> = (p == 0)
+            .then(|| (0..n).map(|i| X8(std::array::from_fn(|k| l[k * n + i]))).collect());
+        let lanes = lanes.as_deref();
         let mut words: Vec<String> = Vec::new();
-        dump(&sys, (x, u, t), (&xi, &ui, ti), &mut words);
+        dump(&sys, (x, u, t), (&xi, &ui, ti), lanes, &mut words);
         let mut k = 0;
         while let Some(frame) = sys.frame(k) {{
-            dump(frame, (x, u, t), (&xi, &ui, ti), &mut words);
+            dump(frame, (x, u, t), (&xi, &ui, ti), lanes, &mut words);
             k += 1;
         }}
         writeln!(out, "{{}}", words.join(" ")).expect("stdout");
@@ -343,7 +358,8 @@ fn evaluate(sys: &dyn System, s: &Sample) -> Values {
 }
 
 /// A point and a box around it: states near their initial set, inputs in their box, time in
-/// [0, 6] (past the end of the unicycle's table).
+/// [0, 6] (past the end of the unicycle's table); for a model without inputs, the eight states
+/// of `drift_x8`'s lanes.
 struct Sample {
     x: Vec<f64>,
     u: Vec<f64>,
@@ -351,6 +367,7 @@ struct Sample {
     xi: Vec<Interval>,
     ui: Vec<Interval>,
     ti: Interval,
+    lanes: Vec<Vec<f64>>,
 }
 
 fn sample(model: &Model, rng: &mut Rng) -> Sample {
@@ -360,20 +377,34 @@ fn sample(model: &Model, rng: &mut Rng) -> Sample {
         let lo = v - r * rng.next();
         Interval::new(lo.min(v), (lo + r).max(v))
     };
-    let x: Vec<f64> = model
-        .states
-        .iter()
-        .map(|s| {
-            let (lo, hi) = s.bounds.map_or((-2.0, 2.0), |b| (b.lo - 2.0, b.hi + 2.0));
-            rng.uniform(lo, hi)
-        })
-        .collect();
+    let state = |rng: &mut Rng| -> Vec<f64> {
+        model
+            .states
+            .iter()
+            .map(|s| {
+                let (lo, hi) = s.bounds.map_or((-2.0, 2.0), |b| (b.lo - 2.0, b.hi + 2.0));
+                rng.uniform(lo, hi)
+            })
+            .collect()
+    };
+    let x = state(rng);
     let u: Vec<f64> = model
         .inputs
         .iter()
         .map(|i| i.bounds.map_or(0.0, |b| rng.uniform(b.lo, b.hi)))
         .collect();
     let t = rng.uniform(0.0, 6.0);
+    let n = model.states.len();
+    // The sample's own state, signed zeros, a wide one and states near the initial set, so
+    // the lanes differ from each other.
+    let lanes = if model.inputs.is_empty() {
+        let mut lanes = vec![x.clone(), vec![0.0; n], vec![-0.0; n]];
+        lanes.push((0..n).map(|_| rng.uniform(-1e3, 1e3)).collect());
+        lanes.extend((0..4).map(|_| state(rng)));
+        lanes
+    } else {
+        Vec::new()
+    };
     Sample {
         xi: x.iter().map(|&v| around(v, rng)).collect(),
         ui: u.iter().map(|&v| around(v, rng)).collect(),
@@ -381,6 +412,7 @@ fn sample(model: &Model, rng: &mut Rng) -> Sample {
         x,
         u,
         t,
+        lanes,
     }
 }
 
@@ -411,6 +443,18 @@ fn generated_code_agrees_with_the_interpreter() {
         "vanderpol",
     ];
     let keywords = workspace().join("tests/good/rust_keywords.sde");
+    // Every shipped spec that gets `drift_x8` is probed.
+    for path in shipped_specs() {
+        let model = load(&path).unwrap().model;
+        let stem = path.file_stem().unwrap().to_string_lossy();
+        let lanes = model.inputs.is_empty() && model.states.len() <= codegen::LANES_MAX_STATES;
+        assert!(!lanes || shipped.contains(&&*stem), "{stem} is not probed");
+    }
+    // Specs without inputs and with at most four states (generated with `drift_x8`) that the
+    // shipped ones do not cover: every function of values in lanes and of `t` alone, entries of
+    // `t` alone, constant, zero, and a state itself.
+    let lanes_specs =
+        ["lanes", "lanes_leaves"].map(|n| workspace().join(format!("tests/good/{n}.sde")));
     // Then specs whose methods (of more than 3 operands) are split into helper functions that
     // pass values through scratch arrays: chain10 (chain1000's equations, which are split at the
     // default size), the pendulum (a frame) and the unicycle (a table, inputs and time).
@@ -423,6 +467,7 @@ fn generated_code_agrees_with_the_interpreter() {
         .iter()
         .map(|n| (spec(&format!("{n}.sde")), default))
         .chain([(keywords, default)])
+        .chain(lanes_specs.into_iter().map(|p| (p, default)))
         .chain(
             ["chain10", "pendulum", "unicycle"]
                 .iter()
@@ -438,6 +483,13 @@ fn generated_code_agrees_with_the_interpreter() {
         let name = name.as_str();
         let dir = scratch.0.join(name);
         let written = write_with(&path, &dir, options);
+        let mut model = load(&path).unwrap().model;
+        // `drift_x8` is generated (else the trait's default, per lane, is what the probe sees).
+        let lanes = model.inputs.is_empty()
+            && model.states.len() <= codegen::LANES_MAX_STATES
+            && options == default;
+        let lib = std::fs::read_to_string(dir.join("src/lib.rs")).unwrap();
+        assert_eq!(lib.contains("fn drift_x8("), lanes, "{name}: drift_x8");
         let ident = written.crate_name.replace('-', "_");
         std::fs::write(
             dir.join("src/main.rs"),
@@ -447,7 +499,6 @@ fn generated_code_agrees_with_the_interpreter() {
         let binary = compile_crate_in(&dir, false, &target_dir())
             .unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
 
-        let mut model = load(&path).unwrap().model;
         let prepared = prepare(&mut model);
         let interp = Interpreter::new(model.clone(), &prepared);
 
@@ -462,6 +513,7 @@ fn generated_code_agrees_with_the_interpreter() {
                 words.push(hex(iv.lo()));
                 words.push(hex(iv.hi()));
             }
+            words.extend(s.lanes.iter().flatten().map(|&v| hex(v)));
             input.push_str(&words.join(" "));
             input.push('\n');
         }
@@ -471,13 +523,12 @@ fn generated_code_agrees_with_the_interpreter() {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(input.as_bytes())
-            .unwrap();
+        // Written from another thread: the probe's output fills its pipe before it has read
+        // all of the input.
+        let mut stdin = child.stdin.take().unwrap();
+        let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
         let output = child.wait_with_output().unwrap();
+        writer.join().unwrap().unwrap();
         assert!(
             output.status.success(),
             "{name}: probe failed:\n{}",
@@ -533,6 +584,26 @@ fn generated_code_agrees_with_the_interpreter() {
                         v.is_nan() || g.contains(v),
                         "{what}: {entry} = {g:?} misses {v:e}"
                     );
+                }
+                // `drift_x8`: lane `l` of entry `i` is the drift at the lane's state, bit for
+                // bit.
+                if !s.lanes.is_empty() {
+                    let n = sys.n();
+                    assert!(words.len() >= at + 8 * n, "{what}: too few lane values");
+                    let mut f = vec![0.0; n];
+                    for (l, state) in s.lanes.iter().enumerate() {
+                        sys.drift(state, &[], s.t, &mut f);
+                        for (i, &want) in f.iter().enumerate() {
+                            let got = words[at + 8 * i + l];
+                            assert!(
+                                same(got, want),
+                                "{what}: drift_x8[{i}] lane {l} at {state:?}, t = {}: \
+                                 generated {got:e}, interpreter {want:e}",
+                                s.t
+                            );
+                        }
+                    }
+                    at += 8 * n;
                 }
             }
             assert_eq!(at, words.len(), "{name}: sample {k}: too many values");

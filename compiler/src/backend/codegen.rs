@@ -13,6 +13,12 @@
 //! enclosures. `sinc`, `sign`, `sinc'` and table interpolation call the same
 //! `reachc_runtime::{func, table}` functions the interpreter uses.
 //!
+//! A model without inputs and with at most [`LANES_MAX_STATES`] states also gets `drift_x8`,
+//! the drift of eight states at once over `reachc_runtime::X8` for the Monte Carlo simulator:
+//! the same expression text as `drift`, with values that depend on a state in lanes, and the
+//! constants, `t` and values of `t` alone as plain `f64` (widened where they meet lanes), so
+//! every lane is bit for bit what `drift` gives.
+//!
 //! A method larger than [`Options::split_above`] (a model with hundreds of states) is split into
 //! `#[inline(never)]` helper functions of bounded size in private modules, called in sequence,
 //! values crossing from one to a later one passing through a scratch array; its dense interval
@@ -41,6 +47,10 @@ use crate::model::Model;
 /// When an output has at least this many zero entries, it is cleared with one `fill` instead
 /// of one assignment per zero.
 const FILL_THRESHOLD: usize = 8;
+
+/// Models without inputs and with at most this many states get `drift_x8` (the simulator runs
+/// eight sample paths in lanes only for small models; larger ones keep the default, per lane).
+pub const LANES_MAX_STATES: usize = 4;
 
 /// The default [`Options::split_above`]: every shipped spec but specs/chain1000.sde stays below
 /// (the largest method of the others costs 140), so their code is one function per method.
@@ -108,6 +118,7 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
     let p = int(model.inputs.len());
     let m = int(model.noises.len());
 
+    let lanes = model.inputs.is_empty() && model.states.len() <= LANES_MAX_STATES;
     let mut tables = Tables::default();
     let (bodies, helpers) = system_bodies(
         &model.pool,
@@ -115,7 +126,7 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
         &name,
         (&model.drift, &model.diffusion),
         &prepared.derivatives,
-        options,
+        (options, lanes),
     );
     let mut frame_items = TokenStream::new();
     let mut frame_arms = TokenStream::new();
@@ -127,7 +138,7 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
             &frame_name,
             (&frame.drift, &frame.diffusion),
             &frame.derivatives,
-            options,
+            (options, lanes),
         );
         let doc = format!(
             " `{name}` in the coordinates `y = T x`, `T = {}`: drift `T f(T^-1 y, u, t)`, \
@@ -218,14 +229,15 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
 }
 
 /// The `System` methods (f64 and interval) of a drift, diffusion and their Jacobians, and the
-/// modules of helper functions of those split into chunks (see [`chunked_method`]).
+/// modules of helper functions of those split into chunks (see [`chunked_method`]); with
+/// `lanes`, also `drift_x8` (unless the drift is chunked).
 fn system_bodies(
     pool: &Pool,
     tables: &mut Tables,
     owner: &Ident,
     (drift, diffusion): (&[ExprId], &[Vec<ExprId>]),
     d: &Derivatives,
-    options: &Options,
+    (options, lanes): (&Options, bool),
 ) -> (TokenStream, TokenStream) {
     let flat = |m: &[Vec<ExprId>]| -> Vec<ExprId> { m.iter().flatten().copied().collect() };
     let (jac_x, jac_u, diffusion) = (flat(&d.jac_x), flat(&d.jac_u), flat(diffusion));
@@ -294,6 +306,18 @@ fn system_bodies(
             helpers.extend(parts);
         }
     }
+    if lanes {
+        let def = MethodDef {
+            name: "drift",
+            kind: Kind::X8,
+            roots: drift,
+            with_u: false,
+            owner,
+        };
+        // Never split: a drift that would be is left to the trait's default.
+        let (method, _) = method_fn(pool, tables, &def, options);
+        bodies.extend(method);
+    }
     bodies.extend(sparse_fn);
     helpers.extend(sparse_helpers);
     let pattern = nonzeros.iter().map(|&(i, j, _)| {
@@ -348,6 +372,8 @@ fn format_file(tokens: TokenStream) -> String {
 enum Kind {
     F64,
     Interval,
+    /// `reachc_runtime::X8` for the values that depend on a state, `f64` for the others.
+    X8,
 }
 
 /// The `(table, column)` pairs read by the generated code, in a deterministic order.
@@ -454,6 +480,8 @@ struct Emitter<'a> {
     uses_t: bool,
     /// The path of the file's top level, where the tables are (`super::` in a helper module).
     top: TokenStream,
+    /// [`Kind::X8`]: the `let`s emitted so far whose value is in lanes (depends on a state).
+    lanes: BTreeSet<ExprId>,
 }
 
 impl<'a> Emitter<'a> {
@@ -466,7 +494,25 @@ impl<'a> Emitter<'a> {
             u_len: 0,
             uses_t: false,
             top: TokenStream::new(),
+            lanes: BTreeSet::new(),
         }
+    }
+
+    /// Whether the value of `id` is in lanes (`X8`): only in [`Kind::X8`], and there exactly
+    /// when it depends on a state; constants and values of `t` alone stay `f64`. A node is
+    /// asked for after its `let` (children come first).
+    fn in_lanes(&self, id: ExprId) -> bool {
+        self.kind == Kind::X8
+            && match self.pool.node(id) {
+                Node::Var(v) => matches!(v, Var::State(_)),
+                Node::Const(_) => false,
+                _ => self.lanes.contains(&id),
+            }
+    }
+
+    /// `v`, a value of `f64` type, as lanes: `X8::splat(v)`.
+    fn splat(v: &TokenStream) -> TokenStream {
+        quote!(reachc_runtime::X8::splat(#v))
     }
 
     /// `use reachc_runtime::Interval;` if the body names `Interval`.
@@ -484,7 +530,7 @@ impl<'a> Emitter<'a> {
     fn constant(&mut self, v: f64) -> TokenStream {
         let lit = float(v);
         match self.kind {
-            Kind::F64 => lit,
+            Kind::F64 | Kind::X8 => lit,
             Kind::Interval => {
                 self.uses_interval = true;
                 quote!(Interval::point(#lit))
@@ -527,7 +573,7 @@ impl<'a> Emitter<'a> {
         let r = self.operand(recv);
         if matches!(self.pool.node(recv), Node::Const(_)) {
             let ty = match self.kind {
-                Kind::F64 => quote!(f64),
+                Kind::F64 | Kind::X8 => quote!(f64),
                 Kind::Interval => {
                     self.uses_interval = true;
                     quote!(Interval)
@@ -541,6 +587,12 @@ impl<'a> Emitter<'a> {
 
     /// The expression computing node `id` from its children, mirroring `Pool::eval`.
     fn node_expr(&mut self, id: ExprId, tables: &mut Tables) -> TokenStream {
+        if children(self.pool.node(id))
+            .into_iter()
+            .any(|c| self.in_lanes(c))
+        {
+            self.lanes.insert(id);
+        }
         match self.pool.node(id) {
             Node::Const(_) | Node::Var(_) => self.operand(id),
             Node::Sum { constant, terms } => {
@@ -631,7 +683,12 @@ impl<'a> Emitter<'a> {
                 );
                 let (times, values) = (quote!(#top #times), quote!(#top #values));
                 match self.kind {
-                    Kind::F64 => quote!(reachc_runtime::table::eval(&#times, &#values, #a)),
+                    _ if self.in_lanes(*arg) => {
+                        quote!(#a.map(|at| reachc_runtime::table::eval(&#times, &#values, at)))
+                    }
+                    Kind::F64 | Kind::X8 => {
+                        quote!(reachc_runtime::table::eval(&#times, &#values, #a))
+                    }
                     Kind::Interval => {
                         quote!(reachc_runtime::table::eval_interval(&#times, &#values, #a))
                     }
@@ -655,13 +712,20 @@ impl<'a> Emitter<'a> {
             Func1::Tanh => "tanh",
             Func1::Sinc | Func1::Sign | Func1::DSinc => {
                 let x = self.operand(a);
-                return match (self.kind, f) {
-                    (Kind::F64, Func1::Sinc) => quote!(reachc_runtime::func::sinc(#x)),
-                    (Kind::F64, Func1::Sign) => quote!(reachc_runtime::func::sign(#x)),
-                    (Kind::F64, _) => quote!(reachc_runtime::func::dsinc(#x)),
-                    (Kind::Interval, Func1::Sinc) => self.method(a, "sinc", &[]),
-                    (Kind::Interval, Func1::Sign) => self.method(a, "sign", &[]),
-                    (Kind::Interval, _) => quote!(reachc_runtime::func::dsinc_interval(#x)),
+                let name = match f {
+                    Func1::Sinc => "sinc",
+                    Func1::Sign => "sign",
+                    _ => "dsinc",
+                };
+                let func = format_ident!("{name}");
+                let func = quote!(reachc_runtime::func::#func);
+                return match self.kind {
+                    Kind::Interval if f == Func1::DSinc => {
+                        quote!(reachc_runtime::func::dsinc_interval(#x))
+                    }
+                    Kind::Interval => self.method(a, name, &[]),
+                    _ if self.in_lanes(a) => quote!(#x.map(#func)),
+                    Kind::F64 | Kind::X8 => quote!(#func(#x)),
                 };
             }
         };
@@ -670,21 +734,29 @@ impl<'a> Emitter<'a> {
 
     fn call2(&mut self, f: Func2, a: ExprId, b: ExprId) -> TokenStream {
         let y = self.operand(b);
+        let (a_lanes, b_lanes) = (self.in_lanes(a), self.in_lanes(b));
         match (f, self.kind) {
-            (Func2::Atan2, _) => self.method(a, "atan2", &[y]),
-            (Func2::Pow, Kind::F64) => self.method(a, "powf", &[y]),
-            (Func2::Pow, Kind::Interval) => self.method(a, "pow", &[y]),
             (Func2::Min | Func2::Max, kind) => {
                 let x = self.operand(a);
                 let m = format_ident!("{}", if f == Func2::Min { "min" } else { "max" });
                 match kind {
-                    Kind::F64 => quote!(f64::#m(#x, #y)),
+                    _ if a_lanes || b_lanes => quote!(reachc_runtime::X8::#m(#x, #y)),
+                    Kind::F64 | Kind::X8 => quote!(f64::#m(#x, #y)),
                     Kind::Interval => {
                         self.uses_interval = true;
                         quote!(Interval::#m(#x, #y))
                     }
                 }
             }
+            // An `f64` receiver and an argument in lanes: the receiver widened to lanes.
+            (Func2::Atan2 | Func2::Pow, _) if !a_lanes && b_lanes => {
+                let x = Self::splat(&self.operand(a));
+                let m = format_ident!("{}", if f == Func2::Atan2 { "atan2" } else { "powf" });
+                quote!(#x.#m(#y))
+            }
+            (Func2::Atan2, _) => self.method(a, "atan2", &[y]),
+            (Func2::Pow, Kind::F64 | Kind::X8) => self.method(a, "powf", &[y]),
+            (Func2::Pow, Kind::Interval) => self.method(a, "pow", &[y]),
         }
     }
 }
@@ -707,21 +779,33 @@ impl MethodDef<'_> {
         match self.kind {
             Kind::F64 => format_ident!("{}", self.name),
             Kind::Interval => format_ident!("{}_interval", self.name),
+            Kind::X8 => format_ident!("{}_x8", self.name),
         }
     }
 
+    /// The type of the elements of `x`, `u` and `out`.
     fn scalar(&self) -> TokenStream {
         match self.kind {
             Kind::F64 => quote!(f64),
             Kind::Interval => quote!(reachc_runtime::Interval),
+            Kind::X8 => quote!(reachc_runtime::X8),
         }
     }
 
-    /// `0.0` or `Interval::ZERO` as the method body can name it.
+    /// The type of `t`: one time for all lanes.
+    fn time(&self) -> TokenStream {
+        match self.kind {
+            Kind::X8 => quote!(f64),
+            Kind::F64 | Kind::Interval => self.scalar(),
+        }
+    }
+
+    /// `0.0`, `Interval::ZERO` or `X8::splat(0.0)` as the method body can name it.
     fn zero(&self) -> TokenStream {
         match self.kind {
             Kind::F64 => quote!(0.0),
             Kind::Interval => quote!(reachc_runtime::Interval::ZERO),
+            Kind::X8 => Emitter::splat(&quote!(0.0)),
         }
     }
 }
@@ -765,6 +849,8 @@ fn output(e: &mut Emitter, k: usize, r: ExprId, fill: bool) -> Option<TokenStrea
             e.uses_interval = true;
             quote!(Interval::ZERO)
         }
+        // a constant or a value of `t` alone, in every lane
+        _ if e.kind == Kind::X8 && !e.in_lanes(r) => Emitter::splat(&e.operand(r)),
         _ => e.operand(r),
     };
     let k = int(k);
@@ -803,6 +889,10 @@ fn method_fn(
     };
     let cost = lets.iter().map(|&id| node_cost(pool, id)).sum::<usize>() + writes;
     if cost > options.split_above {
+        if kind == Kind::X8 {
+            // Only small models run in lanes; a drift that large keeps the trait's default.
+            return (TokenStream::new(), TokenStream::new());
+        }
         return chunked_method(pool, tables, def, fill, options.chunk_size);
     }
 
@@ -815,7 +905,7 @@ fn method_fn(
     }
     if fill {
         let zero = match kind {
-            Kind::F64 => quote!(0.0),
+            Kind::F64 | Kind::X8 => def.zero(),
             Kind::Interval => {
                 e.uses_interval = true;
                 quote!(Interval::ZERO)
@@ -831,15 +921,23 @@ fn method_fn(
     let u = param_name(e.u_len > 0, "u");
     let t = param_name(e.uses_t, "t");
     let out = param_name(!roots.is_empty(), "out");
-    let (fn_name, scalar) = (def.fn_name(), def.scalar());
+    let (fn_name, scalar, time) = (def.fn_name(), def.scalar(), def.time());
     let use_interval = e.use_interval();
     let u_param = if def.with_u {
         quote!(#u: &[#scalar],)
     } else {
         TokenStream::new()
     };
+    // The simulator's vector loop calls `drift_x8` once per step of eight paths: inlined, its
+    // lanes stay in vector registers (a call passes them through memory).
+    let inline = if kind == Kind::X8 {
+        quote!(#[inline])
+    } else {
+        TokenStream::new()
+    };
     let method = quote! {
-        fn #fn_name(&self, #x: &[#scalar], #u_param #t: #scalar, #out: &mut [#scalar]) {
+        #inline
+        fn #fn_name(&self, #x: &[#scalar], #u_param #t: #time, #out: &mut [#scalar]) {
             #use_interval
             #body
         }
@@ -992,7 +1090,7 @@ fn chunked_method(
         }
     }
 
-    let (fn_name, scalar) = (def.fn_name(), def.scalar());
+    let (fn_name, scalar, time) = (def.fn_name(), def.scalar(), def.time());
     let owner = def.owner.to_string().to_ascii_lowercase();
     let (mut uses_x, mut uses_u, mut uses_t) = (false, false, false);
     let mut helpers = TokenStream::new();
@@ -1037,7 +1135,7 @@ fn chunked_method(
         let (mut params, mut args, mut prefixes) =
             (TokenStream::new(), TokenStream::new(), TokenStream::new());
         if e.uses_t {
-            params.extend(quote!(t: #scalar,));
+            params.extend(quote!(t: #time,));
             args.extend(quote!(t,));
         }
         // `arg` passes the slice: `x`, `out` (the method's parameters) or `&mut s` (its array).
@@ -1108,7 +1206,7 @@ fn chunked_method(
         TokenStream::new()
     };
     let method = quote! {
-        fn #fn_name(&self, #x: &[#scalar], #u_param #t: #scalar, out: &mut [#scalar]) {
+        fn #fn_name(&self, #x: &[#scalar], #u_param #t: #time, out: &mut [#scalar]) {
             #fill
             #scratch
             #calls

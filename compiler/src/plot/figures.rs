@@ -167,6 +167,34 @@ fn legend<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Draws a chart's axes in the figures' style (scale `s`): the descriptions `desc` and tick
+/// labels by `fmt` (x, then y), a light grid at the labelled ticks only.
+fn mesh<DB: DrawingBackend, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
+    s: u32,
+    desc: [&str; 2],
+    fmt: [&dyn Fn(&f64) -> String; 2],
+) -> Result<(), String>
+where
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let f = |v: u32| f64::from(v * s);
+    chart
+        .configure_mesh()
+        .x_desc(desc[0])
+        .y_desc(desc[1])
+        .x_label_formatter(fmt[0])
+        .y_label_formatter(fmt[1])
+        .label_style((FAMILY, f(14)))
+        .axis_desc_style((FAMILY, f(17)))
+        .max_light_lines(0)
+        .bold_line_style(GRID.stroke_width(s))
+        .axis_style(BLACK.stroke_width(s))
+        .set_all_tick_mark_size(5 * s as i32)
+        .draw()
+        .map_err(err)
+}
+
 /// The smallest rectangle holding `points`, padded by 6% (and to a non-zero size).
 fn view(points: impl Iterator<Item = Point>) -> ((f64, f64), (f64, f64)) {
     let (mut x, mut y) = (
@@ -229,20 +257,12 @@ impl Draw for SetsScene {
             .map_err(err)?;
         let x_fmt = |v: &f64| tick(*v, vx.1 - vx.0);
         let y_fmt = |v: &f64| tick(*v, vy.1 - vy.0);
-        chart
-            .configure_mesh()
-            .x_desc(self.axes[0].as_str())
-            .y_desc(self.axes[1].as_str())
-            .x_label_formatter(&x_fmt)
-            .y_label_formatter(&y_fmt)
-            .label_style((FAMILY, f(14)))
-            .axis_desc_style((FAMILY, f(17)))
-            .max_light_lines(0)
-            .bold_line_style(GRID.stroke_width(s))
-            .axis_style(BLACK.stroke_width(s))
-            .set_all_tick_mark_size(i(5))
-            .draw()
-            .map_err(err)?;
+        mesh(
+            &mut chart,
+            s,
+            [&self.axes[0], &self.axes[1]],
+            [&x_fmt, &y_fmt],
+        )?;
         let mut entries = Vec::new();
 
         // Unsafe sets first: everything else is drawn over them.
@@ -487,7 +507,7 @@ impl RadiusScene {
     where
         Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     {
-        let (i, f) = (|v: i32| v * s as i32, |v: u32| f64::from(v * s));
+        let i = |v: i32| v * s as i32;
         let x_span = self.times.last().copied().unwrap_or(1.0);
         let y_span = if log { 0.0 } else { chart.y_range().end };
         let x_fmt = |v: &f64| tick(*v, x_span);
@@ -498,20 +518,7 @@ impl RadiusScene {
                 tick(*v, y_span)
             }
         };
-        chart
-            .configure_mesh()
-            .x_desc("t")
-            .y_desc("radius (P-norm)")
-            .x_label_formatter(&x_fmt)
-            .y_label_formatter(&y_fmt)
-            .label_style((FAMILY, f(14)))
-            .axis_desc_style((FAMILY, f(17)))
-            .max_light_lines(0)
-            .bold_line_style(GRID.stroke_width(s))
-            .axis_style(BLACK.stroke_width(s))
-            .set_all_tick_mark_size(i(5))
-            .draw()
-            .map_err(err)?;
+        mesh(&mut chart, s, ["t", "radius (P-norm)"], [&x_fmt, &y_fmt])?;
         // Runs of drawable points: a curve is broken where a value is missing, not finite, or
         // (log scale) not positive.
         let runs = |values: &mut dyn Iterator<Item = Option<f64>>| -> Vec<Vec<(f64, f64)>> {

@@ -16,7 +16,7 @@ const R: f64 = 3.654_152_885_361_009;
 /// Area of every layer under `exp(-x^2 / 2)` (Marsaglia and Tsang's `v` for 256 layers).
 const V: f64 = 4.928_673_233_99e-3;
 /// `2^52`: the uniforms' resolution is `2^-52`.
-const TWO52: f64 = (1u64 << 52) as f64;
+pub(super) const TWO52: f64 = (1u64 << 52) as f64;
 
 /// The layer tables.
 #[derive(Debug)]
@@ -30,8 +30,8 @@ pub(crate) struct Ziggurat {
     fx: [f64; LAYERS + 1],
     /// `ratio` and `x` scaled by `2^52` and `2^-52` (exactly: powers of two), for the
     /// rectangle test on the uniform's integer numerator (see [`sample`](Self::sample)).
-    ratio52: [f64; LAYERS],
-    x52: [f64; LAYERS],
+    pub(super) ratio52: [f64; LAYERS],
+    pub(super) x52: [f64; LAYERS],
 }
 
 /// `exp(-x^2 / 2)`, the unnormalised density.
@@ -100,7 +100,7 @@ impl Ziggurat {
     /// Returns the sample and the stream after it.
     #[cold]
     #[inline(never)]
-    fn sample_slow(&self, mut i: usize, mut u: f64, mut rng: PathRng) -> (f64, PathRng) {
+    pub(super) fn sample_slow(&self, mut i: usize, mut u: f64, mut rng: PathRng) -> (f64, PathRng) {
         loop {
             if i == 0 {
                 return (tail(u < 0.0, &mut rng), rng);

@@ -6,11 +6,12 @@
 //! [`super::rng`]); the statistics are counts, minima and candidate lists, whose merge does not
 //! depend on the order, so the results are the same for any thread count.
 //!
-//! Two loops run the steps: `additive_lanes` for the common case (constant diagonal noise, no
-//! inputs, no unsafe sets or domain, a small model with a non-negative diagonal metric), with
-//! every per-step constant in a register, and `step_lanes` for everything else. Both compute
-//! the same operations in the same order as [`sample_paths`](super::sample_paths), so the paths
-//! are the same whichever loop runs them.
+//! Three loops run the steps: `additive_lanes` for the common case (constant diagonal noise,
+//! no inputs, no unsafe sets or domain, a small model with a non-negative diagonal metric),
+//! with every per-step constant in a register; `additive_x8`, the same eight paths at a time
+//! in AVX-512 lanes where the processor has them; and `step_lanes` for everything else. All
+//! compute the same operations in the same order as [`sample_paths`](super::sample_paths), so
+//! the paths are the same whichever loop runs them.
 
 use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
@@ -70,6 +71,10 @@ pub(crate) struct Plan<'a, S: ?Sized> {
     /// copies do the same IEEE operations in the same order (Rust never fuses a multiply and an
     /// add), so the results do not depend on it.
     pub(crate) avx2: bool,
+    /// The processor has AVX-512 (F and DQ): `additive_lanes`' paths run eight at a time in
+    /// vector lanes ([`super::avx512`]), which draw the same numbers and do the same IEEE
+    /// operations per lane, so the results do not depend on it either.
+    pub(crate) avx512: bool,
 }
 
 /// Statistics of a chunk of paths.
@@ -102,6 +107,13 @@ impl ChunkStats {
             left_domain: 0,
             diverged: 0,
         }
+    }
+
+    /// A path whose state became non-finite at an earlier report step, at report step `k`:
+    /// it stays outside every PRS, above every quantile.
+    fn ended(&mut self, k: usize) {
+        self.outside[k] += 1;
+        self.candidates.push((k as u32, f64::INFINITY));
     }
 
     /// Adds `other` (order-independent: sums, minima, concatenation).
@@ -290,7 +302,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             let x = &mut l.x[a * nn..][..n];
             self.initial.sample(&mut path.rng, self.zig, x, &mut l.init);
             let qa = self.metric.quad(x, &self.nominal[..n]);
-            path.alive = self.record(0, x, qa, thresholds[0], st, &mut path.outside_any);
+            self.record(0, x, qa, thresholds[0], st, path);
             let hit = &mut l.hit[a * sets..][..sets];
             self.check_sets(0.0, x, hit, &mut path.left_domain, st);
         }
@@ -301,7 +313,24 @@ impl<S: System + ?Sized> Plan<'_, S> {
             && self.domain.is_none()
             && self.noise.diagonal().is_some()
             && self.metric.nonneg_diagonal().is_some();
-        for (k, span) in (1..).zip(&self.spans) {
+        // With a quiet bound at every report step every step runs `additive_lanes`: then
+        // groups of eight paths run in vector lanes, the rest below.
+        let mut start = 0;
+        #[cfg(target_arch = "x86_64")]
+        if let (true, true, Some(quiet)) = (additive, self.avx512, &l.quiet) {
+            // Groups of eight paths in vector lanes, the rest below.
+            start = lanes / 8 * 8;
+            let groups =
+                l.x.chunks_exact_mut(8 * nn)
+                    .zip(l.paths.chunks_exact_mut(8));
+            for (x, paths) in groups.take(lanes / 8) {
+                // SAFETY: `avx512` says the processor has the extensions.
+                unsafe { self.additive_x8(dim, x, paths, quiet, thresholds, st) };
+            }
+        }
+        // (None left: nothing to step.)
+        let spans = if start < lanes { &self.spans[..] } else { &[] };
+        for (k, span) in (1..).zip(spans) {
             if let Some(d) = self.noise.diagonal() {
                 for (ds, d) in l.ds.iter_mut().zip(d) {
                     *ds = d * span.sqrt_h;
@@ -327,12 +356,11 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     report,
                     lanes,
                 };
+                let (x, paths) = (&mut l.x[start * nn..], &mut l.paths[start..lanes]);
                 if additive && report.is_none() {
-                    let paths = &mut l.paths[..lanes];
-                    self.additive::<D, false>(dim, &step, &l.ds, &mut l.x, paths, st);
+                    self.additive::<D, false>(dim, &step, &l.ds, x, paths, st);
                 } else if additive && report.is_some_and(|r| r.quiet.is_some()) {
-                    let paths = &mut l.paths[..lanes];
-                    self.additive::<D, true>(dim, &step, &l.ds, &mut l.x, paths, st);
+                    self.additive::<D, true>(dim, &step, &l.ds, x, paths, st);
                 } else if self.noise.diagonal().is_some() {
                     self.general::<D, true>(dim, &step, l, st);
                 } else {
@@ -383,9 +411,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         for (a, (x, path)) in lane_data {
             if !path.alive {
                 if let Some(rep) = step.report {
-                    // A non-finite state stays outside every PRS.
-                    st.outside[rep.k] += 1;
-                    st.candidates.push((rep.k as u32, f64::INFINITY));
+                    st.ended(rep.k);
                 }
                 continue;
             }
@@ -431,7 +457,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 }
             };
             if !quiet {
-                path.alive = self.record(rep.k, x, (q, a), rep.thr, st, &mut path.outside_any);
+                self.record(rep.k, x, (q, a), rep.thr, st, path);
             }
         }
     }
@@ -472,9 +498,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         for (x, path) in x.chunks_exact_mut(n).zip(paths) {
             if !path.alive {
                 if REPORT {
-                    // A non-finite state stays outside every PRS.
-                    st.outside[k] += 1;
-                    st.candidates.push((k as u32, f64::INFINITY));
+                    st.ended(k);
                 }
                 continue;
             }
@@ -489,7 +513,62 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 let q = diag_quad(w, x, c);
                 let quiet = q < quiet;
                 if !quiet {
-                    path.alive = self.record(k, x, (q, q), thr, st, &mut path.outside_any);
+                    self.record(k, x, (q, q), thr, st, path);
+                }
+            }
+        }
+    }
+
+    /// [`additive_lanes`](Self::additive_lanes) for eight paths (`paths`, states `x`) through
+    /// every span, in the lanes of AVX-512 registers ([`super::avx512`]): the same draws and
+    /// the same IEEE operations in the same order per lane (the drift by
+    /// [`System::drift_x8`]), so the same paths and records. `quiet` is [`Lanes::quiet`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn additive_x8<D: Dim>(
+        &self,
+        dim: D,
+        x: &mut [f64],
+        paths: &mut [Path],
+        quiet: &[f64],
+        thresholds: &[f64],
+        st: &mut ChunkStats,
+    ) {
+        use crate::lanes::X8;
+        let n = dim.get();
+        let (Some(g), Some(w)) = (self.noise.diagonal(), self.metric.nonneg_diagonal()) else {
+            unreachable!("the caller checks additive diagonal noise and metric");
+        };
+        let mut live = 0u8;
+        for (a, path) in paths.iter().enumerate() {
+            live |= u8::from(path.alive) << a;
+        }
+        let mut group = super::avx512::Group8::new(n, x, std::array::from_fn(|a| paths[a].rng));
+        let mut f = [X8::splat(0.0); SMALL];
+        for (k, span) in (1..).zip(&self.spans) {
+            let h = span.h;
+            let ds = std::array::from_fn(|i| if i < n { g[i] * span.sqrt_h } else { 0.0 });
+            for step in 0..span.steps {
+                let t = span.t0 + f64::from(step) * h;
+                self.sys.drift_x8(&group.states()[..n], t, &mut f[..n]);
+                group.step(n, &f, h, &ds, self.zig, live);
+            }
+            // Lanes to record: ended paths, and states not below the quiet bound (or NaN).
+            let c = &self.nominal[k * n..][..n];
+            let (q, loud) = group.quad(n, w, c, quiet[k]);
+            let mut loud = loud | !live;
+            while loud != 0 {
+                let a = loud.trailing_zeros() as usize;
+                loud &= loud - 1;
+                let path = &mut paths[a];
+                if !path.alive {
+                    st.ended(k);
+                    continue;
+                }
+                let (xa, qa) = (group.lane(a), (q.0[a], q.0[a]));
+                self.record(k, &xa[..n], qa, thresholds[k], st, path);
+                if !path.alive {
+                    live &= !(1 << a);
                 }
             }
         }
@@ -559,9 +638,9 @@ impl<S: System + ?Sized> Plan<'_, S> {
         self.additive_lanes::<D, REPORT>(dim, step, scales, x, paths, st);
     }
 
-    /// Records the state at report step `k` (its membership and, above the candidate
-    /// threshold `thr`, its squared distance), given `(q, a) = metric.quad(x, x*_k)`; `false`
-    /// if the state is not finite.
+    /// Records `path`'s state `x` at report step `k` (its membership and, above the candidate
+    /// threshold `thr`, its squared distance), given `(q, a) = metric.quad(x, x*_k)`; the path
+    /// ends if the state is not finite.
     #[inline(never)]
     fn record(
         &self,
@@ -570,8 +649,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
         (q, a): (f64, f64),
         thr: f64,
         st: &mut ChunkStats,
-        outside_any: &mut bool,
-    ) -> bool {
+        path: &mut Path,
+    ) {
         let n = x.len();
         let c = &self.nominal[k * n..(k + 1) * n];
         // P is positive definite: a non-finite coordinate makes q non-finite.
@@ -585,12 +664,12 @@ impl<S: System + ?Sized> Plan<'_, S> {
         };
         if !inside {
             st.outside[k] += 1;
-            *outside_any = true;
+            path.outside_any = true;
         }
         if q > thr {
             st.candidates.push((k as u32, q));
         }
-        finite
+        path.alive = finite;
     }
 
     /// Unsafe-set entries and domain exits of a path at time `t`.

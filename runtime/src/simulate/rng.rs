@@ -7,9 +7,9 @@
 //! how paths were grouped, which is what makes the results independent of the thread count.
 
 /// wyrand's Weyl increment (odd).
-const INC: u64 = 0xa076_1d64_78bd_642f;
+pub(super) const INC: u64 = 0xa076_1d64_78bd_642f;
 /// wyrand's mixing constant.
-const MIX: u64 = 0xe703_7ed1_a0b4_28db;
+pub(super) const MIX: u64 = 0xe703_7ed1_a0b4_28db;
 
 /// Number of draws reserved for each path (the segment length).
 pub(crate) const DRAWS_PER_PATH: u64 = 1 << 32;
@@ -38,6 +38,16 @@ impl PathRng {
         PathRng {
             state: splitmix64(seed).wrapping_add(start),
         }
+    }
+
+    /// The stream at wyrand state `state` (see [`state`](Self::state)).
+    pub(super) fn at(state: u64) -> Self {
+        PathRng { state }
+    }
+
+    /// Its wyrand state: the stream continues from [`at`](Self::at) of it.
+    pub(super) fn state(self) -> u64 {
+        self.state
     }
 
     /// The next 64 random bits.
