@@ -167,6 +167,22 @@ fn legend<DB: DrawingBackend>(
     Ok(())
 }
 
+/// A chart on `area` in the figures' style (scale `s`): the caption `title`, the margin and
+/// the label areas.
+fn chart_builder<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    s: u32,
+) -> ChartBuilder<'a, 'static, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(title, (FAMILY, f64::from(22 * s)))
+        .margin(14 * s)
+        .x_label_area_size(50 * s)
+        .y_label_area_size(80 * s);
+    builder
+}
+
 /// Draws a chart's axes in the figures' style (scale `s`): the descriptions `desc` and tick
 /// labels by `fmt` (x, then y), a light grid at the labelled ticks only.
 fn mesh<DB: DrawingBackend, Y>(
@@ -248,11 +264,7 @@ impl Draw for SetsScene {
                 .chain(self.paths.iter().flatten().copied())
                 .chain(bounded.flat_map(|(x, y)| [[x.0, y.0], [x.1, y.1]])),
         );
-        let mut chart = ChartBuilder::on(&plot_area)
-            .caption(&self.title, (FAMILY, f(22)))
-            .margin(14 * s)
-            .x_label_area_size(50 * s)
-            .y_label_area_size(80 * s)
+        let mut chart = chart_builder(&plot_area, &self.title, s)
             .build_cartesian_2d(vx.0..vx.1, vy.0..vy.1)
             .map_err(err)?;
         let x_fmt = |v: &f64| tick(*v, vx.1 - vx.0);
@@ -451,7 +463,6 @@ impl Draw for RadiusScene {
         area: &DrawingArea<DB, Shift>,
         s: u32,
     ) -> Result<(), String> {
-        let f = |v: u32| f64::from(v * s);
         let (w, _) = area.dim_in_pixel();
         let (plot_area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s));
         let t_last = self.times.last().copied().unwrap_or(1.0);
@@ -467,12 +478,7 @@ impl Draw for RadiusScene {
             .collect();
         let top = values.iter().copied().fold(0.0, f64::max);
         let low = values.iter().copied().fold(f64::INFINITY, f64::min);
-        let mut builder = ChartBuilder::on(&plot_area);
-        builder
-            .caption(&self.title, (FAMILY, f(22)))
-            .margin(14 * s)
-            .x_label_area_size(50 * s)
-            .y_label_area_size(80 * s);
+        let mut builder = chart_builder(&plot_area, &self.title, s);
         // Exploding radii (an analysis whose c is positive) would flatten everything else.
         if top > LOG_RATIO * low {
             let chart = builder

@@ -27,20 +27,8 @@ const KEYS: &[&str] = &[
 
 impl Checker<'_> {
     pub(super) fn analysis(&mut self, name: &Ident, body: &Block, span: Span) {
-        if let Some(first) = self
-            .analyses
-            .iter()
-            .find(|a| a.name == name.name)
-            .map(|a| a.span.clone())
-        {
-            self.diags.push(
-                Diagnostic::error(
-                    format!("analysis `{}` is defined twice", name.name),
-                    name.span.clone(),
-                    "again",
-                )
-                .with_label(first, "first defined here"),
-            );
+        let first = self.analyses.iter().find(|a| a.name == name.name);
+        if self.defined_twice("analysis", name, first.map(|a| a.span.clone())) {
             return;
         }
         let f = self.fields(body, KEYS, "an analysis");

@@ -124,6 +124,21 @@ impl Checker<'_> {
         None
     }
 
+    /// Reports the `what` (an analysis, an unsafe set) called `name` defined again, given
+    /// `first`, the span of its first definition if there is one; `true` if it was.
+    fn defined_twice(&mut self, what: &str, name: &Ident, first: Option<Span>) -> bool {
+        let Some(first) = first else { return false };
+        self.diags.push(
+            Diagnostic::error(
+                format!("{what} `{}` is defined twice", name.name),
+                name.span.clone(),
+                "again",
+            )
+            .with_label(first, "first defined here"),
+        );
+        true
+    }
+
     /// Defines `name`, reporting a duplicate (with the earlier definition) or a builtin clash.
     fn define(&mut self, name: &Ident, sym: Symbol) -> bool {
         if scope::BUILTIN_NAMES.contains(&name.name.as_str())

@@ -244,20 +244,8 @@ impl Checker<'_> {
 
     /// `unsafe NAME box|ball|halfspace { ... }`.
     pub(super) fn unsafe_set(&mut self, name: &Ident, kind: &Ident, body: &Block, span: Span) {
-        if let Some(first) = self
-            .unsafe_sets
-            .iter()
-            .find(|u| u.name == name.name)
-            .map(|u| u.span.clone())
-        {
-            self.diags.push(
-                Diagnostic::error(
-                    format!("unsafe set `{}` is defined twice", name.name),
-                    name.span.clone(),
-                    "again",
-                )
-                .with_label(first, "first defined here"),
-            );
+        let first = self.unsafe_sets.iter().find(|u| u.name == name.name);
+        if self.defined_twice("unsafe set", name, first.map(|u| u.span.clone())) {
             return;
         }
         let shape = match kind.name.as_str() {
