@@ -4,7 +4,7 @@
 //!
 //! wyrand's 64 x 64 -> 128-bit product has no vector instruction; it is built from four
 //! 32 x 32 -> 64-bit products (`vpmuludq`), eight lanes at a time. The ziggurat's rectangle
-//! test (99% of the draws) runs in the lanes with two table gathers; the lanes that fail it
+//! test (98.5% of the draws) runs in the lanes with two table gathers; the lanes that fail it
 //! finish in the scalar [`Ziggurat::sample_slow`] with their own streams.
 
 use super::normal::{Ziggurat, TWO52};

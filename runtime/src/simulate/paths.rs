@@ -318,7 +318,6 @@ impl<S: System + ?Sized> Plan<'_, S> {
         let mut start = 0;
         #[cfg(target_arch = "x86_64")]
         if let (true, true, Some(quiet)) = (additive, self.avx512, &l.quiet) {
-            // Groups of eight paths in vector lanes, the rest below.
             start = lanes / 8 * 8;
             let groups =
                 l.x.chunks_exact_mut(8 * nn)
@@ -328,7 +327,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 unsafe { self.additive_x8(dim, x, paths, quiet, thresholds, st) };
             }
         }
-        // (None left: nothing to step.)
+        // The paths the lanes did not take, if any.
         let spans = if start < lanes { &self.spans[..] } else { &[] };
         for (k, span) in (1..).zip(spans) {
             if let Some(d) = self.noise.diagonal() {
