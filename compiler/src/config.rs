@@ -3,7 +3,7 @@
 //! ```no_run
 //! // build.rs of a crate depending on `reachc-runtime` (and on `reachc` as a build-dependency)
 //! fn main() -> Result<(), Box<dyn std::error::Error>> {
-//!     reachc::Config::new().compile(&["specs/pendulum.sde"])?;
+//!     reachc_compiler::Config::new().compile(&["specs/pendulum.sde"])?;
 //!     Ok(())
 //! }
 //! ```

@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use reachc::backend::codegen::{generate, generate_with, main_rs, Options, LANES_MAX_STATES};
-use reachc::backend::{mangle, prepare};
-use reachc::model::Model;
+use reachc_compiler::backend::codegen::{generate, generate_with, main_rs, Options, LANES_MAX_STATES};
+use reachc_compiler::backend::{mangle, prepare};
+use reachc_compiler::model::Model;
 
 fn specs() -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../specs");
@@ -21,7 +21,7 @@ fn specs() -> Vec<PathBuf> {
 
 /// Loads and prepares the spec, and generates its code twice (to check determinism).
 fn generate_for(path: &Path) -> (Model, String, String) {
-    let mut model = reachc::driver::load(path)
+    let mut model = reachc_compiler::driver::load(path)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         .model;
     let prepared = prepare(&mut model);
@@ -254,7 +254,7 @@ fn small_models_without_inputs_get_a_drift_in_lanes() {
         model.states.len() > LANES_MAX_STATES && !code.contains("X8"),
         "{code}"
     );
-    let mut model = reachc::driver::load(&lanes).unwrap().model;
+    let mut model = reachc_compiler::driver::load(&lanes).unwrap().model;
     let prepared = prepare(&mut model);
     let split = Options {
         split_above: 3,

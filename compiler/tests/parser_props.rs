@@ -5,8 +5,8 @@
 use proptest::prelude::*;
 use std::path::Path;
 
-use reachc::driver::check_source;
-use reachc::syntax::parse;
+use reachc_compiler::driver::check_source;
+use reachc_compiler::syntax::parse;
 
 /// A valid spec exercising every item kind (with a non-ASCII comment).
 const VALID: &str = "/// Doc line.

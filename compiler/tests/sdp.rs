@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use reachc::analysis::sdp::{jacobian_vertices, optimal_metric};
-use reachc::analysis::{constants, synthesize_metric, Derivatives};
+use reachc_compiler::analysis::sdp::{jacobian_vertices, optimal_metric};
+use reachc_compiler::analysis::{constants, synthesize_metric, Derivatives};
 
 fn spec(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -15,7 +15,7 @@ fn spec(name: &str) -> PathBuf {
 
 /// `(c default, c sdp, certified c of the SDP's P)` for one spec.
 fn compare(name: &str) -> (f64, f64, f64) {
-    let mut model = reachc::driver::load(&spec(name)).unwrap().model;
+    let mut model = reachc_compiler::driver::load(&spec(name)).unwrap().model;
     let d = Derivatives::of(&mut model);
     let p = synthesize_metric(&model, &d).unwrap();
     let c_default = constants(&model, &d, &p).unwrap().c;

@@ -379,7 +379,7 @@ pub fn simulate_cli<S: System + Sync>(
                 "  time: {secs:.3} s for {path_steps:.3e} path-steps ({:.3e} path-steps/s, {} \
                  threads)",
                 path_steps / secs,
-                a.opts.threads.unwrap_or_else(rayon::current_num_threads)
+                simulate::thread_count(a.opts.threads)
             );
         }
         let file = a.out_dir.join(format!("{}.sim.json", report.analysis));

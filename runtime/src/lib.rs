@@ -1,17 +1,11 @@
-//! Runtime for `reachc`-generated crates: outward-rounded intervals, the [`System`] trait the
-//! generated code implements, and the engines computing delta-probabilistic reachable sets.
+//! Runtime for `reachc`-generated crates: the core (`reachc-core`: intervals, the [`System`]
+//! trait, the data model, the engines and their typed results) re-exported, plus reports (JSON,
+//! CSV, text; feature `report`), parallel Monte Carlo (feature `simulate`) and the `main` of
+//! generated binaries (feature `app`).
 
+pub use reachc_core::{engine, func, interval, kappa, lanes, simulate, system, table};
+pub use reachc_core::{Interval, System, X8};
+
+#[cfg(feature = "app")]
 pub mod app;
-pub mod engine;
-pub mod func;
 mod include;
-pub mod interval;
-pub mod kappa;
-pub mod lanes;
-pub mod simulate;
-pub mod system;
-pub mod table;
-
-pub use interval::Interval;
-pub use lanes::X8;
-pub use system::System;

@@ -1,8 +1,8 @@
 //! The bad-spec corpus: every file in `tests/bad/` must fail to load with diagnostics that
 //! carry spans, and the rendered report is pinned by a snapshot.
 
-use reachc::diagnostics::render;
-use reachc::driver::{load, LoadError};
+use reachc_compiler::diagnostics::render;
+use reachc_compiler::driver::{load, LoadError};
 use reachc_e2e::relative;
 
 #[test]

@@ -9,12 +9,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use reachc::backend::codegen;
-use reachc::backend::crate_writer::{compile_crate_in, write_crate, CrateOptions, WrittenCrate};
-use reachc::backend::interp::Interpreter;
-use reachc::backend::prepare;
-use reachc::driver::load;
-use reachc::model::Model;
+use reachc_compiler::backend::codegen;
+use reachc_compiler::backend::crate_writer::{compile_crate_in, write_crate, CrateOptions, WrittenCrate};
+use reachc_compiler::backend::interp::Interpreter;
+use reachc_compiler::backend::prepare;
+use reachc_compiler::driver::load;
+use reachc_compiler::model::Model;
 use reachc_e2e::{relative, shipped_specs, workspace, Rng};
 use reachc_runtime::{Interval, System};
 

@@ -1,6 +1,6 @@
 //! Every ```sde example in docs/language.md parses (fragments get a `model` line first).
 
-use reachc::syntax::parse;
+use reachc_compiler::syntax::parse;
 use reachc_e2e::workspace;
 
 #[test]

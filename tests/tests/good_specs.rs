@@ -1,6 +1,6 @@
 //! Specs in `tests/good/` that stress the language (not shipped as examples) must check.
 
-use reachc::driver::load;
+use reachc_compiler::driver::load;
 use reachc_e2e::{relative, workspace};
 
 #[test]

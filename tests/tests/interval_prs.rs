@@ -2,8 +2,8 @@
 //! shipped spec (each inclusion function, with and without the spec's transforms) against
 //! sampled deterministic trajectories, and the paper's pendulum in `y = T x`.
 
-use reachc::backend::{interp::Interpreter, prepare};
-use reachc::driver::load;
+use reachc_compiler::backend::{interp::Interpreter, prepare};
+use reachc_compiler::driver::load;
 use reachc_e2e::{euler_maruyama, shipped_specs, workspace, Rng};
 use reachc_runtime::engine::{self, AnalysisResult, RunError};
 use reachc_runtime::system::{Analysis, Constants, Inclusion, Method, ModelInfo, Rate};

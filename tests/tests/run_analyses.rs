@@ -1,8 +1,8 @@
 //! Contraction-based delta-PRS end to end through the interpreter backend: constants, Psi and
 //! radii against closed forms and the 30-digit reference, and coverage against Monte Carlo.
 
-use reachc::backend::{interp::Interpreter, prepare};
-use reachc::driver::load;
+use reachc_compiler::backend::{interp::Interpreter, prepare};
+use reachc_compiler::driver::load;
 use reachc_e2e::{euler_maruyama, workspace, Rng};
 use reachc_runtime::engine::{self, AnalysisResult};
 use reachc_runtime::System;

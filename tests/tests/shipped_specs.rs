@@ -3,10 +3,10 @@
 
 use std::collections::HashMap;
 
-use reachc::analysis::Derivatives;
-use reachc::driver::{check_source, load};
-use reachc::ir::{ExprId, Names, VarValues};
-use reachc::model::Model;
+use reachc_compiler::analysis::Derivatives;
+use reachc_compiler::driver::{check_source, load};
+use reachc_compiler::ir::{ExprId, Names, VarValues};
+use reachc_compiler::model::Model;
 use reachc_e2e::{relative, shipped_specs, Rng};
 
 /// A random point: states in the domain (or within 3 of the initial set where unbounded),
@@ -174,7 +174,7 @@ fn printed_expressions_parse_back_to_the_same_function() {
         exprs.extend(d.jac_u.iter().flatten());
         exprs.extend(d.jac_g.iter().map(|g| g.expr));
         let names_of =
-            |v: &[reachc::model::Variable]| v.iter().map(|x| x.name.clone()).collect::<Vec<_>>();
+            |v: &[reachc_compiler::model::Variable]| v.iter().map(|x| x.name.clone()).collect::<Vec<_>>();
         let (s, u, w) = (
             names_of(&model.states),
             names_of(&model.inputs),
@@ -230,14 +230,14 @@ fn printed_expressions_parse_back_to_the_same_function() {
 
 /// The spec text with its `analysis` items cut out (located with the parser).
 fn without_analyses(source: &str) -> String {
-    let (spec, diags) = reachc::syntax::parse(source);
+    let (spec, diags) = reachc_compiler::syntax::parse(source);
     assert!(diags.is_empty(), "{diags:?}");
     let mut out = source.to_string();
     let mut spans: Vec<_> = spec
         .items
         .iter()
         .filter_map(|item| match item {
-            reachc::syntax::ast::Item::Analysis { span, .. } => Some(span.clone()),
+            reachc_compiler::syntax::ast::Item::Analysis { span, .. } => Some(span.clone()),
             _ => None,
         })
         .collect();

@@ -2,8 +2,8 @@
 //! delta-PRS (recomputed at delta = 0.01) holds the simulated states at every report time.
 //! The 10^5-path version of this check is a documented command (docs/results.md).
 
-use reachc::backend::{interp::Interpreter, prepare};
-use reachc::driver::load;
+use reachc_compiler::backend::{interp::Interpreter, prepare};
+use reachc_compiler::driver::load;
 use reachc_e2e::{relative, shipped_specs};
 use reachc_runtime::engine::{self, RunError};
 use reachc_runtime::simulate::{self, Options};

@@ -1,6 +1,6 @@
 //! Interval bounds of expressions over the model's domain, input box and time range.
 
-use reachc_runtime::interval::Interval;
+use reachc_core::interval::Interval;
 
 use crate::ir::{ExprId, VarValues};
 use crate::model::{Bounds, Model};

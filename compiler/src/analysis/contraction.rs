@@ -15,8 +15,8 @@
 use std::fmt;
 
 use nalgebra::{DMatrix, SymmetricEigen};
-use reachc_runtime::interval::Interval;
-use reachc_runtime::system::Constants;
+use reachc_core::interval::Interval;
+use reachc_core::system::Constants;
 
 use super::psd::{certify_min, is_psd, is_zero, sqrt_up, IMat, Pencil};
 use super::{bound_matrix, eval_box, split_atoms, time_range, Derivatives};
@@ -706,7 +706,7 @@ pub fn constants(
 }
 
 /// The constants of Assumption 1 without the contraction rate, for analyses whose rate is
-/// estimated at run time ([`Rate::Empirical`](reachc_runtime::system::Rate::Empirical)):
+/// estimated at run time ([`Rate::Empirical`](reachc_core::system::Rate::Empirical)):
 /// `sigma` and `rho` as in [`constants`], `c` infinite (not bounded here).
 pub fn constants_without_rate(
     model: &Model,

@@ -6,7 +6,7 @@
 //! if every real symmetric matrix inside the interval matrix is positive semidefinite, so the
 //! accepted `x` is a bound for the exact matrices, whatever the float estimate's error was.
 
-use reachc_runtime::interval::Interval;
+use reachc_core::interval::Interval;
 
 /// A dense `rows x cols` matrix of intervals, row-major.
 #[derive(Clone, Debug, PartialEq)]

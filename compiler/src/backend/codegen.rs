@@ -34,7 +34,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
-use reachc_runtime::system::{
+use reachc_core::system::{
     Analysis, Constants, Inclusion, InitialBall, InitialSet, Integrator, Method, ModelInfo,
     RadiusRule, Rate, UnsafeSet, UnsafeShape,
 };

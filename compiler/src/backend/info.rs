@@ -1,7 +1,7 @@
 //! What every backend needs: the Jacobians and the runtime's [`ModelInfo`], with the constants
 //! of Assumption 1 derived (and certified) for each analysis.
 
-use reachc_runtime::system::{self as rt, ModelInfo};
+use reachc_core::system::{self as rt, ModelInfo};
 
 use crate::analysis::{
     constants, constants_without_rate, synthesize_metric, ConstantsError, Derivatives, Frame,

@@ -3,7 +3,7 @@
 //! agree with generated code (the same operations in the same order; both use the runtime's
 //! special functions and table interpolation).
 
-use reachc_runtime::{Interval, System};
+use reachc_core::{Interval, System};
 
 use std::sync::Arc;
 

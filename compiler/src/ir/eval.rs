@@ -1,8 +1,8 @@
 //! Evaluation of expressions in any [`Arith`]: `f64` for point values, [`Interval`] for sound
 //! enclosures.
 
-use reachc_runtime::func;
-use reachc_runtime::interval::Interval;
+use reachc_core::func;
+use reachc_core::interval::Interval;
 
 use super::node::{ExprId, Func1, Func2, Node, Var};
 use super::pool::Pool;

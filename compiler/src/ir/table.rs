@@ -1,7 +1,7 @@
 //! Tabulated signals: piecewise-linear functions of time.
 
-use reachc_runtime::interval::Interval;
-use reachc_runtime::table;
+use reachc_core::interval::Interval;
+use reachc_core::table;
 
 /// A table of signals sampled at increasing times, linearly interpolated in between and held
 /// constant outside `[times[0], times[last]]`.
@@ -28,13 +28,13 @@ impl Table {
         table::column_range(&self.values[column])
     }
 
-    /// The signal `column` at time `t` (NaN for NaN); see [`reachc_runtime::table::eval`].
+    /// The signal `column` at time `t` (NaN for NaN); see [`reachc_core::table::eval`].
     pub fn eval_f64(&self, column: usize, t: f64) -> f64 {
         table::eval(&self.times, &self.values[column], t)
     }
 
     /// `(lo, hi)` enclosing the signal `column` over all times in `[t_lo, t_hi]`, rounded
-    /// outward; see [`reachc_runtime::table::eval_range`].
+    /// outward; see [`reachc_core::table::eval_range`].
     pub fn eval_range(&self, column: usize, t_lo: f64, t_hi: f64) -> (f64, f64) {
         table::eval_range(&self.times, &self.values[column], t_lo, t_hi)
     }

@@ -9,7 +9,7 @@ use crate::diagnostics::Span;
 use crate::ir::{ExprId, Pool, Table};
 
 // The analysis settings are the runtime's own types: the compiler hands them on unchanged.
-pub use reachc_runtime::system::{Inclusion, Integrator, Method, RadiusRule, Rate};
+pub use reachc_core::system::{Inclusion, Integrator, Method, RadiusRule, Rate};
 
 /// A checked spec, ready for analysis and code generation.
 #[derive(Clone, Debug)]

@@ -1,4 +1,4 @@
-//! The pendulum of `specs/pendulum.sde`, compiled by `build.rs` with `reachc::Config` and
+//! The pendulum of `specs/pendulum.sde`, compiled by `build.rs` with `reachc_compiler::Config` and
 //! included here: [`Pendulum`] implements `reachc_runtime::System`, [`info`] describes the spec's
 //! sets and analyses.
 

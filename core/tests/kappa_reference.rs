@@ -1,8 +1,8 @@
 //! `kappa(n, delta)` against the shared 30-digit reference values
 //! (`../shared/reference/kappa.jsonl`) and the structural properties of the rules.
 
-use reachc_runtime::kappa::{kappa, kappa_amgf, kappa_paper, kappa_paper_optimal, log_phi_lower};
-use reachc_runtime::system::RadiusRule;
+use reachc_core::kappa::{kappa, kappa_amgf, kappa_paper, kappa_paper_optimal, log_phi_lower};
+use reachc_core::system::RadiusRule;
 
 struct Row {
     n: usize,

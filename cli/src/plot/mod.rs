@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::system::{Analysis, ModelInfo, System};
 
-use crate::ir::Table;
+use reachc_compiler::ir::Table;
 use geometry::{Plane, Point};
 use input::ResultFile;
 use output::Draw;

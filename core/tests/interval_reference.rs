@@ -5,7 +5,7 @@
 // The table contains f64 values that happen to equal std constants.
 #![allow(clippy::approx_constant)]
 
-use reachc_runtime::interval::Interval;
+use reachc_core::interval::Interval;
 
 /// `r` contains the real `h + l` where `h` is its nearest f64.
 fn contains_dd(r: Interval, h: f64, l: f64) -> bool {

@@ -31,16 +31,17 @@ mod report;
 mod rng;
 mod sample;
 mod topk;
+mod workers;
 
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
 pub use inputs::InputMode;
 pub use report::{Coverage, HorizonReport, InputsReport, SimReport, SimStep, UnsafeHits};
 pub use sample::{sample_paths, MAX_SAMPLE_PATHS};
+pub use workers::thread_count;
 
 use crate::engine::AnalysisResult;
 use crate::system::{ModelInfo, System, UnsafeShape};
 use paths::{ChunkStats, Plan, Span};
-use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::fmt;
 
@@ -137,15 +138,7 @@ pub fn simulate<S: System + Sync + ?Sized>(
         .clamp(4 * CHUNK, MAX_BATCH)
         .div_ceil(CHUNK)
         * CHUNK;
-    let pool = match opts.threads {
-        Some(t) => Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .map_err(|e| SimError::Invalid(format!("cannot start {t} threads: {e}")))?,
-        ),
-        None => None,
-    };
+    let workers = workers::Workers::new(opts.threads)?;
     let mut topk = topk::TopK::new(steps, usize::try_from(j).unwrap_or(usize::MAX));
     let mut total = ChunkStats::new(steps, plan.unsafe_sets.len());
     let mut done = 0;
@@ -159,16 +152,7 @@ pub fn simulate<S: System + Sync + ?Sized>(
             .step_by(CHUNK as usize)
             .map(|s| (s, (s + CHUNK).min(end)))
             .collect();
-        let run = || -> Vec<ChunkStats> {
-            chunks
-                .into_par_iter()
-                .map(|(s, e)| plan.run_chunk(s..e, &thresholds))
-                .collect()
-        };
-        let stats = match &pool {
-            Some(p) => p.install(run),
-            None => run(),
-        };
+        let stats = workers.map(chunks, |(s, e)| plan.run_chunk(s..e, &thresholds));
         for c in &stats {
             total.merge(c);
             for &(k, d) in &c.candidates {

@@ -2,7 +2,7 @@
 //!
 //! Target: under 10 ms per `(n, delta)` in release for `n = 1000`, `delta = 1e-15` (amgf).
 
-use reachc_runtime::kappa::{kappa_amgf, kappa_paper, kappa_paper_optimal};
+use reachc_core::kappa::{kappa_amgf, kappa_paper, kappa_paper_optimal};
 
 fn main() {
     divan::main();

@@ -12,11 +12,11 @@ use reachc_runtime::interval::Interval;
 use serde::Serialize;
 use serde_json::{json, Value};
 
-use crate::analysis::{
+use reachc_compiler::analysis::{
     bound_matrix, eval_box, split_atoms, time_range, AtomSplit, Derivatives, GradEntry,
 };
-use crate::ir::{ExprId, Names};
-use crate::model::{Bounds, Model, UnsafeShape, Variable};
+use reachc_compiler::ir::{ExprId, Names};
+use reachc_compiler::model::{Bounds, Model, UnsafeShape, Variable};
 
 /// A dense matrix of expressions with its interval bounds.
 struct Matrix {
@@ -298,7 +298,7 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out)
 }
 
-fn unsafe_json(model: &Model, u: &crate::model::UnsafeSet) -> Value {
+fn unsafe_json(model: &Model, u: &reachc_compiler::model::UnsafeSet) -> Value {
     let name = |i: &usize| model.states[*i].name.clone();
     match &u.shape {
         UnsafeShape::Box(sides) => json!({"name": u.name, "kind": "box",

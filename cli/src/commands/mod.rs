@@ -12,8 +12,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::diagnostics::render;
-use crate::driver::{load, LoadError, Loaded};
+use reachc_compiler::diagnostics::render;
+use reachc_compiler::driver::{load, LoadError, Loaded};
 
 /// reachc: a compiler for stochastic reachability (delta-probabilistic reachable sets).
 #[derive(Parser, Debug)]

@@ -8,11 +8,11 @@ use clap::ValueEnum;
 
 use super::plot::{self, RunPlotArgs};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
-use crate::backend::crate_writer::{compile_crate, shared_target_dir, write_crate, CrateOptions};
-use crate::backend::interp::Interpreter;
-use crate::backend::{mangle, prepare};
-use crate::diagnostics::render;
-use crate::driver::Loaded;
+use reachc_compiler::backend::crate_writer::{compile_crate, shared_target_dir, write_crate, CrateOptions};
+use reachc_compiler::backend::interp::Interpreter;
+use reachc_compiler::backend::{mangle, prepare};
+use reachc_compiler::diagnostics::render;
+use reachc_compiler::driver::Loaded;
 use reachc_runtime::app::DEFAULT_OUT_DIR;
 use reachc_runtime::system::ModelInfo;
 

@@ -2,13 +2,13 @@
 //! linear system with an input (closed-form reachable set), soundness of the boxes on the
 //! paper's pendulum against sampled trajectories, safety margins, renderings.
 
-use reachc_runtime::engine::{self, RunError, Verdict};
-use reachc_runtime::interval::Interval;
-use reachc_runtime::system::{
+use reachc_core::engine::{self, RunError, Verdict};
+use reachc_core::interval::Interval;
+use reachc_core::system::{
     Analysis, Constants, Inclusion, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate,
     Transform, UnsafeSet, UnsafeShape,
 };
-use reachc_runtime::System;
+use reachc_core::System;
 
 // ---------------------------------------------------------------------------------------------
 // Systems

@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{load_reporting, EXIT_USAGE};
-use crate::backend::crate_writer::{compile_crate, write_crate, CrateOptions};
-use crate::backend::mangle;
-use crate::diagnostics::render;
+use reachc_compiler::backend::crate_writer::{compile_crate, write_crate, CrateOptions};
+use reachc_compiler::backend::mangle;
+use reachc_compiler::diagnostics::render;
 
 /// Runs `reachc build SPEC [-o OUT] [--no-compile] [--release]`: writes the crate (default
 /// `./<crate name>`), compiles it unless `no_compile`, and prints what was written and the

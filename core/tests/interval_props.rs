@@ -1,4 +1,4 @@
-//! Property tests for `reachc_runtime::interval::Interval`: for random
+//! Property tests for `reachc_core::interval::Interval`: for random
 //! intervals (infinite ends, tiny widths, points, neighbourhoods of `k*pi/2`
 //! and of 0) and random points inside them, the value of the function at
 //! the points lies in the interval result.
@@ -10,7 +10,7 @@
 //! functions the `std` f64 value at the point is used.
 
 use proptest::prelude::*;
-use reachc_runtime::interval::Interval;
+use reachc_core::interval::Interval;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 // ---------------------------------------------------------------------------

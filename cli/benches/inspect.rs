@@ -13,24 +13,24 @@ fn main() {
 
 /// Parse and check only.
 #[divan::bench(sample_count = 20)]
-fn load_chain1000() -> reachc::model::Model {
-    reachc::driver::load(&chain1000()).unwrap().model
+fn load_chain1000() -> reachc_compiler::model::Model {
+    reachc_compiler::driver::load(&chain1000()).unwrap().model
 }
 
 /// Everything `reachc inspect --json` does after reading the file.
 #[divan::bench(sample_count = 20)]
 fn inspect_json_chain1000() -> usize {
-    let mut model = reachc::driver::load(&chain1000()).unwrap().model;
+    let mut model = reachc_compiler::driver::load(&chain1000()).unwrap().model;
     let mut out = Vec::new();
-    reachc::cli::inspect::json(&mut model, &mut out).unwrap();
+    reachc::commands::inspect::json(&mut model, &mut out).unwrap();
     out.len()
 }
 
 /// The text report.
 #[divan::bench(sample_count = 20)]
 fn inspect_text_chain1000() -> usize {
-    let mut model = reachc::driver::load(&chain1000()).unwrap().model;
+    let mut model = reachc_compiler::driver::load(&chain1000()).unwrap().model;
     let mut out = Vec::new();
-    reachc::cli::inspect::text(&mut model, &mut out).unwrap();
+    reachc::commands::inspect::text(&mut model, &mut out).unwrap();
     out.len()
 }

@@ -1,14 +1,14 @@
 //! The contraction-based delta-PRS engine on hand-written systems: closed forms, a Monte Carlo
 //! check of the probability level, safety margins, and the paper's pendulum.
 
-use reachc_runtime::engine::{self, RunError, Verdict};
-use reachc_runtime::interval::Interval;
-use reachc_runtime::kappa::kappa;
-use reachc_runtime::system::{
+use reachc_core::engine::{self, RunError, Verdict};
+use reachc_core::interval::Interval;
+use reachc_core::kappa::kappa;
+use reachc_core::system::{
     Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate, Transform,
     UnsafeSet, UnsafeShape,
 };
-use reachc_runtime::System;
+use reachc_core::System;
 
 // ---------------------------------------------------------------------------------------------
 // Systems
@@ -715,7 +715,7 @@ fn euler_uneven_horizon_domain_and_ball() {
     // Ball of radius 0.5 over both states with metric diag(4, 1): bounding box (0.25, 0.5).
     inf.initial = InitialSet {
         boxes: vec![None, None],
-        balls: vec![reachc_runtime::system::InitialBall {
+        balls: vec![reachc_core::system::InitialBall {
             states: vec![0, 1],
             center: vec![1.0, -1.0],
             radius: 0.5,

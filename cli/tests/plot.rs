@@ -7,8 +7,8 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use reachc::backend::interp::Interpreter;
-use reachc::backend::prepare;
+use reachc_compiler::backend::interp::Interpreter;
+use reachc_compiler::backend::prepare;
 use reachc_runtime::engine;
 use reachc_runtime::simulate::{self, Options};
 
@@ -320,7 +320,7 @@ fn an_analysis_without_a_prs_gets_paths_and_unsafe_sets() {
 fn sample_paths_are_the_monte_carlo_paths() {
     // Path p of sample_paths is path p of simulate: the largest distance from the nominal at
     // each report time is the report's `max`.
-    let mut loaded = reachc::driver::load(Path::new(&spec("pendulum.sde"))).unwrap();
+    let mut loaded = reachc_compiler::driver::load(Path::new(&spec("pendulum.sde"))).unwrap();
     let prepared = prepare(&mut loaded.model);
     let info = prepared.info.clone();
     let interp = Interpreter::new(loaded.model, &prepared);

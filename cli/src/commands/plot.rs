@@ -15,9 +15,9 @@ use reachc_runtime::simulate::{self, SimReport};
 use reachc_runtime::system::ModelInfo;
 
 use super::{load_reporting, EXIT_USAGE};
-use crate::backend::interp::Interpreter;
-use crate::backend::prepare;
-use crate::driver::Loaded;
+use reachc_compiler::backend::interp::Interpreter;
+use reachc_compiler::backend::prepare;
+use reachc_compiler::driver::Loaded;
 use crate::plot::input::{ResultFile, SimFile};
 use crate::plot::{self, select, Choice, Model, Quantile};
 

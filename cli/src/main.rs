@@ -1,0 +1,5 @@
+//! The `reachc` binary; everything lives in the library (`reachc::commands`).
+
+fn main() -> std::process::ExitCode {
+    reachc::main()
+}

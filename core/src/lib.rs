@@ -1,0 +1,17 @@
+//! The core of reachc: outward-rounded intervals, the [`System`] trait generated code
+//! implements, the data model of a spec's sets and analyses, and the engines computing
+//! delta-probabilistic reachable sets, with typed results. No dependencies (rayon with the
+//! `parallel` feature, for Monte Carlo).
+
+pub mod engine;
+pub mod func;
+pub mod interval;
+pub mod kappa;
+pub mod lanes;
+pub mod simulate;
+pub mod system;
+pub mod table;
+
+pub use interval::Interval;
+pub use lanes::X8;
+pub use system::System;

@@ -1,0 +1,67 @@
+//! Where the Monte Carlo chunks run: on a rayon pool with the `parallel` feature, otherwise in
+//! order on the calling thread. Chunks are independent and merged in order, so the results are
+//! the same either way.
+
+use super::SimError;
+
+/// The workers of one simulation.
+pub(super) struct Workers {
+    /// A pool of the requested size (`None`: the current rayon pool).
+    #[cfg(feature = "parallel")]
+    pool: Option<rayon::ThreadPool>,
+}
+
+impl Workers {
+    /// `threads` workers, or the current rayon pool when `None` (one thread without the
+    /// `parallel` feature, whatever is asked).
+    pub(super) fn new(threads: Option<usize>) -> Result<Workers, SimError> {
+        #[cfg(feature = "parallel")]
+        {
+            let pool = match threads {
+                Some(t) => Some(
+                    rayon::ThreadPoolBuilder::new()
+                        .num_threads(t)
+                        .build()
+                        .map_err(|e| SimError::Invalid(format!("cannot start {t} threads: {e}")))?,
+                ),
+                None => None,
+            };
+            Ok(Workers { pool })
+        }
+        #[cfg(not(feature = "parallel"))]
+        {
+            let _ = threads;
+            Ok(Workers {})
+        }
+    }
+
+    /// `f` of each item, in the items' order.
+    pub(super) fn map<T: Send, R: Send>(&self, items: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            let run = || items.into_par_iter().map(&f).collect();
+            match &self.pool {
+                Some(p) => p.install(run),
+                None => run(),
+            }
+        }
+        #[cfg(not(feature = "parallel"))]
+        {
+            items.into_iter().map(f).collect()
+        }
+    }
+}
+
+/// The number of worker threads a simulation with `threads` uses.
+pub fn thread_count(threads: Option<usize>) -> usize {
+    #[cfg(feature = "parallel")]
+    {
+        threads.unwrap_or_else(rayon::current_num_threads)
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        let _ = threads;
+        1
+    }
+}
