@@ -324,11 +324,7 @@ fn sample_paths_are_the_monte_carlo_paths() {
     let prepared = prepare(&mut loaded.model);
     let info = prepared.info.clone();
     let interp = Interpreter::new(loaded.model, &prepared);
-    let analysis = info
-        .analyses
-        .iter()
-        .find(|a| a.name == "contraction")
-        .unwrap();
+    let analysis = info.analysis("contraction").unwrap();
     let result = engine::run(&interp, &info, analysis).unwrap();
     let opts = Options {
         paths: 64,
@@ -345,10 +341,10 @@ fn sample_paths_are_the_monte_carlo_paths() {
         let max = paths
             .iter()
             .map(|x| {
-                let d: Vec<f64> = (0..2).map(|i| x[2 * k + i] - step.nominal[i]).collect();
+                let d: Vec<f64> = (0..2).map(|i| x[2 * k + i] - step.nominal()[i]).collect();
                 (0..2)
                     .flat_map(|i| (0..2).map(move |j| (i, j)))
-                    .map(|(i, j)| p[i][j] * d[i] * d[j])
+                    .map(|(i, j)| p[i * 2 + j] * d[i] * d[j])
                     .sum::<f64>()
                     .sqrt()
             })

@@ -19,8 +19,10 @@ fn main() {
     divan::main();
 }
 
-fn pendulum() -> (Interpreter, reachc_runtime::system::ModelInfo) {
-    let mut model = reachc_compiler::driver::load(&spec("pendulum.sde")).unwrap().model;
+fn pendulum() -> (Interpreter, reachc_runtime::ModelInfo) {
+    let mut model = reachc_compiler::driver::load(&spec("pendulum.sde"))
+        .unwrap()
+        .model;
     let prepared = prepare(&mut model);
     (Interpreter::new(model, &prepared), prepared.info)
 }
@@ -28,11 +30,7 @@ fn pendulum() -> (Interpreter, reachc_runtime::system::ModelInfo) {
 #[divan::bench]
 fn contraction_prs_interpreted(bencher: divan::Bencher) {
     let (interp, info) = pendulum();
-    let analysis = info
-        .analyses
-        .iter()
-        .find(|a| a.name == "contraction")
-        .unwrap();
+    let analysis = info.analysis("contraction").unwrap();
     bencher.bench(|| {
         reachc_runtime::engine::run(&interp, &info, analysis)
             .unwrap()
@@ -57,18 +55,13 @@ fn interval_prs_interpreted(bencher: divan::Bencher, inclusion: &str) {
 
 /// The analysis `name` of `info` with the given inclusion function.
 fn with_inclusion(
-    info: &reachc_runtime::system::ModelInfo,
+    info: &reachc_runtime::ModelInfo,
     name: &str,
     inclusion: &str,
-) -> reachc_runtime::system::Analysis {
-    use reachc_runtime::system::Inclusion;
-    let mut a = info
-        .analyses
-        .iter()
-        .find(|a| a.name == name)
-        .unwrap()
-        .clone();
-    a.inclusion = match inclusion {
+) -> reachc_runtime::model::Analysis {
+    use reachc_runtime::model::Inclusion;
+    let mut a = info.analysis(name).unwrap().clone();
+    a.spec.inclusion = match inclusion {
         "natural" => Inclusion::Natural,
         "mixed" => Inclusion::Mixed,
         _ => Inclusion::Jacobian,
@@ -76,24 +69,26 @@ fn with_inclusion(
     a
 }
 
-/// The embedding system of `specs/chain1000.sde` resized to `n` states (`engine::reach`, Jacobian
-/// inclusion): 10 Euler steps (divide by 10 for one step). The cost of a step grows with the
+/// The embedding system of `specs/chain1000.sde` resized to `n` states
+/// (`engine::interval_boxes`, Jacobian inclusion): 10 Euler steps (divide by 10 for one step). The cost of a step grows with the
 /// size of the expressions (linear in n for the chain), not with n^2.
 #[divan::bench(args = [10, 100, 1000], sample_count = 20)]
 fn chain_embedding_10_steps(bencher: divan::Bencher, n: usize) {
     let src = std::fs::read_to_string(spec("chain1000.sde"))
         .unwrap()
         .replace("const N = 1000", &format!("const N = {n}"));
-    let mut model = reachc_compiler::driver::check_source(&src, &spec("")).0.unwrap();
+    let mut model = reachc_compiler::driver::check_source(&src, &spec(""))
+        .0
+        .unwrap();
     let prepared = prepare(&mut model);
     let info = prepared.info.clone();
     let interp = Interpreter::new(model, &prepared);
-    let mut a = with_inclusion(&info, "contraction", "jacobian");
-    a.method = reachc_runtime::system::Method::Interval;
-    a.integrator = reachc_runtime::system::Integrator::Euler;
+    let mut a = with_inclusion(&info, "contraction", "jacobian").spec;
+    a.method = reachc_runtime::model::Method::Interval;
+    a.integrator = reachc_runtime::model::Integrator::Euler;
     a.horizon = 10.0 * a.step;
     bencher.bench(|| {
-        reachc_runtime::engine::reach(&interp, &info, &a)
+        reachc_runtime::engine::interval_boxes(&interp, &info, &a)
             .unwrap()
             .len()
     });
@@ -114,7 +109,9 @@ fn drift_interpreted(bencher: divan::Bencher) {
 /// certified constants), generate and format the crate's sources.
 #[divan::bench(sample_count = 5)]
 fn build_chain1000_without_cargo() -> usize {
-    let mut model = reachc_compiler::driver::load(&spec("chain1000.sde")).unwrap().model;
+    let mut model = reachc_compiler::driver::load(&spec("chain1000.sde"))
+        .unwrap()
+        .model;
     let files = reachc_compiler::backend::crate_writer::generate_files(
         &mut model,
         &reachc_compiler::backend::crate_writer::CrateOptions::default(),

@@ -3,7 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use reachc_compiler::backend::codegen::{generate, generate_with, main_rs, Options, LANES_MAX_STATES};
+use reachc_compiler::backend::codegen::{
+    generate, generate_with, main_rs, Options, LANES_MAX_STATES,
+};
 use reachc_compiler::backend::{mangle, prepare};
 use reachc_compiler::model::Model;
 
@@ -61,7 +63,7 @@ fn every_shipped_spec_generates_parsable_deterministic_code() {
         // The drift in lanes exactly for small models without inputs.
         let lanes = model.inputs.is_empty() && model.states.len() <= LANES_MAX_STATES;
         assert_eq!(code.contains("fn drift_x8("), lanes, "{name}: drift_x8");
-        assert!(code.contains("pub fn info() -> reachc_runtime::system::ModelInfo"));
+        assert!(code.contains("pub fn info() -> reachc_runtime::model::ModelInfo"));
         assert!(code.contains(&format!("pub const N: usize = {};", model.states.len())));
         if !model.tables.is_empty() {
             assert!(code.contains("static T0_TIMES: [f64;"), "{name}");

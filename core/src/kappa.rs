@@ -14,7 +14,7 @@
 //!
 //! Only `std` is used.
 
-use crate::system::RadiusRule;
+use crate::model::RadiusRule;
 
 /// Relative margin added to every returned `kappa` (`kappa * (1 + KAPPA_MARGIN)`).
 ///

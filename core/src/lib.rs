@@ -8,10 +8,16 @@ pub mod func;
 pub mod interval;
 pub mod kappa;
 pub mod lanes;
+pub mod model;
+pub mod prs;
+mod reach;
 pub mod simulate;
 pub mod system;
 pub mod table;
 
 pub use interval::Interval;
 pub use lanes::X8;
+pub use model::{Bounds, ModelInfo};
+pub use prs::Prs;
+pub use reach::{InputPlan, Reach};
 pub use system::System;

@@ -1,14 +1,15 @@
 //! The contraction-based delta-PRS engine on hand-written systems: closed forms, a Monte Carlo
 //! check of the probability level, safety margins, and the paper's pendulum.
 
-use reachc_core::engine::{self, RunError, Verdict};
+use reachc_core::engine::{self, RunError};
 use reachc_core::interval::Interval;
 use reachc_core::kappa::kappa;
-use reachc_core::system::{
-    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate, Transform,
-    UnsafeSet, UnsafeShape,
+use reachc_core::model::{
+    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Integrator, Method, ModelInfo,
+    RadiusRule, Rate, Transform, UnsafeSet, UnsafeShape,
 };
-use reachc_core::System;
+use reachc_core::prs::{Prs, Unproved, UnsafeKind, Verdict};
+use reachc_core::{InputPlan, Reach, System};
 
 // ---------------------------------------------------------------------------------------------
 // Systems
@@ -180,19 +181,14 @@ fn identity(n: usize) -> Vec<f64> {
 
 fn analysis(delta: f64, horizon: f64, step: f64, constants: Constants) -> Analysis {
     Analysis {
-        name: "main".into(),
-        method: Method::Contraction,
-        delta,
-        horizon,
-        step,
-        radius: RadiusRule::Amgf,
-        rate: Rate::Certified,
-        integrator: Integrator::Rk4,
-        inclusion: Default::default(),
-        outputs: vec![],
-        constants: Some(constants),
-        constants_error: None,
-        transform: None,
+        spec: AnalysisSpec {
+            name: "main".into(),
+            delta,
+            horizon,
+            step,
+            ..AnalysisSpec::default()
+        },
+        constants: Ok(constants),
     }
 }
 
@@ -208,12 +204,18 @@ fn info(
         states: states.iter().map(|s| s.to_string()).collect(),
         inputs: (0..input_box.len()).map(|j| format!("u{j}")).collect(),
         noises: vec!["w".into()],
-        input_box,
+        input_box: input_box
+            .into_iter()
+            .map(|(a, b)| Bounds::new(a, b))
+            .collect(),
         initial: InitialSet {
-            boxes: boxes.into_iter().map(Some).collect(),
+            boxes: boxes
+                .into_iter()
+                .map(|(a, b)| Some(Bounds::new(a, b)))
+                .collect(),
             balls: vec![],
         },
-        domain: vec![(f64::NEG_INFINITY, f64::INFINITY); n],
+        domain: vec![Bounds::ENTIRE; n],
         has_domain: false,
         unsafe_sets: vec![],
         analyses: vec![],
@@ -227,27 +229,15 @@ fn linear_setup(delta: f64, horizon: f64, step: f64) -> (Linear, ModelInfo, Anal
         a: -0.4,
         s: 2f64.sqrt(),
     };
-    let constants = Constants {
-        metric: identity(2),
-        c: -0.4,
-        sigma: 2f64.sqrt(),
-        rho: 0.0,
-        how: "by hand".into(),
-    };
     let inf = info("linear", &["x1", "x2"], vec![(0.0, 0.0); 2], vec![]);
+    let constants = Constants::given(&inf, identity(2), -0.4, 2f64.sqrt(), 0.0);
     (sys, inf, analysis(delta, horizon, step, constants))
 }
 
 /// System (b): `x' = -x + u`, `u` in `[-1, 1]`, X0 = [0.5, 1.5].
 fn input_setup() -> (WithInput, ModelInfo, Analysis) {
-    let constants = Constants {
-        metric: vec![1.0],
-        c: -1.0,
-        sigma: 0.1,
-        rho: 1.0,
-        how: "by hand".into(),
-    };
     let inf = info("input", &["x"], vec![(0.5, 1.5)], vec![(-1.0, 1.0)]);
+    let constants = Constants::given(&inf, vec![1.0], -1.0, 0.1, 1.0);
     (WithInput, inf, analysis(0.01, 2.0, 0.1, constants))
 }
 
@@ -255,13 +245,6 @@ const PENDULUM_P: [f64; 4] = [35.68, 2.21, 2.21, 1.27];
 
 /// System (e): the pendulum with the paper's constants.
 fn pendulum_setup() -> (Pendulum, ModelInfo, Analysis) {
-    let constants = Constants {
-        metric: PENDULUM_P.to_vec(),
-        c: -0.5,
-        sigma: 0.1130,
-        rho: 0.0,
-        how: "paper, Sec. VIII-B".into(),
-    };
     let pi10 = std::f64::consts::PI / 10.0;
     let inf = info(
         "pendulum",
@@ -269,10 +252,12 @@ fn pendulum_setup() -> (Pendulum, ModelInfo, Analysis) {
         vec![(-pi10, pi10), (-0.2, 0.2)],
         vec![],
     );
+    // The paper's constants (Sec. VIII-B).
+    let constants = Constants::given(&inf, PENDULUM_P.to_vec(), -0.5, 0.1130, 0.0);
     (Pendulum, inf, analysis(1e-3, 4.0, 0.01, constants))
 }
 
-fn step_at(res: &engine::AnalysisResult, t: f64) -> usize {
+fn step_at(res: &Prs, t: f64) -> usize {
     res.steps
         .iter()
         .position(|s| (s.t - t).abs() < 1e-9)
@@ -317,28 +302,28 @@ fn linear_psi_matches_closed_form_and_r_uses_kappa() {
             "r^2/psi = {ratio}, kappa = {k}"
         );
         assert!(st.r_t * st.r_t >= st.psi * k * (1.0 - 1e-15));
-        assert_eq!(st.det_set.radius, 0.0);
-        assert_eq!(st.nominal, vec![0.0, 0.0]);
+        assert_eq!(st.det.radius(), 0.0);
+        assert_eq!(st.nominal(), [0.0, 0.0]);
         assert!(st.prs_radius >= st.r_t);
     }
     assert_eq!(res.steps[0].psi, 0.0);
     assert_eq!(res.steps[0].prs_radius, 0.0);
     eprintln!("max relative deviation of Psi from the closed form: {worst:e}");
     assert_eq!(res.verdict, Verdict::NoUnsafeSets);
-    assert!(!res.validated.conditional_on_domain);
+    assert!(!res.validation.conditional_on_domain);
 }
 
 #[test]
 fn paper_rules_report_eps() {
     let (sys, inf, mut an) = linear_setup(1e-3, 1.0, 0.1);
-    an.radius = RadiusRule::Paper(1.0 / 16.0);
+    an.spec.radius = RadiusRule::Paper(1.0 / 16.0);
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.radius_rule.rule, "paper");
+    assert_eq!(res.radius_rule.rule, RadiusRule::Paper(1.0 / 16.0));
     assert_eq!(res.radius_rule.eps, Some(1.0 / 16.0));
     assert_eq!(res.kappa, kappa(2, 1e-3, RadiusRule::Paper(1.0 / 16.0)));
-    an.radius = RadiusRule::PaperOptimal;
+    an.spec.radius = RadiusRule::PaperOptimal;
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.radius_rule.rule, "paper_optimal");
+    assert_eq!(res.radius_rule.rule, RadiusRule::PaperOptimal);
     let eps = res.radius_rule.eps.unwrap();
     assert!(eps > 0.0 && eps < 1.0);
 }
@@ -359,18 +344,18 @@ fn input_deterministic_radius() {
     for t in [1.0f64, 2.0] {
         let st = &res.steps[step_at(&res, t)];
         let expect = (-t).exp() * 0.5 + (1.0 - (-t).exp());
-        assert!(st.det_set.radius >= expect);
+        assert!(st.det.radius() >= expect);
         assert!(
-            (st.det_set.radius - expect).abs() <= 1e-14,
+            (st.det.radius() - expect).abs() <= 1e-14,
             "R_{t} = {} vs {expect}",
-            st.det_set.radius
+            st.det.radius()
         );
         // Nominal x* = e^-t (u = 0), RK4 at step 0.1.
-        assert!((st.nominal[0] - (-t).exp()).abs() < 1e-6);
-        assert!((st.prs_radius - (st.det_set.radius + st.r_t)).abs() <= 1e-15);
+        assert!((st.nominal()[0] - (-t).exp()).abs() < 1e-6);
+        assert!((st.prs_radius - (st.det.radius() + st.r_t)).abs() <= 1e-15);
     }
     // R_0 = r1.
-    assert_eq!(res.steps[0].det_set.radius, 0.5);
+    assert_eq!(res.steps[0].det.radius(), 0.5);
 }
 
 #[test]
@@ -379,12 +364,12 @@ fn membership() {
     let res = engine::run(&sys, &inf, &an).unwrap();
     let k = step_at(&res, 1.0);
     let st = &res.steps[k];
-    let (c, r) = (st.nominal[0], st.prs_radius);
-    assert!(engine::contains(&res, k, &[c]));
-    assert!(engine::contains(&res, k, &[c + 0.999 * r]));
-    assert!(engine::contains(&res, k, &[c - 0.999 * r]));
-    assert!(!engine::contains(&res, k, &[c + 1.001 * r]));
-    assert!(!engine::contains(&res, k, &[c - 1.001 * r]));
+    let (c, r) = (st.nominal()[0], st.prs_radius);
+    assert!(res.contains_at(k, &[c]));
+    assert!(res.contains_at(k, &[c + 0.999 * r]));
+    assert!(res.contains_at(k, &[c - 0.999 * r]));
+    assert!(!res.contains_at(k, &[c + 1.001 * r]));
+    assert!(!res.contains_at(k, &[c - 1.001 * r]));
 
     // Pendulum: the P-ball boundary along an eigen-direction of P.
     let (sys, inf, an) = pendulum_setup();
@@ -398,10 +383,10 @@ fn membership() {
         .sqrt();
     let at = |s: f64| {
         let f = s * st.prs_radius / norm;
-        [st.nominal[0] + f * d[0], st.nominal[1] + f * d[1]]
+        [st.nominal()[0] + f * d[0], st.nominal()[1] + f * d[1]]
     };
-    assert!(engine::contains(&res, k, &at(0.999)));
-    assert!(!engine::contains(&res, k, &at(1.001)));
+    assert!(res.contains_at(k, &at(0.999)));
+    assert!(!res.contains_at(k, &at(1.001)));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -454,7 +439,7 @@ fn monte_carlo_probability_level() {
             x1 += -0.4 * x1 * dt + sq * z1;
             x2 += -0.4 * x2 * dt + sq * z2;
         }
-        if !engine::contains(&res, k, &[x1, x2]) {
+        if !res.contains_at(k, &[x1, x2]) {
             outside += 1;
         }
         norms.push((x1 * x1 + x2 * x2).sqrt());
@@ -498,7 +483,7 @@ fn half_space_safety() {
     // P = I: max of a.x over the ball is |a| R, margin = (100 - 5 R) / 5 = 20 - R.
     let far = &res.unsafe_sets[0];
     assert!(far.safe);
-    assert_eq!(far.kind, "half_space");
+    assert_eq!(far.kind, UnsafeKind::HalfSpace);
     let last = res.steps.last().unwrap();
     let expect = 20.0 - last.prs_radius;
     assert!(far.min_margin <= expect && expect - far.min_margin < 1e-12);
@@ -515,10 +500,9 @@ fn half_space_safety() {
         Verdict::NotShownSafe {
             t: 0.0,
             step: 0,
-            set: "crossing".into()
+            set: 1
         }
     );
-    assert!(res.summary().contains("not shown safe"));
 }
 
 #[test]
@@ -528,7 +512,7 @@ fn safety_against_boxes_and_balls() {
     inf.unsafe_sets = vec![
         UnsafeSet {
             name: "box_far".into(),
-            shape: UnsafeShape::Box(vec![(0, (5.0, f64::INFINITY))]),
+            shape: UnsafeShape::Box(vec![(0, Bounds::new(5.0, f64::INFINITY))]),
         },
         UnsafeSet {
             name: "ball_far".into(),
@@ -540,12 +524,12 @@ fn safety_against_boxes_and_balls() {
         },
         UnsafeSet {
             name: "box_hit".into(),
-            shape: UnsafeShape::Box(vec![(0, (0.9, 1.1))]),
+            shape: UnsafeShape::Box(vec![(0, Bounds::new(0.9, 1.1))]),
         },
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();
     for st in &res.steps {
-        let (x, r) = (st.nominal[0], st.prs_radius);
+        let (x, r) = (st.nominal()[0], st.prs_radius);
         let box_gap = 5.0 - (x + r);
         assert!(st.margins[0] <= box_gap && box_gap - st.margins[0] < 1e-12);
         let ball_gap = (x + 4.0) - r - 1.0;
@@ -553,7 +537,7 @@ fn safety_against_boxes_and_balls() {
     }
     assert!(res.unsafe_sets[0].safe && res.unsafe_sets[1].safe);
     assert!(!res.unsafe_sets[2].safe);
-    assert!(matches!(&res.verdict, Verdict::NotShownSafe { set, .. } if set == "box_hit"));
+    assert!(matches!(res.verdict, Verdict::NotShownSafe { set: 2, .. }));
 }
 
 #[test]
@@ -569,7 +553,7 @@ fn pendulum_half_space_uses_inverse_metric() {
         },
         UnsafeSet {
             name: "omega_box".into(),
-            shape: UnsafeShape::Box(vec![(1, (3.0, 4.0))]),
+            shape: UnsafeShape::Box(vec![(1, Bounds::new(3.0, 4.0))]),
         },
         UnsafeSet {
             name: "ball".into(),
@@ -592,7 +576,7 @@ fn pendulum_half_space_uses_inverse_metric() {
     let (tr, dt) = (pinv[0] + pinv[3], pinv[0] * pinv[3] - pinv[1] * pinv[2]);
     let lmax = tr / 2.0 + (tr * tr / 4.0 - dt).sqrt();
     for st in &res.steps {
-        let (x, r) = (&st.nominal, st.prs_radius);
+        let (x, r) = (&st.nominal(), st.prs_radius);
         let e0 = 1.0 - x[0] - r * pinv[0].sqrt();
         assert!(
             st.margins[0] <= e0 && e0 - st.margins[0] < 1e-12,
@@ -601,12 +585,33 @@ fn pendulum_half_space_uses_inverse_metric() {
         );
         let e1 = 3.0 - (x[1] + r * pinv[3].sqrt());
         assert!(st.margins[1] <= e1 && e1 - st.margins[1] < 1e-12);
-        let e2 = (x[0] * x[0] + (x[1] - 5.0).powi(2)).sqrt() - r * lmax.sqrt() - 0.5;
+        // A ball: the larger of two lower bounds of the gap, through the ellipse's spread
+        // and through its bounding box.
+        let by_spread = (x[0] * x[0] + (x[1] - 5.0).powi(2)).sqrt() - r * lmax.sqrt() - 0.5;
+        let gap = |c: f64, w: f64| (c.abs() - w).max(0.0);
+        let (w0, w1) = (r * pinv[0].sqrt(), r * pinv[3].sqrt());
+        let by_box = (gap(x[0], w0).powi(2) + gap(x[1] - 5.0, w1).powi(2)).sqrt() - 0.5;
+        let want = by_spread.max(by_box);
         assert!(
-            st.margins[2] <= e2 && e2 - st.margins[2] < 1e-9,
-            "{} {e2}",
+            st.margins[2] <= want && want - st.margins[2] < 1e-9,
+            "{} {want}",
             st.margins[2]
         );
+        // Sound: no point of the PRS (its boundary, sampled) is closer to the unsafe ball.
+        let closest = (0..720)
+            .map(|k| {
+                // |d|_P = r on the ellipse: d = r L^-T (cos, sin) with P = L L'.
+                let a = f64::from(k) * std::f64::consts::PI / 360.0;
+                let l11 = PENDULUM_P[0].sqrt();
+                let l21 = PENDULUM_P[2] / l11;
+                let l22 = (PENDULUM_P[3] - l21 * l21).sqrt();
+                let (u, v) = (a.cos(), a.sin());
+                let d1 = v / l22;
+                let d0 = (u - l21 * d1) / l11;
+                ((x[0] + r * d0).powi(2) + (x[1] + r * d1 - 5.0).powi(2)).sqrt() - 0.5
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(st.margins[2] <= closest, "{} > {closest}", st.margins[2]);
     }
     assert_eq!(res.verdict, Verdict::Safe);
 }
@@ -629,11 +634,11 @@ fn pendulum_radii_finite_and_decreasing() {
     assert!(res.r1 >= r1 && res.r1 - r1 < 1e-14);
     for st in &res.steps {
         assert!(st.prs_radius.is_finite() && st.r_t.is_finite() && st.psi.is_finite());
-        assert!(st.nominal.iter().all(|v| v.is_finite()));
+        assert!(st.nominal().iter().all(|v| v.is_finite()));
     }
     for w in res.steps.windows(2) {
         // R_t decreases throughout; the PRS radius once the stochastic part has built up.
-        assert!(w[1].det_set.radius < w[0].det_set.radius);
+        assert!(w[1].det.radius() < w[0].det.radius());
         assert!(w[1].r_t >= w[0].r_t);
         if w[0].t >= 0.5 {
             assert!(w[1].prs_radius < w[0].prs_radius, "t = {}", w[1].t);
@@ -641,29 +646,16 @@ fn pendulum_radii_finite_and_decreasing() {
     }
     let last = res.steps.last().unwrap();
     // R_4 = e^-2 r1; r_4 = sqrt(sigma^2 (1 - e^-4) kappa).
-    assert!((last.det_set.radius - (-2.0f64).exp() * r1).abs() < 1e-12);
+    assert!((last.det.radius() - (-2.0f64).exp() * r1).abs() < 1e-12);
     let psi4 = 0.1130f64.powi(2) * (-(-4.0f64).exp_m1());
     assert!((last.psi - psi4).abs() < 1e-12 * psi4);
     eprintln!(
         "pendulum t = 4: R = {:.6}, r = {:.6}, PRS radius = {:.6}, kappa = {:.6}",
-        last.det_set.radius, last.r_t, last.prs_radius, res.kappa
+        last.det.radius(),
+        last.r_t,
+        last.prs_radius,
+        res.kappa
     );
-    // The outputs render.
-    let json = res.to_json();
-    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-    assert_eq!(v["model"], "pendulum");
-    assert_eq!(v["steps"].as_array().unwrap().len(), 401);
-    let mut csv = Vec::new();
-    res.write_csv(&mut csv).unwrap();
-    let csv = String::from_utf8(csv).unwrap();
-    assert_eq!(
-        csv.lines().next().unwrap(),
-        "t,theta,omega,det_radius,r_t,psi,c,sigma,prs_radius"
-    );
-    assert_eq!(csv.lines().count(), 402);
-    let summary = res.summary();
-    assert!(summary.contains("kappa") && summary.contains("amgf"));
-    eprintln!("{summary}");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -674,8 +666,8 @@ fn pendulum_radii_finite_and_decreasing() {
 fn errors() {
     let (sys, inf, mut an) = linear_setup(1e-3, 1.0, 0.1);
     // A coordinate transform needs the system's transformed frame, which this one lacks.
-    an.method = Method::Interval;
-    an.transform = Some(Transform {
+    an.spec.method = Method::Interval;
+    an.spec.transform = Some(Transform {
         matrix: identity(sys.n),
         inverse: identity(sys.n),
         frame: 0,
@@ -684,21 +676,20 @@ fn errors() {
         engine::run(&sys, &inf, &an),
         Err(RunError::Unsupported(_))
     ));
-    an.transform = None;
-    an.method = Method::Contraction;
-    let constants = an.constants.take();
-    an.constants_error = Some("d f[x1]/d x1 is unbounded".into());
+    an.spec.transform = None;
+    an.spec.method = Method::Contraction;
+    let constants = std::mem::replace(&mut an.constants, Err("d f[x1]/d x1 is unbounded".into()));
     match engine::run(&sys, &inf, &an) {
         Err(RunError::NoConstants(m)) => assert!(m.contains("unbounded"), "{m}"),
         other => panic!("expected NoConstants, got {other:?}"),
     }
     an.constants = constants;
-    an.delta = 1.5;
+    an.spec.delta = 1.5;
     assert!(matches!(
         engine::run(&sys, &inf, &an),
         Err(RunError::Invalid(_))
     ));
-    an.delta = 1e-3;
+    an.spec.delta = 1e-3;
     let mut bad = an.clone();
     bad.constants.as_mut().unwrap().metric = vec![1.0, 2.0, 2.0, 1.0];
     assert!(matches!(
@@ -710,12 +701,12 @@ fn errors() {
 #[test]
 fn euler_uneven_horizon_domain_and_ball() {
     let (sys, mut inf, mut an) = linear_setup(1e-2, 1.05, 0.1);
-    an.integrator = Integrator::Euler;
+    an.spec.integrator = Integrator::Euler;
     inf.has_domain = true;
     // Ball of radius 0.5 over both states with metric diag(4, 1): bounding box (0.25, 0.5).
     inf.initial = InitialSet {
         boxes: vec![None, None],
-        balls: vec![reachc_core::system::InitialBall {
+        balls: vec![reachc_core::model::Ball {
             states: vec![0, 1],
             center: vec![1.0, -1.0],
             radius: 0.5,
@@ -730,13 +721,9 @@ fn euler_uneven_horizon_domain_and_ball() {
     let r1 = (0.25f64 * 0.25 + 0.25).sqrt();
     assert!(res.r1 >= r1 && res.r1 - r1 < 1e-14);
     // Euler: x*_{k+1} = (1 - 0.04) x*_k on full steps.
-    assert!((res.steps[1].nominal[0] - 0.96).abs() < 1e-15);
-    assert!(res.validated.conditional_on_domain);
-    assert!(res
-        .validated
-        .not_validated
-        .iter()
-        .any(|s| s.contains("domain")));
+    assert!((res.steps[1].nominal()[0] - 0.96).abs() < 1e-15);
+    assert!(res.validation.conditional_on_domain);
+    assert!(res.validation.not_validated.contains(&Unproved::Domain));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -760,22 +747,22 @@ fn empirical_rate_of_a_linear_drift_is_its_rate() {
     ] {
         let exact = certified.constants.as_ref().unwrap().c;
         let mut empirical = certified.clone();
-        empirical.rate = Rate::Empirical { paths: 50 };
+        empirical.spec.rate = Rate::Empirical { paths: 50 };
         // The compiler leaves c unbounded for an empirical analysis.
         empirical.constants.as_mut().unwrap().c = f64::INFINITY;
         let want = engine::run(sys.as_ref(), &inf, &certified).unwrap();
         let got = engine::run(sys.as_ref(), &inf, &empirical).unwrap();
-        assert_eq!(got.rate.kind, "empirical");
-        assert_eq!(got.rate.paths, Some(50));
-        assert!(got.rate.note.contains("not a guarantee"));
-        assert!(got.validated.not_validated[0].starts_with("EMPIRICAL"));
-        assert!(got.summary().contains("rate: EMPIRICAL"));
+        assert_eq!(got.rate.rate, Rate::Empirical { paths: 50 });
+        assert_eq!(
+            got.validation.not_validated[0],
+            Unproved::EmpiricalRate { paths: 50 }
+        );
         assert!((got.rate.max_c - exact).abs() < 1e-12, "{}", got.rate.max_c);
         for (a, b) in want.steps.iter().zip(&got.steps) {
             assert!((b.c - exact).abs() < 1e-12, "t = {}: c = {}", b.t, b.c);
             let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(1e-12);
             assert!(close(a.r_t, b.r_t), "t = {}: {} vs {}", a.t, a.r_t, b.r_t);
-            assert!(close(a.det_set.radius, b.det_set.radius), "t = {}", a.t);
+            assert!(close(a.det.radius(), b.det.radius()), "t = {}", a.t);
         }
     }
 }
@@ -789,11 +776,163 @@ fn empirical_rate_needs_no_certified_c_and_not_the_interval_method() {
         engine::run(&sys, &inf, &an),
         Err(RunError::NoConstants(_))
     ));
-    an.rate = Rate::Empirical { paths: 20 };
+    an.spec.rate = Rate::Empirical { paths: 20 };
     assert!(engine::run(&sys, &inf, &an).is_ok());
-    an.method = Method::Interval;
+    an.spec.method = Method::Interval;
     assert!(matches!(
         engine::run(&sys, &inf, &an),
         Err(RunError::Unsupported(_))
     ));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The `Reach` handle
+// ---------------------------------------------------------------------------------------------
+
+/// `from_box` is the run from that box; `at`, `contains` and `hull` answer at report times.
+#[test]
+fn reach_from_a_box_is_the_run_from_that_box() {
+    let (sys, mut inf, an) = pendulum_setup();
+    inf.analyses = vec![an];
+    let reach = Reach::new(&sys, &inf, "main").unwrap();
+    let x0 = [Bounds::new(0.1, 0.2), Bounds::new(-0.05, 0.0)];
+    let prs = reach.from_box(&x0).unwrap();
+    let mut moved = inf.clone();
+    moved.initial = InitialSet::from_box(&x0);
+    let direct = engine::run(&sys, &moved, &moved.analyses[0]).unwrap();
+    assert_eq!(prs.steps, direct.steps);
+    assert_eq!(prs.r1, direct.r1);
+    // The spec's own initial set gives another (larger) PRS.
+    assert!(reach.run().unwrap().r1 > prs.r1);
+    // Report times only, found from a literal time.
+    let st = prs.at(0.3).unwrap();
+    assert_eq!(st.t, prs.steps[30].t);
+    assert!(prs.at(0.305).is_none() && prs.contains(&[0.0, 0.0], 0.305).is_none());
+    assert_eq!(prs.contains(st.nominal(), 0.3), Some(true));
+    // The hull: the P-ball's extent along each axis, r sqrt((P^-1)_ii), rounded outward.
+    let det = PENDULUM_P[0] * PENDULUM_P[3] - PENDULUM_P[1] * PENDULUM_P[2];
+    let spread = [PENDULUM_P[3] / det, PENDULUM_P[0] / det].map(f64::sqrt);
+    let hull = prs.hull(0.3).unwrap();
+    for i in 0..2 {
+        let (c, e) = (st.nominal()[i], st.prs_radius * spread[i]);
+        assert!(
+            hull[i].lo <= c - e && c - e - hull[i].lo < 1e-12,
+            "{hull:?}"
+        );
+        assert!(
+            hull[i].hi >= c + e && hull[i].hi - (c + e) < 1e-12,
+            "{hull:?}"
+        );
+        // The hull is tight: the P-ball's extreme point along axis i, c + r P^-1 e_i /
+        // sqrt((P^-1)_ii), is in the PRS when pulled in slightly, not when pushed out.
+        let pinv_col = [
+            [PENDULUM_P[3] / det, -PENDULUM_P[2] / det],
+            [-PENDULUM_P[1] / det, PENDULUM_P[0] / det],
+        ][i];
+        for (s, inside) in [(0.999, true), (1.001, false)] {
+            let x: Vec<f64> = (0..2)
+                .map(|j| st.nominal()[j] + s * st.prs_radius * pinv_col[j] / spread[i])
+                .collect();
+            assert_eq!(prs.contains(&x, 0.3), Some(inside), "axis {i}, {s}");
+        }
+    }
+}
+
+/// What the constants were certified for cannot be changed: another domain or input box in
+/// the model data, or an initial set outside the spec's domain, is refused.
+#[test]
+fn reach_refuses_what_the_constants_do_not_cover() {
+    let (sys, mut inf, an) = input_setup();
+    inf.analyses = vec![an];
+    assert!(Reach::new(&sys, &inf, "main").is_ok());
+    assert!(matches!(
+        Reach::new(&sys, &inf, "other"),
+        Err(RunError::UnknownAnalysis { .. })
+    ));
+    let mut wider = inf.clone();
+    wider.input_box = vec![Bounds::new(-2.0, 2.0)];
+    match Reach::new(&sys, &wider, "main").map(|_| ()) {
+        Err(RunError::Invalid(m)) => assert!(m.contains("input box"), "{m}"),
+        other => panic!("expected Invalid, got {other:?}"),
+    }
+    let mut bounded = inf.clone();
+    bounded.domain = vec![Bounds::new(-5.0, 5.0)];
+    bounded.has_domain = true;
+    assert!(matches!(
+        engine::run(&sys, &bounded, &bounded.analyses[0]),
+        Err(RunError::Invalid(m)) if m.contains("domain")
+    ));
+    // With constants certified over that domain: initial sets inside it run, others do not.
+    let constants = Constants::given(&bounded, vec![1.0], -1.0, 0.1, 1.0);
+    bounded.analyses[0].constants = Ok(constants);
+    let reach = Reach::new(&sys, &bounded, "main").unwrap();
+    assert!(reach.from_box(&[Bounds::new(4.0, 5.0)]).is_ok());
+    match reach.from_box(&[Bounds::new(4.0, 5.5)]).map(|_| ()) {
+        Err(RunError::Invalid(m)) => assert!(m.contains("leaves the domain"), "{m}"),
+        other => panic!("expected Invalid, got {other:?}"),
+    }
+    // A longer horizon than certified.
+    let mut longer = inf.clone();
+    longer.analyses[0].constants.as_mut().unwrap().region.time = Bounds::new(0.0, 1.0);
+    assert!(Reach::new(&sys, &longer, "main").is_err());
+}
+
+/// A known input: no input uncertainty (`R_t = e^(ct) r1`), the nominal follows the plan, and
+/// a plan outside the input box is refused.
+#[test]
+fn reach_under_an_input_plan() {
+    let (sys, mut inf, an) = input_setup();
+    inf.analyses = vec![an];
+    let reach = Reach::new(&sys, &inf, "main").unwrap();
+    let x0 = [Bounds::new(0.9, 1.1)];
+    let plan = InputPlan::steps(vec![0.0, 1.0], vec![vec![0.5], vec![-0.5]]).unwrap();
+    let prs = reach.from_box_with(&x0, &plan).unwrap();
+    let free = reach.from_box(&x0).unwrap();
+    assert_eq!(prs.r2, 0.0);
+    assert_eq!(prs.input_center, [0.5]);
+    for (st, any) in prs.steps.iter().zip(&free.steps) {
+        // x' = -x + u from x0 = 1 (RK4 with step 0.1: within 1e-6 of the exact solution).
+        let x = if st.t <= 1.0 {
+            0.5 + 0.5 * (-st.t).exp()
+        } else {
+            let x1 = 0.5 + 0.5 * (-1.0f64).exp();
+            -0.5 + (x1 + 0.5) * (-(st.t - 1.0)).exp()
+        };
+        assert!((st.nominal()[0] - x).abs() < 1e-6, "t = {}", st.t);
+        let r = (-st.t).exp() * 0.1;
+        assert!(st.det.radius() >= r && st.det.radius() - r < 1e-12);
+        // The free input's set also covers the input's uncertainty.
+        assert!(any.det.radius() >= st.det.radius());
+    }
+    let outside = InputPlan::constant(&[1.5]);
+    assert!(matches!(
+        reach.from_box_with(&x0, &outside),
+        Err(RunError::Invalid(m)) if m.contains("input box")
+    ));
+    assert!(InputPlan::steps(vec![0.5], vec![vec![0.0]]).is_err());
+    // A plan is not simulated with random inputs: the simulator refuses it.
+    let opts = reachc_core::simulate::Options::default();
+    assert!(reachc_core::simulate::simulate(&sys, &inf, &prs, &opts, &mut |_, _| {}).is_err());
+}
+
+/// Another delta changes the stochastic radius only, by the ratio of the kappas.
+#[test]
+fn reach_at_another_delta() {
+    let (sys, mut inf, an) = linear_setup(1e-3, 1.0, 0.1);
+    inf.analyses = vec![an];
+    let base = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
+    let wide = Reach::new(&sys, &inf, "main")
+        .unwrap()
+        .with_delta(0.1)
+        .unwrap()
+        .run()
+        .unwrap();
+    let ratio = (kappa(2, 0.1, RadiusRule::Amgf) / kappa(2, 1e-3, RadiusRule::Amgf)).sqrt();
+    let (a, b) = (&base.steps[10], &wide.steps[10]);
+    assert!((b.r_t / a.r_t - ratio).abs() < 1e-12);
+    assert_eq!(wide.delta, 0.1);
+    assert!(Reach::new(&sys, &inf, "main")
+        .unwrap()
+        .with_delta(1.0)
+        .is_err());
 }

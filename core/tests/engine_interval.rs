@@ -2,13 +2,14 @@
 //! linear system with an input (closed-form reachable set), soundness of the boxes on the
 //! paper's pendulum against sampled trajectories, safety margins, renderings.
 
-use reachc_core::engine::{self, RunError, Verdict};
+use reachc_core::engine::{self, RunError};
 use reachc_core::interval::Interval;
-use reachc_core::system::{
-    Analysis, Constants, Inclusion, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate,
-    Transform, UnsafeSet, UnsafeShape,
+use reachc_core::model::{
+    Analysis, AnalysisSpec, Bounds, Constants, Inclusion, InitialSet, Integrator, Method,
+    ModelInfo, Transform, UnsafeSet, UnsafeShape,
 };
-use reachc_core::System;
+use reachc_core::prs::{DetSet, Prs, Unproved, Verdict};
+use reachc_core::{Reach, System};
 
 // ---------------------------------------------------------------------------------------------
 // Systems
@@ -108,20 +109,29 @@ impl System for Pendulum {
 
 fn analysis(horizon: f64, step: f64, integrator: Integrator, constants: Constants) -> Analysis {
     Analysis {
-        name: "boxes".into(),
-        method: Method::Interval,
-        delta: 0.01,
-        horizon,
-        step,
-        radius: RadiusRule::Amgf,
-        rate: Rate::Certified,
-        integrator,
-        inclusion: Default::default(),
-        outputs: vec![],
-        constants: Some(constants),
-        constants_error: None,
-        transform: None,
+        spec: AnalysisSpec {
+            name: "boxes".into(),
+            method: Method::Interval,
+            delta: 0.01,
+            horizon,
+            step,
+            integrator,
+            ..AnalysisSpec::default()
+        },
+        constants: Ok(constants),
     }
+}
+
+/// The PRS of `analysis` with another inclusion function.
+fn run_with(
+    sys: &dyn System,
+    info: &ModelInfo,
+    a: &Analysis,
+    inclusion: Inclusion,
+) -> Result<Prs, RunError> {
+    Reach::for_analysis(sys, info, a)?
+        .with_inclusion(inclusion)
+        .run()
 }
 
 fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
@@ -130,12 +140,12 @@ fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
         states: vec!["x".into()],
         inputs: vec!["u".into()],
         noises: vec!["w".into()],
-        input_box: vec![(-1.0, 1.0)],
+        input_box: vec![Bounds::new(-1.0, 1.0)],
         initial: InitialSet {
-            boxes: vec![Some((0.5, 1.5))],
+            boxes: vec![Some(Bounds::new(0.5, 1.5))],
             balls: vec![],
         },
-        domain: vec![(f64::NEG_INFINITY, f64::INFINITY)],
+        domain: vec![Bounds::ENTIRE],
         has_domain: false,
         unsafe_sets,
         analyses: vec![],
@@ -143,13 +153,7 @@ fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
 }
 
 fn lin_constants() -> Constants {
-    Constants {
-        metric: vec![1.0],
-        c: -1.0,
-        sigma: 0.1,
-        rho: 1.0,
-        how: "by hand".into(),
-    }
+    Constants::given(&lin_info(vec![]), vec![1.0], -1.0, 0.1, 1.0)
 }
 
 fn pendulum_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
@@ -161,37 +165,42 @@ fn pendulum_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
         noises: vec!["w".into()],
         input_box: vec![],
         initial: InitialSet {
-            boxes: vec![Some((-th, th)), Some((-0.2, 0.2))],
+            boxes: vec![Some(Bounds::new(-th, th)), Some(Bounds::new(-0.2, 0.2))],
             balls: vec![],
         },
-        domain: vec![(f64::NEG_INFINITY, f64::INFINITY); 2],
+        domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
         unsafe_sets,
         analyses: vec![],
     }
 }
 
+/// The paper's constants.
 fn pendulum_constants() -> Constants {
-    Constants {
-        metric: vec![35.68, 2.21, 2.21, 1.27],
-        c: -0.5,
-        sigma: 0.1130,
-        rho: 0.0,
-        how: "from the paper".into(),
-    }
+    Constants::given(
+        &pendulum_info(vec![]),
+        vec![35.68, 2.21, 2.21, 1.27],
+        -0.5,
+        0.1130,
+        0.0,
+    )
+}
+
+/// The box `(lo, hi)` of a box step.
+fn corners(d: &DetSet) -> (&[f64], &[f64]) {
+    d.box_hull().expect("a box")
 }
 
 /// Index of the report step at time `t` (grids of step `h` starting at 0).
-fn at(res: &engine::AnalysisResult, t: f64) -> usize {
+fn at(res: &Prs, t: f64) -> usize {
     res.steps
         .iter()
         .position(|s| (s.t - t).abs() < 1e-9)
         .expect("time on the grid")
 }
 
-fn half_widths(res: &engine::AnalysisResult, k: usize) -> Vec<f64> {
-    let d = &res.steps[k].det_set;
-    let (lo, hi) = (d.lo.as_ref().unwrap(), d.hi.as_ref().unwrap());
+fn half_widths(res: &Prs, k: usize) -> Vec<f64> {
+    let (lo, hi) = corners(&res.steps[k].det);
     lo.iter().zip(hi).map(|(a, b)| 0.5 * (b - a)).collect()
 }
 
@@ -235,14 +244,11 @@ fn linear_box_matches_exact_reachable_set() {
     for inclusion in [Inclusion::Jacobian, Inclusion::Natural, Inclusion::Mixed] {
         for (integrator, tol) in [(Integrator::Rk4, 1e-9), (Integrator::Euler, 1e-2)] {
             let a = analysis(2.0, 0.01, integrator, lin_constants());
-            let res = engine::run_interval(&Lin, &lin_info(vec![]), &a, inclusion).unwrap();
+            let res = run_with(&Lin, &lin_info(vec![]), &a, inclusion).unwrap();
             for st in &res.steps {
                 let e = (-st.t).exp();
                 let (xlo, xhi) = (0.5 * e - (1.0 - e), 1.5 * e + (1.0 - e));
-                let (lo, hi) = (
-                    st.det_set.lo.as_ref().unwrap()[0],
-                    st.det_set.hi.as_ref().unwrap()[0],
-                );
+                let (lo, hi) = (corners(&st.det).0[0], corners(&st.det).1[0]);
                 // Enclosure up to the (non-validated) time discretisation error.
                 assert!(
                     lo <= xlo + tol && hi >= xhi - tol,
@@ -265,58 +271,36 @@ fn linear_box_matches_exact_reachable_set() {
 }
 
 #[test]
-fn linear_runs_through_dispatch_and_renders() {
+fn linear_runs_through_dispatch() {
     let a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
     let info = lin_info(vec![]);
     let res = engine::run(&Lin, &info, &a).unwrap();
-    assert_eq!(res.method, "interval");
-    assert_eq!(res.inclusion.as_deref(), Some("jacobian"));
+    assert_eq!(res.method, Method::Interval);
+    assert_eq!(res.inclusion, Some(Inclusion::Jacobian));
     assert_eq!(res.steps.len(), 11);
-    assert!(res
-        .validated
-        .not_validated
-        .iter()
-        .any(|s| s.contains("time discretisation of the embedding")));
+    assert!(matches!(
+        res.validation.not_validated[0],
+        Unproved::Embedding { .. }
+    ));
+    assert!(
+        matches!(&res.steps[0].det, DetSet::Box { lo, hi, .. } if lo == &[0.5] && hi == &[1.5])
+    );
     // r_t agrees with the contraction engine's (same Psi_t, kappa).
     let mut c = a.clone();
-    c.method = Method::Contraction;
+    c.spec.method = Method::Contraction;
     let rc = engine::run(&Lin, &info, &c).unwrap();
     for (s, t) in res.steps.iter().zip(&rc.steps) {
         assert_eq!(s.r_t, t.r_t);
         assert_eq!(s.psi, t.psi);
     }
-    // The contraction result has no box fields or inclusion.
-    let vc: serde_json::Value = serde_json::from_str(&rc.to_json()).unwrap();
-    assert!(vc.get("inclusion").is_none());
-    assert!(vc["steps"][0]["det_set"].get("lo").is_none());
-    assert_eq!(vc["steps"][0]["det_set"]["shape"], "p_ball");
-    // JSON of the interval result.
-    let v: serde_json::Value = serde_json::from_str(&res.to_json()).unwrap();
-    assert_eq!(v["method"], "interval");
-    assert_eq!(v["inclusion"], "jacobian");
-    assert_eq!(v["steps"][0]["det_set"]["shape"], "box");
-    assert_eq!(v["steps"][0]["det_set"]["lo"][0], 0.5);
-    assert_eq!(v["steps"][0]["det_set"]["hi"][0], 1.5);
-    // CSV.
-    let mut csv = Vec::new();
-    res.write_csv(&mut csv).unwrap();
-    let csv = String::from_utf8(csv).unwrap();
-    assert!(csv.starts_with("t,x_lo,x_hi,r_t,psi\n"), "{csv}");
-    assert_eq!(csv.lines().count(), 12);
-    assert!(csv.lines().nth(1).unwrap().starts_with("0,0.5,1.5,0,0"));
-    // Summary.
-    let s = res.summary();
-    assert!(
-        s.contains("interval method") && s.contains("jacobian inclusion"),
-        "{s}"
-    );
-    assert!(s.contains("x [lo, hi]"), "{s}");
+    assert!(rc.inclusion.is_none());
+    assert!(matches!(rc.steps[0].det, DetSet::Ball { .. }));
 }
 
 #[test]
 fn refuses_transform_and_missing_constants() {
     let mut a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
-    a.transform = Some(Transform {
+    a.spec.transform = Some(Transform {
         matrix: vec![1.0],
         inverse: vec![1.0],
         frame: 0,
@@ -326,7 +310,7 @@ fn refuses_transform_and_missing_constants() {
         Err(RunError::Unsupported(_))
     ));
     let mut a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
-    a.constants = None;
+    a.constants = Err("not bounded".into());
     assert!(matches!(
         engine::run(&Lin, &lin_info(vec![]), &a),
         Err(RunError::NoConstants(_))
@@ -346,7 +330,7 @@ fn linear_safety_and_membership() {
         },
         UnsafeSet {
             name: "far_box".into(),
-            shape: UnsafeShape::Box(vec![(0, (-5.0, -3.0))]),
+            shape: UnsafeShape::Box(vec![(0, Bounds::new(-5.0, -3.0))]),
         },
         UnsafeSet {
             name: "far_ball".into(),
@@ -377,16 +361,12 @@ fn linear_safety_and_membership() {
                 .iter()
                 .position(|s| Some(s.t) == res.unsafe_sets[3].first_not_safe_t)
                 .unwrap(),
-            set: "touching".into()
+            set: 3
         }
     );
     // Margins by hand at the last step: PRS = [lo - r, hi + r] (P = 1).
     let st = res.steps.last().unwrap();
-    let (lo, hi, r) = (
-        st.det_set.lo.as_ref().unwrap()[0],
-        st.det_set.hi.as_ref().unwrap()[0],
-        st.r_t,
-    );
+    let (lo, hi, r) = (corners(&st.det).0[0], corners(&st.det).1[0], st.r_t);
     let m_half = 3.0 - (hi + r);
     let m_box = (lo - r) - (-3.0);
     let m_ball = (4.0 - (hi + r)) - 1.0;
@@ -395,10 +375,10 @@ fn linear_safety_and_membership() {
     }
     // Membership: the box and its r_t-neighbourhood in, beyond it out.
     let k = res.steps.len() - 1;
-    assert!(engine::contains(&res, k, &[0.5 * (lo + hi)]));
-    assert!(engine::contains(&res, k, &[hi + 0.99 * r]));
-    assert!(!engine::contains(&res, k, &[hi + 1.01 * r]));
-    assert!(!engine::contains(&res, k, &[lo - 1.01 * r]));
+    assert!(res.contains_at(k, &[0.5 * (lo + hi)]));
+    assert!(res.contains_at(k, &[hi + 0.99 * r]));
+    assert!(!res.contains_at(k, &[hi + 1.01 * r]));
+    assert!(!res.contains_at(k, &[lo - 1.01 * r]));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -409,9 +389,9 @@ fn linear_safety_and_membership() {
 fn pendulum_boxes_contain_sampled_trajectories() {
     let info = pendulum_info(vec![]);
     let a = analysis(4.0, 0.01, Integrator::Rk4, pendulum_constants());
-    let jac = engine::run_interval(&Pendulum, &info, &a, Inclusion::Jacobian).unwrap();
-    let nat = engine::run_interval(&Pendulum, &info, &a, Inclusion::Natural);
-    let mixed = engine::run_interval(&Pendulum, &info, &a, Inclusion::Mixed).unwrap();
+    let jac = run_with(&Pendulum, &info, &a, Inclusion::Jacobian).unwrap();
+    let nat = run_with(&Pendulum, &info, &a, Inclusion::Natural);
+    let mixed = run_with(&Pendulum, &info, &a, Inclusion::Mixed).unwrap();
     let th = std::f64::consts::PI / 10.0;
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let sub = 20; // fine step 0.0005
@@ -434,8 +414,7 @@ fn pendulum_boxes_contain_sampled_trajectories() {
                 results.push(n);
             }
             for r in results {
-                let d = &r.steps[k].det_set;
-                let (lo, hi) = (d.lo.as_ref().unwrap(), d.hi.as_ref().unwrap());
+                let (lo, hi) = corners(&r.steps[k].det);
                 for i in 0..2 {
                     assert!(
                         lo[i] - slack <= x[i] && x[i] <= hi[i] + slack,
@@ -445,7 +424,7 @@ fn pendulum_boxes_contain_sampled_trajectories() {
                     );
                 }
                 // The PRS contains the deterministic trajectory too.
-                assert!(engine::contains(r, k, &[x[0], x[1]]));
+                assert!(r.contains_at(k, &[x[0], x[1]]));
             }
         }
     }

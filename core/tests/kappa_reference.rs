@@ -2,7 +2,7 @@
 //! (`../shared/reference/kappa.jsonl`) and the structural properties of the rules.
 
 use reachc_core::kappa::{kappa, kappa_amgf, kappa_paper, kappa_paper_optimal, log_phi_lower};
-use reachc_core::system::RadiusRule;
+use reachc_core::model::RadiusRule;
 
 struct Row {
     n: usize,

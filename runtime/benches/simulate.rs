@@ -9,8 +9,9 @@
 
 use reachc_runtime::engine;
 use reachc_runtime::interval::Interval;
+use reachc_runtime::model::*;
 use reachc_runtime::simulate::{self, Options};
-use reachc_runtime::system::*;
+use reachc_runtime::System;
 use reachc_runtime::X8;
 
 /// Paths per iteration.
@@ -75,41 +76,39 @@ impl System for Linear {
 
 /// The `amgf_rule` analysis of specs/linear.sde with the compiler's constants.
 fn info() -> ModelInfo {
-    ModelInfo {
+    let mut info = ModelInfo {
         name: "linear".into(),
         states: vec!["x1".into(), "x2".into()],
         inputs: vec![],
         noises: vec!["w1".into(), "w2".into()],
         input_box: vec![],
         initial: InitialSet {
-            boxes: vec![Some((0.0, 0.0)), Some((0.0, 0.0))],
+            boxes: vec![Some(Bounds::new(0.0, 0.0)); 2],
             balls: vec![],
         },
-        domain: vec![(f64::NEG_INFINITY, f64::INFINITY); 2],
+        domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
         unsafe_sets: vec![],
-        analyses: vec![Analysis {
+        analyses: vec![],
+    };
+    let constants = Constants::given(
+        &info,
+        vec![1.0, 0.0, 0.0, 1.0],
+        -0.4,
+        1.4142135623730954,
+        0.0,
+    );
+    info.analyses.push(Analysis {
+        spec: AnalysisSpec {
             name: "amgf_rule".into(),
-            method: Method::Contraction,
-            delta: 0.001,
             horizon: 1.5,
             step: 0.01,
-            radius: RadiusRule::Amgf,
-            rate: Rate::Certified,
-            integrator: Integrator::Rk4,
-            inclusion: Inclusion::Jacobian,
             outputs: vec![0, 1],
-            transform: None,
-            constants: Some(Constants {
-                metric: vec![1.0, 0.0, 0.0, 1.0],
-                c: -0.4,
-                sigma: 1.4142135623730954,
-                rho: 0.0,
-                how: "by the compiler".into(),
-            }),
-            constants_error: None,
-        }],
-    }
+            ..AnalysisSpec::default()
+        },
+        constants: Ok(constants),
+    });
+    info
 }
 
 /// `PATHS` paths of the linear example on 1 and 2 worker threads.

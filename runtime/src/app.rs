@@ -1,15 +1,20 @@
-//! The `main` of generated crates' binaries: run the model's analyses, print summaries, write
-//! JSON and CSV results; or (`simulate`) check them against Monte Carlo sample paths.
+//! The front end of generated binaries, and of `reachc run` / `reachc simulate` with the
+//! interpreter: run a model's analyses (summaries, JSON and CSV results) or check them against
+//! Monte Carlo sample paths (`simulate`).
 //!
-//! Arguments are parsed by hand (no clap) so the runtime stays light:
+//! [`run`] and [`simulate`] take typed options ([`RunOptions`], [`SimulateOptions`]); a
+//! generated binary's command line is their textual form, parsed by [`Command::parse`] and
+//! written by `to_args` (by hand, no clap, so the runtime stays light):
 //! `[--analysis NAME] [-o DIR] [--quiet]`, or `simulate --paths N [options]` (see
 //! [`SIMULATE_USAGE`]).
 
-use crate::engine::{self, RunError};
-use crate::simulate::{self, InputMode, SimError};
-use crate::system::{Analysis, ModelInfo, System};
+use crate::report;
+use reachc_core::engine::RunError;
+use reachc_core::model::ModelInfo;
+use reachc_core::simulate::{self, InputMode, SimError};
+use reachc_core::{Reach, System};
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Default output directory.
@@ -50,6 +55,228 @@ pub const EXIT_FAILED: u8 = 1;
 /// Exit status of a usage error.
 pub const EXIT_USAGE: u8 = 2;
 
+/// What `run` does.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunOptions {
+    /// Run only this analysis (all when `None`).
+    pub analysis: Option<String>,
+    /// Directory for `<analysis>.json` and `<analysis>.csv`.
+    pub out_dir: PathBuf,
+    /// Do not print the summaries.
+    pub quiet: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            analysis: None,
+            out_dir: PathBuf::from(DEFAULT_OUT_DIR),
+            quiet: false,
+        }
+    }
+}
+
+/// What `simulate` does.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimulateOptions {
+    /// Check only this analysis (all when `None`).
+    pub analysis: Option<String>,
+    /// Directory for `<analysis>.sim.json`.
+    pub out_dir: PathBuf,
+    /// Do not print the summaries.
+    pub quiet: bool,
+    /// Report progress as `reachc-progress <analysis> <done> <total>` lines on stderr (when no
+    /// progress callback is given).
+    pub progress: bool,
+    /// Recompute each PRS at this delta instead of the analysis' own.
+    pub delta: Option<f64>,
+    /// The simulation itself.
+    pub sim: simulate::Options,
+}
+
+impl Default for SimulateOptions {
+    fn default() -> Self {
+        SimulateOptions {
+            analysis: None,
+            out_dir: PathBuf::from(DEFAULT_OUT_DIR),
+            quiet: false,
+            progress: false,
+            delta: None,
+            sim: simulate::Options::default(),
+        }
+    }
+}
+
+/// A parsed command line of a generated binary.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// Run the analyses.
+    Run(RunOptions),
+    /// Check them against Monte Carlo sample paths.
+    Simulate(SimulateOptions),
+    /// Print this help text.
+    Help(&'static str),
+}
+
+/// A usage error: the message and the help to print after it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UsageError {
+    /// What is wrong.
+    pub message: String,
+    /// The relevant help text.
+    pub usage: &'static str,
+}
+
+impl Command {
+    /// Parses the arguments (without the program name).
+    pub fn parse(args: &[String]) -> Result<Command, UsageError> {
+        match args.first().map(String::as_str) {
+            Some("simulate") => parse_simulate(&args[1..]).map_err(|message| UsageError {
+                message,
+                usage: SIMULATE_USAGE,
+            }),
+            _ => parse_run(args).map_err(|message| UsageError {
+                message,
+                usage: USAGE,
+            }),
+        }
+    }
+}
+
+/// Splits `--flag=value`; a flag's value is the inline one or the next argument.
+struct Args<'a> {
+    it: std::slice::Iter<'a, String>,
+}
+
+impl<'a> Args<'a> {
+    /// The next flag and its inline value, if any.
+    fn next_flag(&mut self) -> Option<(&'a str, Option<&'a str>)> {
+        let a = self.it.next()?;
+        Some(match a.split_once('=') {
+            Some((f, v)) if f.starts_with("--") => (f, Some(v)),
+            _ => (a.as_str(), None),
+        })
+    }
+
+    /// The value of `flag`.
+    fn value(&mut self, flag: &str, inline: Option<&'a str>) -> Result<&'a str, String> {
+        inline
+            .or_else(|| self.it.next().map(String::as_str))
+            .ok_or_else(|| format!("{flag} needs a value"))
+    }
+}
+
+fn parse_run(args: &[String]) -> Result<Command, String> {
+    let mut opts = RunOptions::default();
+    let mut args = Args { it: args.iter() };
+    while let Some((flag, inline)) = args.next_flag() {
+        match flag {
+            "--analysis" => opts.analysis = Some(args.value(flag, inline)?.to_string()),
+            "-o" | "--out" => opts.out_dir = PathBuf::from(args.value(flag, inline)?),
+            "-q" | "--quiet" => opts.quiet = true,
+            "-h" | "--help" => return Ok(Command::Help(USAGE)),
+            other => return Err(format!("unexpected argument `{other}`")),
+        }
+    }
+    Ok(Command::Run(opts))
+}
+
+fn parse_simulate(args: &[String]) -> Result<Command, String> {
+    let mut a = SimulateOptions::default();
+    let mut paths = None;
+    let mut args = Args { it: args.iter() };
+    while let Some((flag, inline)) = args.next_flag() {
+        let mut value = || args.value(flag, inline);
+        match flag {
+            "--analysis" => a.analysis = Some(value()?.to_string()),
+            "-o" | "--out" => a.out_dir = PathBuf::from(value()?),
+            "-q" | "--quiet" => a.quiet = true,
+            "--progress" => a.progress = true,
+            "--paths" => paths = Some(number::<u64>(flag, value()?)?),
+            "--seed" => a.sim.seed = number(flag, value()?)?,
+            "--dt" => a.sim.dt = Some(number(flag, value()?)?),
+            "--hold" => a.sim.hold = Some(number(flag, value()?)?),
+            "--confidence" => a.sim.confidence = number(flag, value()?)?,
+            "--delta" => {
+                let d: f64 = number(flag, value()?)?;
+                if !(d > 0.0 && d < 1.0) {
+                    return Err(format!("--delta {d} must lie in (0, 1)"));
+                }
+                a.delta = Some(d);
+            }
+            "--threads" => {
+                let t: usize = number(flag, value()?)?;
+                if t == 0 {
+                    return Err("--threads must be at least 1".into());
+                }
+                a.sim.threads = Some(t);
+            }
+            "--inputs" => {
+                let v = value()?;
+                a.sim.inputs = InputMode::parse(v)
+                    .ok_or_else(|| format!("--inputs `{v}`: expected random, corners or centre"))?;
+            }
+            "-h" | "--help" => return Ok(Command::Help(SIMULATE_USAGE)),
+            other => return Err(format!("unexpected argument `{other}`")),
+        }
+    }
+    a.sim.paths = paths.ok_or_else(|| "--paths N is required".to_string())?;
+    Ok(Command::Simulate(a))
+}
+
+/// Parses a number given to `flag`.
+fn number<T: std::str::FromStr>(flag: &str, v: &str) -> Result<T, String> {
+    v.trim()
+        .parse()
+        .map_err(|_| format!("{flag}: `{v}` is not a valid number"))
+}
+
+impl RunOptions {
+    /// The command line that [`Command::parse`] reads back as these options.
+    pub fn to_args(&self) -> Vec<String> {
+        let mut args = vec!["-o".to_string(), self.out_dir.display().to_string()];
+        if let Some(name) = &self.analysis {
+            args.extend(["--analysis".to_string(), name.clone()]);
+        }
+        if self.quiet {
+            args.push("--quiet".into());
+        }
+        args
+    }
+}
+
+impl SimulateOptions {
+    /// The command line (starting with `simulate`) that [`Command::parse`] reads back as these
+    /// options. Numbers are written in Rust's shortest round-trip form, so they parse back to
+    /// the same bits.
+    pub fn to_args(&self) -> Vec<String> {
+        let s = &self.sim;
+        let mut args = vec!["simulate".to_string()];
+        let mut opt = |flag: &str, v: Option<String>| {
+            if let Some(v) = v {
+                args.extend([flag.to_string(), v]);
+            }
+        };
+        opt("--paths", Some(s.paths.to_string()));
+        opt("--analysis", self.analysis.clone());
+        opt("--seed", Some(s.seed.to_string()));
+        opt("--dt", s.dt.map(|v| v.to_string()));
+        opt("--delta", self.delta.map(|v| v.to_string()));
+        opt("--inputs", Some(s.inputs.name().to_string()));
+        opt("--hold", s.hold.map(|v| v.to_string()));
+        opt("--confidence", Some(s.confidence.to_string()));
+        opt("--threads", s.threads.map(|v| v.to_string()));
+        opt("-o", Some(self.out_dir.display().to_string()));
+        if self.quiet {
+            args.push("--quiet".into());
+        }
+        if self.progress {
+            args.push("--progress".into());
+        }
+        args
+    }
+}
+
 /// The `main` of a generated binary: parses `std::env::args`, see [`run_cli`]. Generic so that
 /// the simulation's hot loop calls the generated model directly (no virtual calls).
 pub fn main_with<S: System + Sync>(sys: &S, info: &ModelInfo) -> ExitCode {
@@ -64,48 +291,9 @@ pub fn main_with<S: System + Sync>(sys: &S, info: &ModelInfo) -> ExitCode {
     ExitCode::from(code)
 }
 
-/// Parsed command line.
-struct Options {
-    analysis: Option<String>,
-    out_dir: PathBuf,
-    quiet: bool,
-}
-
-/// Parses the arguments; `Err(None)` for `--help`, `Err(Some(msg))` for a usage error.
-fn parse(args: &[String]) -> Result<Options, Option<String>> {
-    let mut opts = Options {
-        analysis: None,
-        out_dir: PathBuf::from(DEFAULT_OUT_DIR),
-        quiet: false,
-    };
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        let (flag, inline) = match a.split_once('=') {
-            Some((f, v)) if f.starts_with("--") => (f, Some(v.to_string())),
-            _ => (a.as_str(), None),
-        };
-        let mut value = |name: &str| {
-            inline
-                .clone()
-                .or_else(|| it.next().cloned())
-                .ok_or_else(|| Some(format!("{name} needs a value")))
-        };
-        match flag {
-            "--analysis" => opts.analysis = Some(value("--analysis")?),
-            "-o" | "--out" => opts.out_dir = PathBuf::from(value(flag)?),
-            "-q" | "--quiet" => opts.quiet = true,
-            "-h" | "--help" => return Err(None),
-            other => return Err(Some(format!("unexpected argument `{other}`"))),
-        }
-    }
-    Ok(opts)
-}
-
-/// Runs the command line `args` (without the program name), writing to `out` / `err`; returns
-/// the exit status: [`EXIT_OK`], [`EXIT_FAILED`] if some analysis could not run or its files
-/// could not be written, [`EXIT_USAGE`] for a usage error (including an unknown analysis name).
-/// Analyses with an unsupported method are reported as skipped, not as failures. A first
-/// argument `simulate` runs [`simulate_cli`].
+/// Runs the command line `args` (without the program name), writing to `out` / `err`: parses
+/// it ([`Command::parse`]) and calls [`run`] or [`simulate`]. A usage error exits with
+/// [`EXIT_USAGE`] after the help text.
 pub fn run_cli<S: System + Sync>(
     sys: &S,
     info: &ModelInfo,
@@ -113,29 +301,40 @@ pub fn run_cli<S: System + Sync>(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> u8 {
-    if args.first().is_some_and(|a| a == "simulate") {
-        return simulate_cli(sys, info, &args[1..], out, err, None);
+    match Command::parse(args) {
+        Ok(Command::Run(opts)) => run(sys, info, &opts, out, err),
+        Ok(Command::Simulate(opts)) => simulate(sys, info, &opts, out, err, None),
+        Ok(Command::Help(usage)) => {
+            let _ = writeln!(out, "{usage}");
+            EXIT_OK
+        }
+        Err(e) => {
+            let _ = writeln!(err, "error: {}\n{}", e.message, e.usage);
+            EXIT_USAGE
+        }
     }
-    let opts = match parse(args) {
-        Ok(o) => o,
-        Err(None) => {
-            let _ = writeln!(out, "{USAGE}");
-            return EXIT_OK;
-        }
-        Err(Some(msg)) => {
-            let _ = writeln!(err, "error: {msg}\n{USAGE}");
-            return EXIT_USAGE;
-        }
-    };
+}
+
+/// Runs the selected analyses, prints their summaries and writes `DIR/<analysis>.json` and
+/// `.csv`. Returns [`EXIT_OK`], [`EXIT_FAILED`] if some analysis could not run or its files
+/// could not be written, [`EXIT_USAGE`] for an unknown analysis name. Analyses with an
+/// unsupported method are reported as skipped, not as failures.
+pub fn run<S: System + Sync>(
+    sys: &S,
+    info: &ModelInfo,
+    opts: &RunOptions,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> u8 {
     let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
     let mut status = EXIT_OK;
-    for a in selected {
-        match engine::run(sys, info, a) {
+    for name in selected {
+        match Reach::new(sys, info, name).and_then(|r| r.run()) {
             Ok(res) => {
                 if !opts.quiet {
-                    let _ = writeln!(out, "{}", res.summary());
+                    let _ = writeln!(out, "{}", report::summary(&res));
                 }
                 match write_files(&res, &opts.out_dir) {
                     Ok((json, csv)) => {
@@ -146,8 +345,7 @@ pub fn run_cli<S: System + Sync>(
                     Err(e) => {
                         let _ = writeln!(
                             err,
-                            "error: analysis `{}`: cannot write results to {}: {e}",
-                            a.name,
+                            "error: analysis `{name}`: cannot write results to {}: {e}",
                             opts.out_dir.display()
                         );
                         status = EXIT_FAILED;
@@ -155,10 +353,10 @@ pub fn run_cli<S: System + Sync>(
                 }
             }
             Err(RunError::Unsupported(why)) => {
-                let _ = writeln!(err, "skipped analysis `{}`: {why}", a.name);
+                let _ = writeln!(err, "skipped analysis `{name}`: {why}");
             }
             Err(e) => {
-                let _ = writeln!(err, "error: analysis `{}` could not run: {e}", a.name);
+                let _ = writeln!(err, "error: analysis `{name}` could not run: {e}");
                 status = EXIT_FAILED;
             }
         }
@@ -167,226 +365,120 @@ pub fn run_cli<S: System + Sync>(
 }
 
 /// Writes `DIR/<analysis>.json` and `DIR/<analysis>.csv`; returns their paths.
-fn write_files(
-    res: &engine::AnalysisResult,
-    dir: &std::path::Path,
-) -> std::io::Result<(String, String)> {
+fn write_files(res: &reachc_core::Prs, dir: &Path) -> std::io::Result<(String, String)> {
     std::fs::create_dir_all(dir)?;
     let json = dir.join(format!("{}.json", res.analysis));
-    std::fs::write(&json, res.to_json() + "\n")?;
+    std::fs::write(&json, report::to_json(res) + "\n")?;
     let csv = dir.join(format!("{}.csv", res.analysis));
     let mut f = std::io::BufWriter::new(std::fs::File::create(&csv)?);
-    res.write_csv(&mut f)?;
+    report::write_csv(res, &mut f)?;
     f.flush()?;
     Ok((json.display().to_string(), csv.display().to_string()))
 }
 
-/// The analyses to run: all, or the one named (`None` after reporting an unknown name).
+/// The names of the analyses to run: all, or the one named (`None` after reporting an unknown
+/// name).
 fn select<'a>(
     info: &'a ModelInfo,
     name: Option<&str>,
     err: &mut dyn Write,
-) -> Option<Vec<&'a Analysis>> {
+) -> Option<Vec<&'a str>> {
+    let names = info.analyses.iter().map(|a| a.spec.name.as_str());
     let Some(name) = name else {
-        return Some(info.analyses.iter().collect());
+        return Some(names.collect());
     };
-    let found: Vec<_> = info.analyses.iter().filter(|a| a.name == name).collect();
+    let found: Vec<&str> = names.clone().filter(|&a| a == name).collect();
     if found.is_empty() {
-        let names: Vec<&str> = info.analyses.iter().map(|a| a.name.as_str()).collect();
+        let all: Vec<&str> = names.collect();
         let _ = writeln!(
             err,
             "error: model `{}` has no analysis `{name}` (available: {})",
             info.name,
-            names.join(", ")
+            all.join(", ")
         );
         return None;
     }
     Some(found)
 }
 
-/// Parsed `simulate` command line.
-struct SimArgs {
-    analysis: Option<String>,
-    out_dir: PathBuf,
-    quiet: bool,
-    progress: bool,
-    delta: Option<f64>,
-    opts: simulate::Options,
-}
-
-/// Parses the `simulate` arguments; `Err(None)` for `--help`, `Err(Some(msg))` for a usage
-/// error.
-fn parse_simulate(args: &[String]) -> Result<SimArgs, Option<String>> {
-    let mut a = SimArgs {
-        analysis: None,
-        out_dir: PathBuf::from(DEFAULT_OUT_DIR),
-        quiet: false,
-        progress: false,
-        delta: None,
-        opts: simulate::Options::default(),
-    };
-    let mut paths = None;
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        let (flag, inline) = match arg.split_once('=') {
-            Some((f, v)) if f.starts_with("--") => (f, Some(v.to_string())),
-            _ => (arg.as_str(), None),
-        };
-        let mut value = || {
-            inline
-                .clone()
-                .or_else(|| it.next().cloned())
-                .ok_or_else(|| Some(format!("{flag} needs a value")))
-        };
-        match flag {
-            "--analysis" => a.analysis = Some(value()?),
-            "-o" | "--out" => a.out_dir = PathBuf::from(value()?),
-            "-q" | "--quiet" => a.quiet = true,
-            "--progress" => a.progress = true,
-            "--paths" => paths = Some(number::<u64>(flag, &value()?)?),
-            "--seed" => a.opts.seed = number(flag, &value()?)?,
-            "--dt" => a.opts.dt = Some(number(flag, &value()?)?),
-            "--hold" => a.opts.hold = Some(number(flag, &value()?)?),
-            "--confidence" => a.opts.confidence = number(flag, &value()?)?,
-            "--delta" => {
-                let d: f64 = number(flag, &value()?)?;
-                if !(d > 0.0 && d < 1.0) {
-                    return Err(Some(format!("--delta {d} must lie in (0, 1)")));
-                }
-                a.delta = Some(d);
-            }
-            "--threads" => {
-                let t: usize = number(flag, &value()?)?;
-                if t == 0 {
-                    return Err(Some("--threads must be at least 1".into()));
-                }
-                a.opts.threads = Some(t);
-            }
-            "--inputs" => {
-                let v = value()?;
-                a.opts.inputs = InputMode::parse(&v).ok_or_else(|| {
-                    Some(format!(
-                        "--inputs `{v}`: expected random, corners or centre"
-                    ))
-                })?;
-            }
-            "-h" | "--help" => return Err(None),
-            other => return Err(Some(format!("unexpected argument `{other}`"))),
-        }
-    }
-    a.opts.paths = paths.ok_or_else(|| Some("--paths N is required".to_string()))?;
-    Ok(a)
-}
-
-/// Parses a number given to `flag`.
-fn number<T: std::str::FromStr>(flag: &str, v: &str) -> Result<T, Option<String>> {
-    v.trim()
-        .parse()
-        .map_err(|_| Some(format!("{flag}: `{v}` is not a valid number")))
-}
-
 /// A progress callback: `(analysis, paths done, paths in all)`.
 pub type Progress<'a> = dyn FnMut(&str, u64, u64) + 'a;
 
-/// `simulate` mode: for each selected analysis, run the engine (at `--delta` if given), simulate
-/// the paths, print the summary and write `DIR/<analysis>.sim.json`. Returns [`EXIT_OK`] when
-/// every coverage check passes, [`EXIT_FAILED`] when one fails or an analysis or its files
-/// fail, [`EXIT_USAGE`] for a usage error. Analyses without a PRS (no constants, unsupported
+/// For each selected analysis: compute its PRS (at `opts.delta` if given), simulate the paths,
+/// print the summary and write `DIR/<analysis>.sim.json`. Returns [`EXIT_OK`] when every
+/// coverage check passes, [`EXIT_FAILED`] when one fails or an analysis or its files fail,
+/// [`EXIT_USAGE`] for a usage error. Analyses without a PRS (no constants, unsupported
 /// transform) are skipped with a message. `progress(analysis, done, total)` is called after each
-/// batch of paths; without it, `--progress` writes `reachc-progress` lines to `err` instead.
-pub fn simulate_cli<S: System + Sync>(
+/// batch of paths; without it, `opts.progress` writes `reachc-progress` lines to `err` instead.
+pub fn simulate<S: System + Sync>(
     sys: &S,
     info: &ModelInfo,
-    args: &[String],
+    opts: &SimulateOptions,
     out: &mut dyn Write,
     err: &mut dyn Write,
     mut progress: Option<&mut Progress<'_>>,
 ) -> u8 {
-    let a = match parse_simulate(args) {
-        Ok(a) => a,
-        Err(None) => {
-            let _ = writeln!(out, "{SIMULATE_USAGE}");
-            return EXIT_OK;
-        }
-        Err(Some(msg)) => {
-            let _ = writeln!(err, "error: {msg}\n{SIMULATE_USAGE}");
-            return EXIT_USAGE;
-        }
-    };
-    let Some(selected) = select(info, a.analysis.as_deref(), err) else {
+    let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
     let mut status = EXIT_OK;
-    for analysis in selected {
-        let mut analysis = analysis.clone();
-        if let Some(d) = a.delta {
-            analysis.delta = d;
-        }
-        let result = match engine::run(sys, info, &analysis) {
+    for name in selected {
+        let reach = Reach::new(sys, info, name).and_then(|r| match opts.delta {
+            Some(d) => r.with_delta(d),
+            None => Ok(r),
+        });
+        let result = match reach.and_then(|r| r.run()) {
             Ok(r) => r,
             Err(e @ (RunError::Unsupported(_) | RunError::NoConstants(_))) => {
-                let _ = writeln!(
-                    err,
-                    "skipped analysis `{}`: no PRS to check ({e})",
-                    analysis.name
-                );
+                let _ = writeln!(err, "skipped analysis `{name}`: no PRS to check ({e})");
                 continue;
             }
             Err(e) => {
-                let _ = writeln!(
-                    err,
-                    "error: analysis `{}` could not run: {e}",
-                    analysis.name
-                );
+                let _ = writeln!(err, "error: analysis `{name}` could not run: {e}");
                 status = EXIT_FAILED;
                 continue;
             }
         };
         let started = std::time::Instant::now();
         let simulated = {
-            let name = analysis.name.as_str();
             let mut report_progress = |done: u64, total: u64| match progress.as_mut() {
                 Some(f) => f(name, done, total),
-                None if a.progress => {
+                None if opts.progress => {
                     let _ = writeln!(err, "reachc-progress {name} {done} {total}");
                 }
                 None => {}
             };
-            simulate::simulate(sys, info, &result, &a.opts, &mut report_progress)
+            simulate::simulate(sys, info, &result, &opts.sim, &mut report_progress)
         };
-        let report = match simulated {
+        let sim = match simulated {
             Ok(r) => r,
             Err(SimError::Usage(m)) => {
                 let _ = writeln!(err, "error: {m}");
                 return EXIT_USAGE;
             }
             Err(SimError::Invalid(m)) => {
-                let _ = writeln!(
-                    err,
-                    "error: analysis `{}` cannot be simulated: {m}",
-                    analysis.name
-                );
+                let _ = writeln!(err, "error: analysis `{name}` cannot be simulated: {m}");
                 status = EXIT_FAILED;
                 continue;
             }
         };
         let secs = started.elapsed().as_secs_f64();
-        if !a.quiet {
-            let path_steps = report.paths as f64 * report.steps_per_path as f64;
-            let _ = write!(out, "{}", report.summary());
+        if !opts.quiet {
+            let path_steps = sim.paths as f64 * sim.steps_per_path as f64;
+            let _ = write!(out, "{}", report::simulation::summary(&sim));
             let _ = writeln!(
                 out,
                 "  time: {secs:.3} s for {path_steps:.3e} path-steps ({:.3e} path-steps/s, {} \
                  threads)",
                 path_steps / secs,
-                simulate::thread_count(a.opts.threads)
+                simulate::thread_count(opts.sim.threads)
             );
         }
-        let file = a.out_dir.join(format!("{}.sim.json", report.analysis));
-        let written = std::fs::create_dir_all(&a.out_dir)
-            .and_then(|()| std::fs::write(&file, report.to_json() + "\n"));
+        let file = opts.out_dir.join(format!("{}.sim.json", sim.analysis));
+        let written = std::fs::create_dir_all(&opts.out_dir)
+            .and_then(|()| std::fs::write(&file, report::simulation::to_json(&sim) + "\n"));
         match written {
-            Ok(()) if !a.quiet => {
+            Ok(()) if !opts.quiet => {
                 let _ = writeln!(out, "  wrote {}\n", file.display());
             }
             Ok(()) => {}
@@ -395,9 +487,57 @@ pub fn simulate_cli<S: System + Sync>(
                 status = EXIT_FAILED;
             }
         }
-        if !report.passed() {
+        if !sim.passed() {
             status = EXIT_FAILED;
         }
     }
     status
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn strings(args: &[&str]) -> Vec<String> {
+        args.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn options_round_trip_through_the_command_line() {
+        let run = RunOptions {
+            analysis: Some("contraction".into()),
+            out_dir: PathBuf::from("some dir/out"),
+            quiet: true,
+        };
+        assert_eq!(Command::parse(&run.to_args()), Ok(Command::Run(run)));
+        let sim = SimulateOptions {
+            analysis: Some("a".into()),
+            out_dir: PathBuf::from("o"),
+            quiet: false,
+            progress: true,
+            delta: Some(0.1 + 0.2),
+            sim: simulate::Options {
+                paths: 12345,
+                seed: u64::MAX,
+                dt: Some(1e-3 / 3.0),
+                inputs: InputMode::Corners,
+                hold: Some(0.7),
+                confidence: 0.99,
+                threads: Some(3),
+            },
+        };
+        assert_eq!(Command::parse(&sim.to_args()), Ok(Command::Simulate(sim)));
+    }
+
+    #[test]
+    fn usage_errors_name_the_problem() {
+        let e = Command::parse(&strings(&["simulate", "--seed", "1"])).unwrap_err();
+        assert_eq!(e.message, "--paths N is required");
+        let e = Command::parse(&strings(&["--out"])).unwrap_err();
+        assert_eq!(e.message, "--out needs a value");
+        assert_eq!(
+            Command::parse(&strings(&["--help"])),
+            Ok(Command::Help(USAGE))
+        );
+    }
 }

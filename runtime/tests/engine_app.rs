@@ -2,10 +2,10 @@
 
 use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::interval::Interval;
-use reachc_runtime::system::{
-    Analysis, Constants, InitialSet, Integrator, Method, ModelInfo, RadiusRule, Rate, Transform,
+use reachc_runtime::model::{
+    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, Transform,
 };
-use reachc_runtime::System;
+use reachc_runtime::{report, Reach, System};
 
 /// `dx = -x dt + 0.5 dW` in one dimension.
 struct Decay;
@@ -51,25 +51,19 @@ impl System for Decay {
 
 fn analysis(name: &str, method: Method, constants: bool) -> Analysis {
     Analysis {
-        name: name.into(),
-        method,
-        delta: 0.01,
-        horizon: 1.0,
-        step: 0.1,
-        radius: RadiusRule::Amgf,
-        rate: Rate::Certified,
-        integrator: Integrator::Rk4,
-        inclusion: Default::default(),
-        outputs: vec![],
-        constants: constants.then(|| Constants {
-            metric: vec![1.0],
-            c: -1.0,
-            sigma: 0.5,
-            rho: 0.0,
-            how: "by hand".into(),
-        }),
-        constants_error: (!constants).then(|| "not bounded".to_string()),
-        transform: None,
+        spec: AnalysisSpec {
+            name: name.into(),
+            method,
+            delta: 0.01,
+            horizon: 1.0,
+            step: 0.1,
+            ..AnalysisSpec::default()
+        },
+        constants: if constants {
+            Ok(Constants::given(&model(vec![]), vec![1.0], -1.0, 0.5, 0.0))
+        } else {
+            Err("not bounded".to_string())
+        },
     }
 }
 
@@ -81,10 +75,10 @@ fn model(analyses: Vec<Analysis>) -> ModelInfo {
         noises: vec!["w".into()],
         input_box: vec![],
         initial: InitialSet {
-            boxes: vec![Some((0.9, 1.1))],
+            boxes: vec![Some(Bounds::new(0.9, 1.1))],
             balls: vec![],
         },
-        domain: vec![(f64::NEG_INFINITY, f64::INFINITY)],
+        domain: vec![Bounds::ENTIRE],
         has_domain: false,
         unsafe_sets: vec![],
         analyses,
@@ -113,13 +107,14 @@ fn runs_writes_and_skips_interval() {
     let info = model(vec![
         analysis("main", Method::Contraction, true),
         // A coordinate transform on a system without transformed frames is skipped, not run.
-        Analysis {
-            transform: Some(Transform {
+        {
+            let mut a = analysis("boxes", Method::Interval, true);
+            a.spec.transform = Some(Transform {
                 matrix: vec![1.0],
                 inverse: vec![1.0],
                 frame: 0,
-            }),
-            ..analysis("boxes", Method::Interval, true)
+            });
+            a
         },
     ]);
     let dir = tmp_dir("ok");
@@ -173,4 +168,61 @@ fn exit_codes() {
     assert_eq!(code, EXIT_OK);
     assert!(out.contains("usage"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The renderings of both methods' results: JSON fields and shapes, CSV columns, summaries.
+#[test]
+fn results_render() {
+    let info = model(vec![
+        analysis("ball", Method::Contraction, true),
+        analysis("boxes", Method::Interval, true),
+    ]);
+    let ball = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
+    let boxes = Reach::new(&Decay, &info, "boxes").unwrap().run().unwrap();
+    let v: serde_json::Value = serde_json::from_str(&report::to_json(&ball)).unwrap();
+    assert_eq!(v["method"], "contraction");
+    assert!(v.get("inclusion").is_none());
+    assert_eq!(v["steps"][0]["det_set"]["shape"], "p_ball");
+    assert!(v["steps"][0]["det_set"].get("lo").is_none());
+    assert_eq!(
+        v["constants"]["how"],
+        "given by hand, not certified by reachc"
+    );
+    assert_eq!(v["verdict"]["status"], "no_unsafe_sets");
+    let v: serde_json::Value = serde_json::from_str(&report::to_json(&boxes)).unwrap();
+    assert_eq!(v["method"], "interval");
+    assert_eq!(v["inclusion"], "jacobian");
+    assert_eq!(v["steps"][0]["det_set"]["shape"], "box");
+    assert_eq!(v["steps"][0]["det_set"]["lo"][0], 0.9);
+    assert_eq!(v["steps"][0]["det_set"]["hi"][0], 1.1);
+    assert!(v["validated"]["not_validated"][0]
+        .as_str()
+        .unwrap()
+        .starts_with("time discretisation of the embedding system"));
+    let csv = |prs| {
+        let mut out = Vec::new();
+        report::write_csv(prs, &mut out).unwrap();
+        String::from_utf8(out).unwrap()
+    };
+    let (c_ball, c_boxes) = (csv(&ball), csv(&boxes));
+    assert!(
+        c_ball.starts_with("t,x,det_radius,r_t,psi,c,sigma,prs_radius\n0,1,"),
+        "{c_ball}"
+    );
+    assert!(
+        c_boxes.starts_with("t,x_lo,x_hi,r_t,psi\n0,0.9,1.1,0,0\n"),
+        "{c_boxes}"
+    );
+    assert_eq!(c_boxes.lines().count(), 12);
+    let s = report::summary(&boxes);
+    assert!(
+        s.contains("interval method") && s.contains("jacobian inclusion"),
+        "{s}"
+    );
+    assert!(s.contains("x [lo, hi]"), "{s}");
+    let s = report::summary(&ball);
+    assert!(
+        s.contains("kappa(n = 1, delta = 0.01)") && s.contains("amgf"),
+        "{s}"
+    );
 }

@@ -3,10 +3,12 @@
 //! check, and the `simulate` command line of generated binaries.
 
 use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
-use reachc_runtime::engine::{self, AnalysisResult};
+use reachc_runtime::engine;
 use reachc_runtime::interval::Interval;
+use reachc_runtime::model::*;
+use reachc_runtime::report::simulation::{summary, to_json};
 use reachc_runtime::simulate::{self, InputMode, Options, SimReport};
-use reachc_runtime::system::*;
+use reachc_runtime::{Prs, System};
 
 /// `dx = (a x + b u) dt + s dW` per state, `n` states, one input shared by all (`b = 0`: none).
 struct Linear {
@@ -94,7 +96,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
     for i in 0..n {
         metric[i * n + i] = 1.0;
     }
-    ModelInfo {
+    let mut info = ModelInfo {
         name: "linear".into(),
         states: (1..=n).map(|i| format!("x{i}")).collect(),
         inputs: if sys.b != 0.0 {
@@ -103,12 +105,16 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
             vec![]
         },
         noises: (1..=n).map(|i| format!("w{i}")).collect(),
-        input_box: if sys.b != 0.0 { vec![(-h, h)] } else { vec![] },
+        input_box: if sys.b != 0.0 {
+            vec![Bounds::new(-h, h)]
+        } else {
+            vec![]
+        },
         initial: InitialSet {
-            boxes: vec![Some((x0 - w, x0 + w)); n],
+            boxes: vec![Some(Bounds::new(x0 - w, x0 + w)); n],
             balls: vec![],
         },
-        domain: vec![(f64::NEG_INFINITY, f64::INFINITY); n],
+        domain: vec![Bounds::ENTIRE; n],
         has_domain: false,
         unsafe_sets: vec![UnsafeSet {
             name: "far".into(),
@@ -117,36 +123,34 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
                 offset: 1.5,
             },
         }],
-        analyses: vec![Analysis {
+        analyses: vec![],
+    };
+    let constants = Constants::given(
+        &info,
+        metric,
+        sys.a,
+        // A factor below 1 makes the PRS too small (a wrong analysis).
+        sys.s * sigma_factor,
+        (sys.b * h * n as f64).abs(),
+    );
+    info.analyses.push(Analysis {
+        spec: AnalysisSpec {
             name: "main".into(),
-            method: Method::Contraction,
             delta,
             horizon: 1.5,
             step: 0.01,
-            radius: RadiusRule::Amgf,
-            rate: Rate::Certified,
-            integrator: Integrator::Rk4,
-            inclusion: Inclusion::Jacobian,
-            outputs: vec![],
-            transform: None,
-            constants: Some(Constants {
-                metric,
-                c: sys.a,
-                // A factor below 1 makes the PRS too small (a wrong analysis).
-                sigma: sys.s * sigma_factor,
-                rho: (sys.b * h * n as f64).abs(),
-                how: "exact".into(),
-            }),
-            constants_error: None,
-        }],
-    }
+            ..AnalysisSpec::default()
+        },
+        constants: Ok(constants),
+    });
+    info
 }
 
-fn run(sys: &Linear, info: &ModelInfo) -> AnalysisResult {
+fn run(sys: &Linear, info: &ModelInfo) -> Prs {
     engine::run(sys, info, &info.analyses[0]).unwrap()
 }
 
-fn simulate(sys: &Linear, info: &ModelInfo, r: &AnalysisResult, opts: &Options) -> SimReport {
+fn simulate(sys: &Linear, info: &ModelInfo, r: &Prs, opts: &Options) -> SimReport {
     simulate::simulate(sys, info, r, opts, &mut |_, _| {}).unwrap()
 }
 
@@ -208,7 +212,7 @@ fn linear_quantiles_match_the_exact_gaussian() {
         errs.iter().sum::<f64>() / errs.len() as f64
     };
     assert!(mean.abs() < 0.01, "mean relative error {mean}");
-    assert!(rep.passed(), "{}", rep.summary());
+    assert!(rep.passed(), "{}", summary(&rep));
     // X0 = 0: the t = 0 state is the nominal exactly, inside the (zero-radius) PRS.
     assert_eq!(rep.steps[0].outside, 0);
     assert_eq!(rep.steps[0].quantile, 0.0);
@@ -223,7 +227,7 @@ fn results_do_not_depend_on_the_thread_count() {
     let info = info(&sys, 0.5, 0.2, 0.3, 0.05, 1.0);
     let r = run(&sys, &info);
     let json = |threads: usize, inputs: InputMode| {
-        simulate(
+        to_json(&simulate(
             &sys,
             &info,
             &r,
@@ -236,8 +240,7 @@ fn results_do_not_depend_on_the_thread_count() {
                 threads: Some(threads),
                 ..Options::default()
             },
-        )
-        .to_json()
+        ))
     };
     for inputs in [InputMode::Random, InputMode::Corners] {
         let one = json(1, inputs);
@@ -262,7 +265,7 @@ fn results_do_not_depend_on_the_thread_count() {
             ..Options::default()
         },
     );
-    assert_ne!(other.to_json(), json(1, InputMode::Random));
+    assert_ne!(to_json(&other), json(1, InputMode::Random));
 }
 
 /// `simulate` and `sample_paths` run the same paths: with one path, the quantile reported at
@@ -293,7 +296,7 @@ fn simulated_paths_are_the_recorded_sample_paths() {
                 // The identity metric's distance, summed as the simulation sums it.
                 let q = x
                     .iter()
-                    .zip(&res.nominal)
+                    .zip(res.nominal())
                     .map(|(x, c)| (x - c) * (x - c))
                     .reduce(|q, t| q + t)
                     .unwrap();
@@ -396,7 +399,7 @@ fn simulate_command_line() {
 
     // An analysis without constants has no PRS: skipped, not a failure.
     let mut none = good.clone();
-    none.analyses[0].constants = None;
+    none.analyses[0].constants = Err("not bounded".into());
     let (code, _, err) = cli(&none, &["simulate", "--paths", "10", "-o", d]);
     assert_eq!(code, EXIT_OK);
     assert!(

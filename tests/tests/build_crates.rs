@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use reachc_compiler::backend::codegen;
-use reachc_compiler::backend::crate_writer::{compile_crate_in, write_crate, CrateOptions, WrittenCrate};
+use reachc_compiler::backend::crate_writer::{
+    compile_crate_in, write_crate, CrateOptions, WrittenCrate,
+};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_compiler::driver::load;
@@ -379,19 +381,20 @@ fn sample(model: &Model, rng: &mut Rng) -> Sample {
     };
     let state = |rng: &mut Rng| -> Vec<f64> {
         model
-            .states
+            .initial
+            .boxes
             .iter()
-            .map(|s| {
-                let (lo, hi) = s.bounds.map_or((-2.0, 2.0), |b| (b.lo - 2.0, b.hi + 2.0));
+            .map(|b| {
+                let (lo, hi) = b.map_or((-2.0, 2.0), |b| (b.lo - 2.0, b.hi + 2.0));
                 rng.uniform(lo, hi)
             })
             .collect()
     };
     let x = state(rng);
     let u: Vec<f64> = model
-        .inputs
+        .input_box
         .iter()
-        .map(|i| i.bounds.map_or(0.0, |b| rng.uniform(b.lo, b.hi)))
+        .map(|b| rng.uniform(b.lo, b.hi))
         .collect();
     let t = rng.uniform(0.0, 6.0);
     let n = model.states.len();

@@ -14,6 +14,6 @@ fn rust_keywords_are_valid_names() {
     assert_eq!(states, ["type", "impl"]);
     assert_eq!(model.inputs[0].name, "where");
     assert_eq!(model.noises[0].name, "loop");
-    assert_eq!(model.analyses[0].name, "async");
+    assert_eq!(model.analyses[0].spec.name, "async");
     assert_eq!(model.constants, [("self".to_string(), 2.0)]);
 }

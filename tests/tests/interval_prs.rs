@@ -5,9 +5,10 @@
 use reachc_compiler::backend::{interp::Interpreter, prepare};
 use reachc_compiler::driver::load;
 use reachc_e2e::{euler_maruyama, shipped_specs, workspace, Rng};
-use reachc_runtime::engine::{self, AnalysisResult, RunError};
-use reachc_runtime::system::{Analysis, Constants, Inclusion, Method, ModelInfo, Rate};
-use reachc_runtime::System;
+use reachc_runtime::engine::{self, RunError};
+use reachc_runtime::model::{Analysis, Bounds, Constants, Inclusion, Method, ModelInfo, Rate};
+use reachc_runtime::prs::DetSet;
+use reachc_runtime::{Prs, Reach, System};
 
 /// The shipped spec's model with the interpreter and its info.
 fn interpreter(path: &std::path::Path) -> (Interpreter, ModelInfo) {
@@ -18,15 +19,19 @@ fn interpreter(path: &std::path::Path) -> (Interpreter, ModelInfo) {
 }
 
 /// Placeholder constants: only the boxes are checked here, and they do not depend on them.
-fn placeholder(n: usize) -> Constants {
-    Constants {
-        metric: (0..n * n)
-            .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
-            .collect(),
-        c: 0.0,
-        sigma: 0.0,
-        rho: 0.0,
-        how: "test placeholder".into(),
+fn placeholder(info: &ModelInfo) -> Constants {
+    let n = info.states.len();
+    let identity = (0..n * n)
+        .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
+        .collect();
+    Constants::given(info, identity, 0.0, 0.0, 0.0)
+}
+
+/// The box `(lo, hi)` of an interval result's step (in `y = T x` for a parallelotope).
+fn y_box(d: &DetSet) -> (&[f64], &[f64]) {
+    match d {
+        DetSet::Box { lo, hi, .. } | DetSet::Parallelotope { lo, hi, .. } => (lo, hi),
+        DetSet::Ball { .. } => panic!("not an interval result"),
     }
 }
 
@@ -36,7 +41,7 @@ fn initial_state(info: &ModelInfo, rng: &mut Rng) -> Vec<f64> {
         .initial
         .boxes
         .iter()
-        .map(|b| b.map_or(0.0, |(lo, hi)| rng.uniform(lo, hi)))
+        .map(|b| b.map_or(0.0, |b| rng.uniform(b.lo, b.hi)))
         .collect();
     for ball in &info.initial.balls {
         let k = ball.states.len();
@@ -66,7 +71,7 @@ fn initial_state(info: &ModelInfo, rng: &mut Rng) -> Vec<f64> {
 fn first_escape(
     sys: &dyn System,
     info: &ModelInfo,
-    r: &AnalysisResult,
+    r: &Prs,
     samples: usize,
     seed: u64,
 ) -> Option<String> {
@@ -100,7 +105,7 @@ fn first_escape(
             }
             if k % hold == 0 {
                 for (j, uj) in u.iter_mut().enumerate() {
-                    let (lo, hi) = info.input_box[j];
+                    let Bounds { lo, hi } = info.input_box[j];
                     // Corners half of the time: extreme inputs push the boxes' faces.
                     *uj = match rng.next() {
                         v if v < 0.25 => lo,
@@ -109,16 +114,13 @@ fn first_escape(
                     };
                 }
             }
-            let (lo, hi) = (
-                st.det_set.lo.as_ref().unwrap(),
-                st.det_set.hi.as_ref().unwrap(),
-            );
+            let (lo, hi) = y_box(&st.det);
             // The box's coordinates: x itself, or y = T x.
             let y: Vec<f64> = match &r.transform {
                 None => x.clone(),
                 Some(tr) => tr
                     .matrix
-                    .iter()
+                    .chunks(n)
                     .map(|row| row.iter().zip(&x).map(|(a, b)| a * b).sum())
                     .collect(),
             };
@@ -155,7 +157,9 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
             // is zero: neither a numerically integrated embedding nor the sampled "true"
             // trajectories are meaningful there. Start well off the reference (the error stays
             // away from 0 for the first second).
-            info.initial.boxes = vec![Some((5.3, 5.4)), Some((4.6, 4.7)), Some((-2.1, -2.0))];
+            info.initial.boxes = [(5.3, 5.4), (4.6, 4.7), (-2.1, -2.0)]
+                .map(|(lo, hi)| Some(Bounds::new(lo, hi)))
+                .to_vec();
             horizon = Some(1.0);
         }
         for a in &info.analyses {
@@ -165,17 +169,16 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
                     continue;
                 }
                 // An empirical rate has no certified c: the interval method gets a placeholder.
-                let certified = a.constants.clone().filter(|c| c.c.is_finite());
-                let variant = Analysis {
-                    method: Method::Interval,
-                    rate: Rate::Certified,
-                    inclusion,
-                    constants: Some(certified.unwrap_or_else(|| placeholder(n))),
-                    transform: a.transform.clone().filter(|_| a.method == Method::Interval),
-                    horizon: horizon.unwrap_or(a.horizon),
+                let certified = a.constants.clone().ok().filter(|c| c.c.is_finite());
+                let mut variant = Analysis {
+                    constants: Ok(certified.unwrap_or_else(|| placeholder(&info))),
                     ..a.clone()
                 };
-                let label = format!("{} / {} / {}", path.display(), a.name, inclusion.name());
+                let v = &mut variant.spec;
+                v.transform = v.transform.take().filter(|_| v.method == Method::Interval);
+                (v.method, v.rate, v.inclusion) = (Method::Interval, Rate::Certified, inclusion);
+                v.horizon = horizon.unwrap_or(v.horizon);
+                let label = format!("{} / {} / {}", path.display(), v.name, inclusion.name());
                 let start = std::time::Instant::now();
                 match engine::run(&sys, &info, &variant) {
                     Ok(r) => {
@@ -196,14 +199,13 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
     assert!(checked >= 25, "only {checked} analyses checked");
 }
 
-fn pendulum_interval(inclusion: Inclusion) -> (AnalysisResult, Interpreter, ModelInfo) {
+fn pendulum_interval(inclusion: Inclusion) -> (Prs, Interpreter, ModelInfo) {
     let (sys, info) = interpreter(&workspace().join("specs/pendulum.sde"));
-    let a = info.analyses.iter().find(|a| a.name == "interval").unwrap();
-    let a = Analysis {
-        inclusion,
-        ..a.clone()
-    };
-    let r = engine::run(&sys, &info, &a).unwrap();
+    let r = Reach::new(&sys, &info, "interval")
+        .unwrap()
+        .with_inclusion(inclusion)
+        .run()
+        .unwrap();
     (r, sys, info)
 }
 
@@ -217,46 +219,34 @@ fn pendulum_in_transformed_coordinates() {
     for inclusion in [Inclusion::Natural, Inclusion::Jacobian, Inclusion::Mixed] {
         let (r, _, _) = pendulum_interval(inclusion);
         let tr = r.transform.as_ref().unwrap();
-        assert_eq!(tr.matrix, vec![vec![1.0, 0.2], vec![1.0, 0.0]]);
+        assert_eq!(tr.matrix, [1.0, 0.2, 1.0, 0.0]);
         assert!(tr.inverse_error > 0.0 && tr.inverse_error < 1e-14);
-        let first = &r.steps[0].det_set;
-        assert_eq!(first.shape, "parallelotope");
-        let (lo, hi) = (first.lo.as_ref().unwrap(), first.hi.as_ref().unwrap());
+        let first = &r.steps[0].det;
+        assert!(matches!(first, DetSet::Parallelotope { .. }));
+        let (lo, hi) = y_box(first);
         // y1 = theta + 0.2 omega over X0: +-(pi/10 + 0.04), rounded outward.
         assert!(hi[0] >= a + 0.04 && hi[0] <= a + 0.04 + 1e-15 && lo[0] == -hi[0]);
         assert!(hi[1] == a && lo[1] == -a);
-        let last = &r.steps.last().unwrap().det_set;
-        let half: Vec<f64> = (0..2)
-            .map(|i| (last.hi.as_ref().unwrap()[i] - last.lo.as_ref().unwrap()[i]) / 2.0)
-            .collect();
+        let last = &r.steps.last().unwrap().det;
+        let (llo, lhi) = y_box(last);
+        let half: Vec<f64> = (0..2).map(|i| (lhi[i] - llo[i]) / 2.0).collect();
         let name = inclusion.name();
         assert!(
             half[0] > 0.035 && half[0] < 0.0385 && half[1] > 0.04 && half[1] < 0.043,
             "{name}: half-widths at t = 4: {half:?}"
         );
-        // `engine::reach` gives the same boxes without the stochastic part.
+        // `engine::interval_boxes` gives the same boxes without the stochastic part.
         let (sys, info) = interpreter(&workspace().join("specs/pendulum.sde"));
-        let a = info.analyses.iter().find(|a| a.name == "interval").unwrap();
-        let boxes = engine::reach(
-            &sys,
-            &info,
-            &Analysis {
-                inclusion,
-                ..a.clone()
-            },
-        )
-        .unwrap();
+        let mut spec = info.analysis("interval").unwrap().spec.clone();
+        spec.inclusion = inclusion;
+        let boxes = engine::interval_boxes(&sys, &info, &spec).unwrap();
         assert_eq!(boxes.len(), r.steps.len());
         for ((t, lo, hi), st) in boxes.iter().zip(&r.steps) {
             assert_eq!(*t, st.t);
-            assert_eq!(Some(lo), st.det_set.lo.as_ref());
-            assert_eq!(Some(hi), st.det_set.hi.as_ref());
+            assert_eq!((&lo[..], &hi[..]), y_box(&st.det));
         }
         // The hull in x contains the parallelotope's vertices.
-        let (hl, hh) = (
-            last.hull_lo.as_ref().unwrap(),
-            last.hull_hi.as_ref().unwrap(),
-        );
+        let (hl, hh) = last.box_hull().unwrap();
         for (s1, s2) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
             let y = [s1 * half[0], s2 * half[1]];
             let x = [y[1], 5.0 * (y[0] - y[1])];
@@ -281,7 +271,7 @@ fn transformed_pendulum_prs_covers_monte_carlo_paths() {
         let mut t = 0.0;
         for (k, &tc) in checkpoints.iter().enumerate() {
             euler_maruyama(&sys, &mut x, &mut t, tc, dt, &mut rng);
-            if !engine::contains(&r, step_of(tc), &x) {
+            if !r.contains_at(step_of(tc), &x) {
                 outside[k] += 1;
             }
         }
@@ -297,7 +287,7 @@ fn transformed_pendulum_prs_covers_monte_carlo_paths() {
     // Not vacuous: a point 2 r_t beyond the parallelotope along theta is outside.
     let k = step_of(4.0);
     let st = &r.steps[k];
-    let far = [st.det_set.hull_hi.as_ref().unwrap()[0] + 2.0 * st.r_t, 0.0];
-    assert!(!engine::contains(&r, k, &far));
-    assert!(engine::contains(&r, k, &[0.0, 0.0]));
+    let far = [st.det.box_hull().unwrap().1[0] + 2.0 * st.r_t, 0.0];
+    assert!(!r.contains_at(k, &far));
+    assert!(r.contains_at(k, &[0.0, 0.0]));
 }

@@ -4,29 +4,18 @@
 use reachc_compiler::backend::{interp::Interpreter, prepare};
 use reachc_compiler::driver::load;
 use reachc_e2e::{euler_maruyama, workspace, Rng};
-use reachc_runtime::engine::{self, AnalysisResult};
-use reachc_runtime::System;
+use reachc_runtime::{ModelInfo, Prs, Reach, System};
 
 /// Runs analysis `name` of the shipped spec `spec` with the interpreter.
-fn run(
-    spec: &str,
-    name: &str,
-) -> (
-    AnalysisResult,
-    Interpreter,
-    reachc_runtime::system::ModelInfo,
-) {
+fn run(spec: &str, name: &str) -> (Prs, Interpreter, ModelInfo) {
     let mut model = load(&workspace().join("specs").join(spec)).unwrap().model;
     let prepared = prepare(&mut model);
     assert!(prepared.warnings.is_empty(), "{:#?}", prepared.warnings);
     let interp = Interpreter::new(model, &prepared);
-    let analysis = prepared
-        .info
-        .analyses
-        .iter()
-        .find(|a| a.name == name)
+    let result = Reach::new(&interp, &prepared.info, name)
+        .unwrap()
+        .run()
         .unwrap();
-    let result = engine::run(&interp, &prepared.info, analysis).unwrap();
     (result, interp, prepared.info)
 }
 
@@ -75,7 +64,7 @@ fn linear_constants_psi_and_radius_match_closed_forms_and_reference() {
                 s.t
             );
             // X0 = 0 exactly and no inputs: the deterministic set is the nominal point.
-            assert_eq!(s.det_set.radius, 0.0);
+            assert_eq!(s.det.radius(), 0.0);
         }
         assert!((r.steps.last().unwrap().t - 1.5).abs() < 1e-12);
     }
@@ -100,18 +89,18 @@ fn pendulum_prs_covers_monte_carlo_paths() {
             .boxes
             .iter()
             .map(|b| {
-                let (lo, hi) = b.unwrap();
-                rng.uniform(lo, hi)
+                let b = b.unwrap();
+                rng.uniform(b.lo, b.hi)
             })
             .collect();
         let mut t = 0.0;
         for (k, &tc) in checkpoints.iter().enumerate() {
             euler_maruyama(&sys, &mut x, &mut t, tc, dt, &mut rng);
             let s = &r.steps[step_of(tc)];
-            let d: Vec<f64> = x.iter().zip(&s.nominal).map(|(a, b)| a - b).collect();
+            let d: Vec<f64> = x.iter().zip(s.nominal()).map(|(a, b)| a - b).collect();
             let p = &r.constants.metric;
             let norm = (0..n)
-                .map(|i| (0..n).map(|j| d[i] * p[i][j] * d[j]).sum::<f64>())
+                .map(|i| (0..n).map(|j| d[i] * p[i * n + j] * d[j]).sum::<f64>())
                 .sum::<f64>()
                 .sqrt();
             if norm > s.prs_radius {

@@ -22,15 +22,16 @@ fn random_point(model: &Model, rng: &mut Rng) -> Point {
         .states
         .iter()
         .zip(&model.domain)
-        .map(|(s, d)| {
-            let (lo, hi) = s.bounds.map_or((-2.0, 2.0), |b| (b.lo - 3.0, b.hi + 3.0));
+        .zip(&model.initial.boxes)
+        .map(|((_, d), b)| {
+            let (lo, hi) = b.map_or((-2.0, 2.0), |b| (b.lo - 3.0, b.hi + 3.0));
             rng.uniform(lo.max(d.lo), hi.min(d.hi))
         })
         .collect();
     let inputs = model
-        .inputs
+        .input_box
         .iter()
-        .map(|u| u.bounds.map_or(0.0, |b| rng.uniform(b.lo, b.hi)))
+        .map(|b| rng.uniform(b.lo, b.hi))
         .collect();
     Point {
         states,
@@ -173,8 +174,9 @@ fn printed_expressions_parse_back_to_the_same_function() {
         exprs.extend(d.jac_x.iter().flatten());
         exprs.extend(d.jac_u.iter().flatten());
         exprs.extend(d.jac_g.iter().map(|g| g.expr));
-        let names_of =
-            |v: &[reachc_compiler::model::Variable]| v.iter().map(|x| x.name.clone()).collect::<Vec<_>>();
+        let names_of = |v: &[reachc_compiler::model::Variable]| {
+            v.iter().map(|x| x.name.clone()).collect::<Vec<_>>()
+        };
         let (s, u, w) = (
             names_of(&model.states),
             names_of(&model.inputs),

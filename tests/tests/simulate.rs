@@ -5,8 +5,10 @@
 use reachc_compiler::backend::{interp::Interpreter, prepare};
 use reachc_compiler::driver::load;
 use reachc_e2e::{relative, shipped_specs};
-use reachc_runtime::engine::{self, RunError};
+use reachc_runtime::engine::RunError;
+use reachc_runtime::report::simulation::summary;
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::Reach;
 
 #[test]
 fn every_shipped_spec_passes_the_coverage_check() {
@@ -19,10 +21,10 @@ fn every_shipped_spec_passes_the_coverage_check() {
         // n = 1000: fewer paths keep the test short.
         let paths = if info.states.len() > 100 { 200 } else { 1_000 };
         for analysis in &info.analyses {
-            let mut analysis = analysis.clone();
-            analysis.delta = 0.01;
-            let name = format!("{} / {}", relative(&spec), analysis.name);
-            let result = match engine::run(&interp, &info, &analysis) {
+            let name = format!("{} / {}", relative(&spec), analysis.spec.name);
+            let reach =
+                Reach::for_analysis(&interp, &info, analysis).and_then(|r| r.with_delta(0.01));
+            let result = match reach.and_then(|r| r.run()) {
                 Ok(r) => r,
                 // No constants (the unicycle's tracking controller): no PRS to check.
                 Err(RunError::NoConstants(_) | RunError::Unsupported(_)) => continue,
@@ -35,7 +37,7 @@ fn every_shipped_spec_passes_the_coverage_check() {
             };
             let report = simulate::simulate(&interp, &info, &result, &opts, &mut |_, _| {})
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
-            assert!(report.passed(), "{name}:\n{}", report.summary());
+            assert!(report.passed(), "{name}:\n{}", summary(&report));
             // Not vacuous: the quantile is a sizeable part of the PRS radius somewhere.
             let ratio = report
                 .steps

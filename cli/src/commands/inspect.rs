@@ -239,9 +239,15 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             .states
             .iter()
             .zip(&model.domain)
-            .map(|(s, d)| json!({"name": s.name, "initial": bounds_json(s.bounds), "domain": [d.lo, d.hi]}))
+            .zip(&model.initial.boxes)
+            .map(|((s, d), b)| json!({"name": s.name, "initial": bounds_json(*b), "domain": [d.lo, d.hi]}))
             .collect(),
-        inputs: model.inputs.iter().map(|u| json!({"name": u.name, "range": bounds_json(u.bounds)})).collect(),
+        inputs: model
+            .inputs
+            .iter()
+            .zip(&model.input_box)
+            .map(|(u, b)| json!({"name": u.name, "range": bounds_json(Some(*b))}))
+            .collect(),
         noise: model.noises.iter().map(|w| w.name.as_str()).collect(),
         initial_balls: model
             .initial
@@ -249,7 +255,8 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             .iter()
             .map(|b| {
                 let over: Vec<&str> = b.states.iter().map(|&i| model.states[i].name.as_str()).collect();
-                json!({"over": over, "center": b.center, "radius": b.radius, "metric": b.metric})
+                let metric: Option<Vec<&[f64]>> = b.metric.as_ref().map(|m| m.chunks(b.states.len()).collect());
+                json!({"over": over, "center": b.center, "radius": b.radius, "metric": metric})
             })
             .collect(),
         domain_given: model.has_domain,
@@ -288,7 +295,8 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             .analyses
             .iter()
             .map(|a| {
-                json!({"name": a.name, "method": format!("{:?}", a.method).to_lowercase(),
+                let a = &a.spec;
+                json!({"name": a.name, "method": a.method.name(),
                        "delta": a.delta, "horizon": a.horizon, "step": a.step})
             })
             .collect(),
@@ -336,10 +344,13 @@ pub fn text(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
         let _ = writeln!(o, "  /// {line}");
     }
     let _ = writeln!(o, "\nstates (initial set; domain):");
-    for (s, d) in model.states.iter().zip(&model.domain) {
-        let init = s
-            .bounds
-            .map_or_else(|| "in an initial ball".to_string(), fmt_bounds);
+    for ((s, d), b) in model
+        .states
+        .iter()
+        .zip(&model.domain)
+        .zip(&model.initial.boxes)
+    {
+        let init = b.map_or_else(|| "in an initial ball".to_string(), fmt_bounds);
         let _ = writeln!(o, "  {:<12} {:<30} domain {}", s.name, init, fmt_bounds(*d));
     }
     for b in &model.initial.balls {
@@ -363,13 +374,8 @@ pub fn text(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     }
     if !model.inputs.is_empty() {
         let _ = writeln!(o, "\ninputs:");
-        for u in &model.inputs {
-            let _ = writeln!(
-                o,
-                "  {:<12} {}",
-                u.name,
-                u.bounds.map_or_else(String::new, fmt_bounds)
-            );
+        for (u, b) in model.inputs.iter().zip(&model.input_box) {
+            let _ = writeln!(o, "  {:<12} {}", u.name, fmt_bounds(*b));
         }
     }
     if !model.noises.is_empty() {

@@ -11,15 +11,15 @@ use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 use reachc_runtime::engine;
+use reachc_runtime::model::ModelInfo;
 use reachc_runtime::simulate::{self, SimReport};
-use reachc_runtime::system::ModelInfo;
 
 use super::{load_reporting, EXIT_USAGE};
+use crate::plot::input::{ResultFile, SimFile};
+use crate::plot::{self, select, Choice, Model, Quantile};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_compiler::driver::Loaded;
-use crate::plot::input::{ResultFile, SimFile};
-use crate::plot::{self, select, Choice, Model, Quantile};
 
 /// Paths `reachc run --plot` simulates for the quantile when no report is at hand.
 pub const RUN_QUANTILE_PATHS: u64 = 2000;
@@ -112,7 +112,12 @@ pub(super) fn result_stamps(args: &RunPlotArgs, loaded: &Loaded, out_dir: &Path)
         .model
         .analyses
         .iter()
-        .map(|a| (a.name.clone(), modified(&result_path(out_dir, &a.name))))
+        .map(|a| {
+            (
+                a.spec.name.clone(),
+                modified(&result_path(out_dir, &a.spec.name)),
+            )
+        })
         .collect()
 }
 
@@ -240,7 +245,7 @@ fn run_quantile(model: &Model<'_>, json: &Path, result: &ResultFile) -> Option<Q
         .info
         .analyses
         .iter()
-        .find(|a| a.name == result.analysis)?;
+        .find(|a| a.spec.name == result.analysis)?;
     let computed = engine::run(model.sys, model.info, analysis).ok()?;
     let opts = simulate::Options {
         paths: RUN_QUANTILE_PATHS,
@@ -299,22 +304,25 @@ pub(super) fn plot_after_run(
     for a in info
         .analyses
         .iter()
-        .filter(|a| analysis.is_none_or(|name| a.name == name))
+        .filter(|a| analysis.is_none_or(|name| a.spec.name == name))
     {
-        let plotted = if a.constants.is_none() {
+        let plotted = if a.constants.is_err() {
             eprintln!(
                 "note: analysis `{}` has no PRS: plotting its sample paths and unsafe sets only",
-                a.name
+                a.spec.name
             );
             plot::plot_without_result(&model, a, &choice, dir)
         } else {
-            let json = result_path(out_dir, &a.name);
-            let previous = before.iter().find(|(n, _)| *n == a.name).and_then(|b| b.1);
+            let json = result_path(out_dir, &a.spec.name);
+            let previous = before
+                .iter()
+                .find(|(n, _)| *n == a.spec.name)
+                .and_then(|b| b.1);
             let fresh = modified(&json).is_some_and(|t| Some(t) != previous);
             if !fresh {
                 eprintln!(
                     "note: no result for analysis `{}` from this run: not plotted",
-                    a.name
+                    a.spec.name
                 );
                 continue;
             }
@@ -326,7 +334,7 @@ pub(super) fn plot_after_run(
         match plotted {
             Ok(files) => report_written(&files),
             Err(e) => {
-                eprintln!("error: plotting analysis `{}`: {e}", a.name);
+                eprintln!("error: plotting analysis `{}`: {e}", a.spec.name);
                 status = Err(EXIT_USAGE);
             }
         }

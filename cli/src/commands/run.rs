@@ -8,13 +8,15 @@ use clap::ValueEnum;
 
 use super::plot::{self, RunPlotArgs};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
-use reachc_compiler::backend::crate_writer::{compile_crate, shared_target_dir, write_crate, CrateOptions};
+use reachc_compiler::backend::crate_writer::{
+    compile_crate, shared_target_dir, write_crate, CrateOptions,
+};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::{mangle, prepare};
 use reachc_compiler::diagnostics::render;
 use reachc_compiler::driver::Loaded;
-use reachc_runtime::app::DEFAULT_OUT_DIR;
-use reachc_runtime::system::ModelInfo;
+use reachc_runtime::app::{RunOptions, DEFAULT_OUT_DIR};
+use reachc_runtime::model::ModelInfo;
 
 /// Which backend computes the sets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -37,19 +39,20 @@ pub fn run_spec(
     let color = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
     plot::check_states(plot, &loaded)?;
-    let out_dir = out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR));
-    let mut args = vec!["-o".to_string(), out_dir.display().to_string()];
-    if let Some(name) = &analysis {
-        args.extend(["--analysis".to_string(), name.clone()]);
-    }
+    let opts = RunOptions {
+        analysis: analysis.clone(),
+        out_dir: out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR)),
+        quiet: false,
+    };
+    let out_dir = opts.out_dir.clone();
     let before = plot::result_stamps(plot, &loaded, &out_dir);
     let (code, model) = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
-            let code = reachc_runtime::app::run_cli(
+            let code = reachc_runtime::app::run(
                 &interp,
                 &info,
-                &args,
+                &opts,
                 &mut std::io::stdout().lock(),
                 &mut std::io::stderr().lock(),
             );
@@ -58,7 +61,7 @@ pub fn run_spec(
         Backend::Compiled => {
             let binary = compiled_binary(&mut loaded, color)?;
             let status = std::process::Command::new(&binary)
-                .args(&args)
+                .args(opts.to_args())
                 .status()
                 .map_err(|e| {
                     eprintln!("error: cannot run {}: {e}", binary.display());

@@ -10,6 +10,8 @@ use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 
 use super::run::{compiled_binary, interpreter, Backend};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
+use reachc_runtime::app::{SimulateOptions, DEFAULT_OUT_DIR};
+use reachc_runtime::simulate::{self, InputMode};
 
 /// The options passed on to the simulation (the runtime's `simulate` command line).
 #[derive(clap::Args, Debug)]
@@ -30,8 +32,8 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub delta: Option<f64>,
     /// Inputs: uniform in the box, random corners (both piecewise constant), or the centre.
-    #[arg(long, value_parser = ["random", "corners", "centre", "center"], default_value = "random")]
-    pub inputs: String,
+    #[arg(long, value_enum, default_value = "random")]
+    pub inputs: Inputs,
     /// Hold time of piecewise-constant inputs (default: the analysis' step).
     #[arg(long)]
     pub hold: Option<f64>,
@@ -46,28 +48,42 @@ pub struct SimulateArgs {
     pub quiet: bool,
 }
 
+/// How the paths' inputs are drawn ([`InputMode`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Inputs {
+    /// Uniform in the input box, piecewise constant.
+    Random,
+    /// A random corner of the input box, piecewise constant.
+    Corners,
+    /// The centre of the input box.
+    #[value(alias = "center")]
+    Centre,
+}
+
 impl SimulateArgs {
-    /// The arguments of the runtime's `simulate` mode (without the word `simulate`).
-    fn to_args(&self, out: Option<&Path>) -> Vec<String> {
-        let mut args = vec!["--paths".to_string(), self.paths.to_string()];
-        let mut opt = |flag: &str, v: Option<String>| {
-            if let Some(v) = v {
-                args.extend([flag.to_string(), v]);
-            }
+    /// The runtime's options for these arguments, writing to `out`.
+    fn options(&self, out: Option<PathBuf>) -> SimulateOptions {
+        let inputs = match self.inputs {
+            Inputs::Random => InputMode::Random,
+            Inputs::Corners => InputMode::Corners,
+            Inputs::Centre => InputMode::Centre,
         };
-        opt("--analysis", self.analysis.clone());
-        opt("--seed", Some(self.seed.to_string()));
-        opt("--dt", self.dt.map(|v| v.to_string()));
-        opt("--delta", self.delta.map(|v| v.to_string()));
-        opt("--inputs", Some(self.inputs.clone()));
-        opt("--hold", self.hold.map(|v| v.to_string()));
-        opt("--confidence", Some(self.confidence.to_string()));
-        opt("--threads", self.threads.map(|v| v.to_string()));
-        opt("-o", out.map(|d| d.display().to_string()));
-        if self.quiet {
-            args.push("--quiet".into());
+        SimulateOptions {
+            analysis: self.analysis.clone(),
+            out_dir: out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR)),
+            quiet: self.quiet,
+            progress: false,
+            delta: self.delta,
+            sim: simulate::Options {
+                paths: self.paths,
+                seed: self.seed,
+                dt: self.dt,
+                inputs,
+                hold: self.hold,
+                confidence: self.confidence,
+                threads: self.threads,
+            },
         }
-        args
     }
 }
 
@@ -120,16 +136,16 @@ pub fn run_simulate(
     let color = std::io::stderr().is_terminal();
     let show_bar = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
-    let args = sim.to_args(out.as_deref());
+    let mut opts = sim.options(out);
     let code = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
             let mut bars = Bars::new();
             let mut progress = |a: &str, done: u64, total: u64| bars.update(a, done, total);
-            reachc_runtime::app::simulate_cli(
+            reachc_runtime::app::simulate(
                 &interp,
                 &info,
-                &args,
+                &opts,
                 &mut std::io::stdout().lock(),
                 &mut std::io::stderr().lock(),
                 show_bar.then_some(&mut progress as &mut dyn FnMut(&str, u64, u64)),
@@ -137,7 +153,9 @@ pub fn run_simulate(
         }
         Backend::Compiled => {
             let binary = compiled_binary(&mut loaded, color)?;
-            run_binary(&binary, &args, show_bar)?
+            // With a bar, the binary's `reachc-progress` lines drive it.
+            opts.progress = show_bar;
+            run_binary(&binary, &opts.to_args(), show_bar)?
         }
     };
     match code {
@@ -155,13 +173,12 @@ fn run_binary(binary: &Path, args: &[String], show_bar: bool) -> Result<u8, u8> 
         EXIT_USAGE
     };
     let mut cmd = Command::new(binary);
-    cmd.arg("simulate").args(args);
+    cmd.args(args);
     if !show_bar {
         let status = cmd.status().map_err(cannot_run)?;
         return Ok(exit_code(status));
     }
     let mut child = cmd
-        .arg("--progress")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()

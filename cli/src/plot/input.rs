@@ -14,8 +14,8 @@ pub struct ResultFile {
     pub model: String,
     /// The analysis' name (also the output file names).
     pub analysis: String,
-    /// `"contraction"` or `"interval"`.
-    pub method: String,
+    /// How the deterministic sets were computed.
+    pub method: Method,
     /// Probability level.
     pub delta: f64,
     /// State names.
@@ -31,6 +31,28 @@ pub struct ResultFile {
     pub initial_center: Vec<f64>,
     /// One record per report time.
     pub steps: Vec<Step>,
+}
+
+/// The method of a result (`"contraction"` or `"interval"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// P-balls around the nominal trajectory.
+    Contraction,
+    /// Boxes (or parallelotopes) of an embedding system.
+    Interval,
+}
+
+/// The shape of a deterministic set (`"p_ball"`, `"box"` or `"parallelotope"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Shape {
+    /// `{x : |x - center|_P <= radius}`.
+    PBall,
+    /// `{x : lo <= x <= hi}`.
+    Box,
+    /// `{x : lo <= T x <= hi}`.
+    Parallelotope,
 }
 
 /// The constants of a result (only the metric is drawn).
@@ -65,8 +87,8 @@ pub struct Step {
 /// A deterministic set: `p_ball`, `box` or `parallelotope` (see docs/results.md).
 #[derive(Clone, Debug, Deserialize)]
 pub struct DetSet {
-    /// The shape's name.
-    pub shape: String,
+    /// Its shape.
+    pub shape: Shape,
     /// Centre of the P-ball (`p_ball`).
     pub center: Vec<f64>,
     /// Radius `R_t` of the P-ball.
@@ -145,14 +167,13 @@ impl ResultFile {
                 (Some(lo), Some(hi)) => lo.len() == n && hi.len() == n && finite(lo) && finite(hi),
                 _ => false,
             };
-            let shape_ok = match d.shape.as_str() {
-                "p_ball" => d.center.len() == n && finite(&d.center) && d.radius.is_finite(),
-                "box" => corners,
-                "parallelotope" => corners && self.transform.is_some(),
-                other => return Err(format!("step {k}: unknown set shape `{other}`")),
+            let shape_ok = match d.shape {
+                Shape::PBall => d.center.len() == n && finite(&d.center) && d.radius.is_finite(),
+                Shape::Box => corners,
+                Shape::Parallelotope => corners && self.transform.is_some(),
             };
             if !shape_ok {
-                return Err(format!("step {k}: malformed `{}` set", d.shape));
+                return Err(format!("step {k}: malformed {:?} set", d.shape));
             }
             if s.nominal.len() != n || !finite(&s.nominal) {
                 return Err(format!(

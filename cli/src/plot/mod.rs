@@ -24,13 +24,14 @@ pub mod select;
 
 use std::path::{Path, PathBuf};
 
+use reachc_runtime::model::{Analysis, ModelInfo};
 use reachc_runtime::simulate::{self, Options};
-use reachc_runtime::system::{Analysis, ModelInfo, System};
+use reachc_runtime::System;
 
-use reachc_compiler::ir::Table;
 use geometry::{Plane, Point};
 use input::ResultFile;
 use output::Draw;
+use reachc_compiler::ir::Table;
 use regions::Region;
 
 /// Sample paths drawn by default.
@@ -226,7 +227,7 @@ pub fn plot_result(
 /// The report times `0, step, 2 step, ..., horizon` of an analysis (the last step may be
 /// shorter; a ratio that is an integer up to rounding adds no sliver step).
 fn report_times(analysis: &Analysis) -> Vec<f64> {
-    let (h, s) = (analysis.horizon, analysis.step);
+    let (h, s) = (analysis.spec.horizon, analysis.spec.step);
     let steps = (h / s * (1.0 - 1e-12)).ceil().max(1.0) as usize;
     let mut times: Vec<f64> = (0..steps).map(|k| k as f64 * s).collect();
     times.push(h);
@@ -243,13 +244,14 @@ pub fn plot_without_result(
 ) -> Result<Vec<PathBuf>, String> {
     font::register()?;
     let info = model.info;
-    if !(analysis.step > 0.0 && analysis.horizon > 0.0 && analysis.horizon / analysis.step <= 1e7) {
+    let a = &analysis.spec;
+    if !(a.step > 0.0 && a.horizon > 0.0 && a.horizon / a.step <= 1e7) {
         return Err(format!(
             "analysis `{}`: horizon {} and step {} give no report times to plot",
-            analysis.name, analysis.horizon, analysis.step
+            a.name, a.horizon, a.step
         ));
     }
-    let states = select::pick_states(&info.states, &analysis.outputs, choice.states.as_deref())?;
+    let states = select::pick_states(&info.states, &a.outputs, choice.states.as_deref())?;
     let times = report_times(analysis);
     let picked = select::pick_times(&times, choice.times.as_deref())?;
     let plane = Plane::of_states(states);
@@ -261,6 +263,6 @@ pub fn plot_without_result(
     sets.notes.extend(notes);
     write_all(
         dir,
-        renderings(&sets, figures::SETS_SIZE, dir, &analysis.name, "sets"),
+        renderings(&sets, figures::SETS_SIZE, dir, &a.name, "sets"),
     )
 }

@@ -8,7 +8,7 @@
 //! project to the whole plane and are not drawn.
 
 use super::geometry::{clip, rectangle, Point};
-use reachc_runtime::system::UnsafeShape;
+use reachc_runtime::model::UnsafeShape;
 
 /// The projection of an unsafe set.
 #[derive(Clone, Debug, PartialEq)]
@@ -50,7 +50,7 @@ impl Region {
                     ranges
                         .iter()
                         .filter(|(i, _)| *i == s)
-                        .fold(all, |acc, (_, r)| (acc.0.max(r.0), acc.1.min(r.1)))
+                        .fold(all, |acc, (_, r)| (acc.0.max(r.lo), acc.1.min(r.hi)))
                 };
                 let (x, y) = (range(plane[0]), range(plane[1]));
                 (x != all || y != all).then_some(Region::Rect { x, y })
@@ -145,12 +145,16 @@ impl Region {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use reachc_runtime::model::Bounds;
 
     #[test]
     fn projections_of_unsafe_sets() {
         let inf = f64::INFINITY;
         // A box over (px, py) in the plane (py, theta): a band in py.
-        let b = UnsafeShape::Box(vec![(0, (2.4, 3.4)), (1, (-0.3, 0.5))]);
+        let b = UnsafeShape::Box(vec![
+            (0, Bounds::new(2.4, 3.4)),
+            (1, Bounds::new(-0.3, 0.5)),
+        ]);
         assert_eq!(
             Region::of(&b, [1, 2]),
             Some(Region::Rect {

@@ -4,9 +4,9 @@
 //! pixels.
 
 use super::geometry::{Plane, Point, Projected};
-use super::input::{ResultFile, Step};
+use super::input::{Method, ResultFile, Shape, Step};
 use super::regions::Region;
-use reachc_runtime::system::{Analysis, ModelInfo};
+use reachc_runtime::model::{Analysis, ModelInfo};
 
 /// The sets figure: a 2-D projection.
 #[derive(Clone, Debug)]
@@ -77,12 +77,12 @@ fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
             d.hi.as_deref().unwrap_or(&[]),
         )
     };
-    match (d.shape.as_str(), &result.transform) {
-        ("box", _) => {
+    match (d.shape, &result.transform) {
+        (Shape::Box, _) => {
             let (lo, hi) = corners();
             plane.boxed(lo, hi)
         }
-        ("parallelotope", Some(t)) => {
+        (Shape::Parallelotope, Some(t)) => {
             let (lo, hi) = corners();
             plane.parallelotope(lo, hi, &t.inverse)
         }
@@ -155,7 +155,7 @@ pub fn sets_scene(
             }
         })
         .collect();
-    let contraction = result.method == "contraction";
+    let contraction = result.method == Method::Contraction;
     let [a, b] = plane.states;
     let shape = match result.transform {
         Some(_) => "parallelotope",
@@ -206,13 +206,13 @@ pub fn paths_scene(
     let paths = project_paths(plane, info.states.len(), paths);
     let [a, b] = plane.states;
     // The reason can be a long Jacobian entry: the warning printed with the spec shows it.
-    let why = match analysis.constants_error.as_deref() {
-        Some(e) if e.chars().count() <= 160 => e.to_string(),
+    let why = match analysis.constants.as_ref().err() {
+        Some(e) if e.chars().count() <= 160 => e.clone(),
         _ => "the analysis' constants (c, sigma, rho) could not be bounded (see the warning)"
             .to_string(),
     };
     SetsScene {
-        title: format!("{} / {}: sample paths", info.name, analysis.name),
+        title: format!("{} / {}: sample paths", info.name, analysis.spec.name),
         axes: [info.states[a].clone(), info.states[b].clone()],
         slices: picked
             .iter()
@@ -240,7 +240,7 @@ pub fn radius_scene(
     result: &ResultFile,
     quantile: Option<(Vec<Option<f64>>, u64, &str)>,
 ) -> RadiusScene {
-    let contraction = result.method == "contraction";
+    let contraction = result.method == Method::Contraction;
     let mut notes = vec![
         format!(
             "radii in the P-norm |v|_P = sqrt(v' P v), δ = {}",

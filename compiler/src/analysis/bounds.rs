@@ -15,7 +15,7 @@ pub fn time_range(model: &Model) -> Interval {
     let end = model
         .analyses
         .iter()
-        .map(|a| a.horizon)
+        .map(|a| a.spec.horizon)
         .reduce(f64::max)
         .unwrap_or(f64::INFINITY);
     Interval::new(0.0, end)
@@ -25,11 +25,7 @@ pub fn time_range(model: &Model) -> Interval {
 /// (outward-rounded interval evaluation; shared sub-expressions evaluated once).
 pub fn eval_box(model: &Model, roots: &[ExprId], time: Interval) -> Vec<Interval> {
     let states: Vec<Interval> = model.domain.iter().map(|&b| to_interval(b)).collect();
-    let inputs: Vec<Interval> = model
-        .inputs
-        .iter()
-        .map(|u| to_interval(u.bounds.unwrap_or(Bounds::ENTIRE)))
-        .collect();
+    let inputs: Vec<Interval> = model.input_box.iter().map(|&b| to_interval(b)).collect();
     // Noise never appears in drift or diffusion coefficients after checking; 0 is a placeholder.
     let noises = vec![Interval::ZERO; model.noises.len()];
     let vars = VarValues {

@@ -16,7 +16,7 @@ use std::fmt;
 
 use nalgebra::{DMatrix, SymmetricEigen};
 use reachc_core::interval::Interval;
-use reachc_core::system::Constants;
+use reachc_core::model::{Bounds, Constants, InputGain, MatrixBound, Provenance, Region};
 
 use super::psd::{certify_min, is_psd, is_zero, sqrt_up, IMat, Pencil};
 use super::{bound_matrix, eval_box, split_atoms, time_range, Derivatives};
@@ -109,33 +109,23 @@ pub(crate) enum MatrixSet {
 }
 
 impl MatrixSet {
-    /// A sentence for [`Constants::how`].
-    fn describe(&self) -> String {
-        let fixed_note = |fixed: usize| {
-            if fixed == 0 {
-                String::new()
-            } else {
-                format!(", {fixed} fixed at one end by semidefiniteness")
-            }
-        };
+    /// What the set is, for the constants' provenance.
+    fn bound(&self) -> MatrixBound {
         match self {
             MatrixSet::Vertices {
                 vertices,
                 atoms,
                 fixed,
-            } => format!(
-                "max over {} vertex matri{} ({atoms} atom{}{})",
-                vertices.len(),
-                if vertices.len() == 1 { "x" } else { "ces" },
-                if *atoms == 1 { "" } else { "s" },
-                fixed_note(*fixed)
-            ),
-            MatrixSet::Hull { atoms, fixed, .. } => format!(
-                "interval-matrix bound ({atoms} atoms{}, {} free > {MAX_VERTEX_ATOMS}, too many \
-                 vertices)",
-                fixed_note(*fixed),
-                atoms - fixed
-            ),
+            } => MatrixBound::Vertices {
+                count: vertices.len(),
+                atoms: *atoms,
+                fixed: *fixed,
+            },
+            MatrixSet::Hull { atoms, fixed, .. } => MatrixBound::Hull {
+                atoms: *atoms,
+                fixed: *fixed,
+                vertex_limit: MAX_VERTEX_ATOMS,
+            },
         }
     }
 }
@@ -603,7 +593,7 @@ pub(crate) fn input_gain(
     set: &MatrixSet,
     p: &IMat,
     h: &[Interval],
-) -> Result<(f64, &'static str), ConstantsError> {
+) -> Result<(f64, InputGain), ConstantsError> {
     let bs: Vec<&IMat> = match set {
         MatrixSet::Vertices { vertices, .. } => vertices.iter().collect(),
         MatrixSet::Hull { matrix, .. } => vec![matrix],
@@ -611,7 +601,7 @@ pub(crate) fn input_gain(
     let n = p.rows;
     let np = h.len();
     if np == 0 || bs.is_empty() {
-        return Ok((0.0, "no inputs"));
+        return Ok((0.0, InputGain::NoInputs));
     }
     for b in &bs {
         for (j, hj) in h.iter().enumerate() {
@@ -658,7 +648,7 @@ pub(crate) fn input_gain(
                 .fold(0.0, f64::max);
             total += Interval::point(sqrt_up(worst));
         }
-        return Ok((total.hi(), "column bound (many inputs)"));
+        return Ok((total.hi(), InputGain::Columns(set.bound())));
     }
     let mut worst = 0.0f64;
     for b in &bs {
@@ -679,7 +669,7 @@ pub(crate) fn input_gain(
             worst = worst.max(quad(&v));
         }
     }
-    Ok((sqrt_up(worst), "max over the input box's corners"))
+    Ok((sqrt_up(worst), InputGain::Corners(set.bound())))
 }
 
 /// The constants of Assumption 1 for a model and one metric `P` (`n x n` row-major, symmetric
@@ -701,12 +691,14 @@ pub fn constants(
     let c = contraction_rate(&jac, &p, metric)?;
     let mut consts = noise_and_input(model, d, metric, &p)?;
     consts.c = c;
-    consts.how = format!("c: {}; {}", jac.describe(), consts.how);
+    if let Provenance::Certified { c, .. } = &mut consts.provenance {
+        *c = Some(jac.bound());
+    }
     Ok(consts)
 }
 
 /// The constants of Assumption 1 without the contraction rate, for analyses whose rate is
-/// estimated at run time ([`Rate::Empirical`](reachc_core::system::Rate::Empirical)):
+/// estimated at run time ([`Rate::Empirical`](reachc_core::model::Rate::Empirical)):
 /// `sigma` and `rho` as in [`constants`], `c` infinite (not bounded here).
 pub fn constants_without_rate(
     model: &Model,
@@ -714,9 +706,7 @@ pub fn constants_without_rate(
     metric: &[f64],
 ) -> Result<Constants, ConstantsError> {
     let p = check_metric(metric, model.states.len())?;
-    let mut consts = noise_and_input(model, d, metric, &p)?;
-    consts.how = format!("c: not bounded by the compiler; {}", consts.how);
-    Ok(consts)
+    noise_and_input(model, d, metric, &p)
 }
 
 /// `sigma` and `rho` (with `c` infinite) and how they were obtained.
@@ -731,31 +721,31 @@ fn noise_and_input(
     let jac_u = matrix_set(model, &d.jac_u, "D_u f", time)?;
     let sigma = noise_level(&diffusion, p)?;
     let h: Vec<Interval> = model
-        .inputs
+        .input_box
         .iter()
-        .map(|u| match u.bounds {
-            Some(b) if b.lo.is_finite() && b.hi.is_finite() => {
+        .map(|&b| match b {
+            b if b.lo.is_finite() && b.hi.is_finite() => {
                 (Interval::point(b.hi) - Interval::point(b.lo)) * 0.5
             }
             _ => Interval::ENTIRE,
         })
         .collect();
-    let (rho, rho_how) = input_gain(&jac_u, p, &h)?;
-    let how = format!(
-        "sigma: {}; rho: {}; certified by interval LDL'",
-        diffusion.describe(),
-        if h.is_empty() {
-            rho_how.to_string()
-        } else {
-            format!("{}, {rho_how}", jac_u.describe())
-        }
-    );
+    let (rho, gain) = input_gain(&jac_u, p, &h)?;
     Ok(Constants {
         metric: metric.to_vec(),
         c: f64::INFINITY,
         sigma,
         rho,
-        how,
+        provenance: Provenance::Certified {
+            c: None,
+            sigma: diffusion.bound(),
+            rho: gain,
+        },
+        region: Region {
+            domain: model.domain.clone(),
+            input_box: model.input_box.clone(),
+            time: Bounds::new(time.lo(), time.hi()),
+        },
     })
 }
 
@@ -797,7 +787,11 @@ mod tests {
             k.sigma
         );
         assert_eq!(k.rho, 0.0);
-        assert!(k.how.contains("2 vertex matrices"), "{}", k.how);
+        assert!(
+            k.provenance.to_string().contains("2 vertex matrices"),
+            "{}",
+            k.provenance
+        );
     }
 
     #[test]
@@ -881,9 +875,11 @@ mod tests {
         // are fixed, one vertex remains, and the bound is the exact -a = -2 (the spec's comment;
         // the interval-matrix bound gave -1.017).
         assert!(
-            k.how.contains("1 vertex matrix (11 atoms, 11 fixed"),
+            k.provenance
+                .to_string()
+                .contains("1 vertex matrix (11 atoms, 11 fixed"),
             "{}",
-            k.how
+            k.provenance
         );
         assert_eq!(k.c, -2.0);
         let s = 0.05f64;
@@ -905,9 +901,13 @@ mod tests {
         let start = std::time::Instant::now();
         let k = constants(&model, &d, &identity(n)).unwrap();
         let elapsed = start.elapsed();
-        eprintln!("chain1000: c = {}, {elapsed:?}, {}", k.c, k.how);
+        eprintln!("chain1000: c = {}, {elapsed:?}, {}", k.c, k.provenance);
         assert_eq!(k.c, -2.0);
-        assert!(k.how.contains("1 vertex matrix"), "{}", k.how);
+        assert!(
+            k.provenance.to_string().contains("1 vertex matrix"),
+            "{}",
+            k.provenance
+        );
         assert!(elapsed.as_secs_f64() < 5.0, "{elapsed:?}");
         // The interval-matrix bound without the fixing, for comparison.
         let t0 = std::time::Instant::now();

@@ -34,7 +34,7 @@ impl Frame {
         // x_i = sum_j (T^-1)_ij y_j.
         let xs: Vec<ExprId> = transform
             .inverse
-            .iter()
+            .chunks(n)
             .map(|row| combine(pool, row, &ys))
             .collect();
         let substituted = |pool: &mut crate::ir::Pool, e: ExprId| {
@@ -52,12 +52,12 @@ impl Frame {
         let m = model.noises.len();
         let drift: Vec<ExprId> = transform
             .matrix
-            .iter()
+            .chunks(n)
             .map(|row| combine(pool, row, &f))
             .collect();
         let diffusion: Vec<Vec<ExprId>> = transform
             .matrix
-            .iter()
+            .chunks(n)
             .map(|row| {
                 (0..m)
                     .map(|k| {
@@ -108,7 +108,7 @@ mod tests {
     #[test]
     fn pendulum_frame_is_simplified() {
         let mut model = pendulum();
-        let t = model.analyses[1].transform.clone().unwrap();
+        let t = model.analyses[1].spec.transform.clone().unwrap();
         let frame = Frame::of(&mut model, &t);
         let names = ["y1".to_string(), "y2".to_string()];
         let noises = ["w".to_string()];
@@ -132,7 +132,7 @@ mod tests {
     #[test]
     fn frame_matches_composition_and_differences() {
         let mut model = pendulum();
-        let t = model.analyses[1].transform.clone().unwrap();
+        let t = model.analyses[1].spec.transform.clone().unwrap();
         let frame = Frame::of(&mut model, &t);
         let eval = |model: &Model, roots: &[ExprId], x: &[f64]| -> Vec<f64> {
             let vars = crate::ir::VarValues {
@@ -155,19 +155,19 @@ mod tests {
             let y = [next(), next()];
             let x: Vec<f64> = t
                 .inverse
-                .iter()
+                .chunks(2)
                 .map(|r| r[0] * y[0] + r[1] * y[1])
                 .collect();
             let f = eval(&model, &model.drift, &x);
             let fy = eval(&model, &frame.drift, &y);
             for i in 0..2 {
-                let want = t.matrix[i][0] * f[0] + t.matrix[i][1] * f[1];
+                let want = t.matrix[2 * i] * f[0] + t.matrix[2 * i + 1] * f[1];
                 assert!((fy[i] - want).abs() <= 1e-12 * (1.0 + want.abs()), "{fy:?}");
             }
             let g = eval(&model, &[model.diffusion[1][0]], &x)[0];
             let gy: Vec<ExprId> = frame.diffusion.iter().map(|r| r[0]).collect();
             let gy = eval(&model, &gy, &y);
-            for (gyi, row) in gy.iter().zip(&t.matrix) {
+            for (gyi, row) in gy.iter().zip(t.matrix.chunks(2)) {
                 assert!((gyi - row[1] * g).abs() <= 1e-15);
             }
             let h = 1e-6;

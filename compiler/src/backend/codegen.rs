@@ -34,9 +34,9 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
-use reachc_core::system::{
-    Analysis, Constants, Inclusion, InitialBall, InitialSet, Integrator, Method, ModelInfo,
-    RadiusRule, Rate, UnsafeSet, UnsafeShape,
+use reachc_core::model::{
+    Analysis, Ball, Bounds, Constants, Inclusion, InitialSet, InputGain, Integrator, MatrixBound,
+    Method, MetricChoice, ModelInfo, Provenance, RadiusRule, Rate, UnsafeSet, UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -143,7 +143,7 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
         let doc = format!(
             " `{name}` in the coordinates `y = T x`, `T = {}`: drift `T f(T^-1 y, u, t)`, \
              diffusion `T G(T^-1 y, t)` (the frame {k} of [`{name}`]'s `System::frame`).",
-            matrix_text(&frame.transform.matrix)
+            matrix_text(&frame.transform.matrix, model.states.len())
         );
         let lints = allow_lints();
         let k = int(k);
@@ -333,10 +333,10 @@ fn system_bodies(
     (bodies, helpers)
 }
 
-/// `[[a, b], [c, d]]`, for docs.
-fn matrix_text(m: &[Vec<f64>]) -> String {
+/// An `n x n` row-major matrix as text for docs, `[[a, b], [c, d]]`.
+fn matrix_text(m: &[f64], n: usize) -> String {
     let rows: Vec<String> = m
-        .iter()
+        .chunks(n.max(1))
         .map(|r| {
             let r: Vec<String> = r.iter().map(|&v| short(v)).collect();
             format!("[{}]", r.join(", "))
@@ -1297,9 +1297,9 @@ fn list(items: impl IntoIterator<Item = TokenStream>) -> TokenStream {
     quote!(Vec::from([#(#items),*]))
 }
 
-fn range((lo, hi): (f64, f64)) -> TokenStream {
-    let (lo, hi) = (float(lo), float(hi));
-    quote!((#lo, #hi))
+fn range(b: Bounds) -> TokenStream {
+    let (lo, hi) = (float(b.lo), float(b.hi));
+    quote!(Bounds::new(#lo, #hi))
 }
 
 fn indices(is: &[usize]) -> TokenStream {
@@ -1382,12 +1382,12 @@ impl InfoWriter {
         let balls: Vec<TokenStream> = s
             .balls
             .iter()
-            .map(|b: &InitialBall| {
+            .map(|b: &Ball| {
                 let states = indices(&b.states);
                 let center = self.floats(&b.center);
                 let radius = float(b.radius);
                 let metric = option(&b.metric, |m| self.floats(m));
-                quote!(InitialBall { states: #states, center: #center, radius: #radius, metric: #metric })
+                quote!(Ball { states: #states, center: #center, radius: #radius, metric: #metric })
             })
             .collect();
         let balls = list(balls);
@@ -1421,21 +1421,56 @@ impl InfoWriter {
         quote!(UnsafeSet { name: #name, shape: #shape })
     }
 
-    fn constants(&mut self, c: &Constants) -> TokenStream {
+    fn constants(&mut self, c: &Constants, info: &ModelInfo) -> TokenStream {
         let metric = self.floats(&c.metric);
         let (cc, sigma, rho) = (float(c.c), float(c.sigma), float(c.rho));
-        let how = string(&c.how);
-        quote!(Constants { metric: #metric, c: #cc, sigma: #sigma, rho: #rho, how: #how })
+        let provenance = provenance(&c.provenance);
+        // The region is the model's domain and input box (bound once in `info()`).
+        let r = &c.region;
+        let domain = if r.domain == info.domain {
+            quote!(domain.clone())
+        } else {
+            list(r.domain.iter().map(|&b| range(b)))
+        };
+        let input_box = if r.input_box == info.input_box {
+            quote!(input_box.clone())
+        } else {
+            list(r.input_box.iter().map(|&b| range(b)))
+        };
+        let time = range(r.time);
+        quote! {
+            Constants {
+                metric: #metric,
+                c: #cc,
+                sigma: #sigma,
+                rho: #rho,
+                provenance: #provenance,
+                region: Region { domain: #domain, input_box: #input_box, time: #time },
+            }
+        }
     }
 
-    fn analysis(&mut self, a: &Analysis) -> TokenStream {
-        let name = string(&a.name);
-        let method = match a.method {
+    fn analysis(&mut self, a: &Analysis, info: &ModelInfo) -> TokenStream {
+        let a_spec = &a.spec;
+        let name = string(&a_spec.name);
+        let method = match a_spec.method {
             Method::Contraction => quote!(Method::Contraction),
             Method::Interval => quote!(Method::Interval),
         };
-        let (delta, horizon, step) = (float(a.delta), float(a.horizon), float(a.step));
-        let radius = match a.radius {
+        let (delta, horizon, step) = (
+            float(a_spec.delta),
+            float(a_spec.horizon),
+            float(a_spec.step),
+        );
+        let metric = match &a_spec.metric {
+            MetricChoice::Identity => quote!(MetricChoice::Identity),
+            MetricChoice::Auto => quote!(MetricChoice::Auto),
+            MetricChoice::Matrix(m) => {
+                let m = self.floats(m);
+                quote!(MetricChoice::Matrix(#m))
+            }
+        };
+        let radius = match a_spec.radius {
             RadiusRule::Amgf => quote!(RadiusRule::Amgf),
             RadiusRule::Paper(eps) => {
                 let eps = float(eps);
@@ -1443,21 +1478,21 @@ impl InfoWriter {
             }
             RadiusRule::PaperOptimal => quote!(RadiusRule::PaperOptimal),
         };
-        let rate = match a.rate {
+        let rate = match a_spec.rate {
             Rate::Certified => quote!(Rate::Certified),
             Rate::Empirical { paths } => quote!(Rate::Empirical { paths: #paths }),
         };
-        let integrator = match a.integrator {
+        let integrator = match a_spec.integrator {
             Integrator::Rk4 => quote!(Integrator::Rk4),
             Integrator::Euler => quote!(Integrator::Euler),
         };
-        let inclusion = match a.inclusion {
+        let inclusion = match a_spec.inclusion {
             Inclusion::Natural => quote!(Inclusion::Natural),
             Inclusion::Jacobian => quote!(Inclusion::Jacobian),
             Inclusion::Mixed => quote!(Inclusion::Mixed),
         };
-        let outputs = indices(&a.outputs);
-        let transform = option(&a.transform, |t| {
+        let outputs = indices(&a_spec.outputs);
+        let transform = option(&a_spec.transform, |t| {
             let (matrix, inverse, frame) = (
                 self.floats(&t.matrix),
                 self.floats(&t.inverse),
@@ -1465,24 +1500,71 @@ impl InfoWriter {
             );
             quote!(Transform { matrix: #matrix, inverse: #inverse, frame: #frame })
         });
-        let consts = option(&a.constants, |c| self.constants(c));
-        let error = option(&a.constants_error, |s| string(s));
+        let constants = match &a.constants {
+            Ok(c) => {
+                let c = self.constants(c, info);
+                quote!(Ok(#c))
+            }
+            Err(e) => {
+                let e = string(e);
+                quote!(Err(#e))
+            }
+        };
         quote! {
             Analysis {
-                name: #name,
-                method: #method,
-                delta: #delta,
-                horizon: #horizon,
-                step: #step,
-                radius: #radius,
-                rate: #rate,
-                integrator: #integrator,
-                inclusion: #inclusion,
-                outputs: #outputs,
-                transform: #transform,
-                constants: #consts,
-                constants_error: #error,
+                spec: AnalysisSpec {
+                    name: #name,
+                    method: #method,
+                    delta: #delta,
+                    horizon: #horizon,
+                    step: #step,
+                    metric: #metric,
+                    radius: #radius,
+                    rate: #rate,
+                    inclusion: #inclusion,
+                    integrator: #integrator,
+                    transform: #transform,
+                    outputs: #outputs,
+                },
+                constants: #constants,
             }
+        }
+    }
+}
+
+/// The literal of a [`Provenance`].
+fn provenance(p: &Provenance) -> TokenStream {
+    let matrix = |m: &MatrixBound| match *m {
+        MatrixBound::Vertices {
+            count,
+            atoms,
+            fixed,
+        } => quote!(MatrixBound::Vertices { count: #count, atoms: #atoms, fixed: #fixed }),
+        MatrixBound::Hull {
+            atoms,
+            fixed,
+            vertex_limit,
+        } => {
+            quote!(MatrixBound::Hull { atoms: #atoms, fixed: #fixed, vertex_limit: #vertex_limit })
+        }
+    };
+    match p {
+        Provenance::Given => quote!(Provenance::Given),
+        Provenance::Certified { c, sigma, rho } => {
+            let c = option(c, matrix);
+            let sigma = matrix(sigma);
+            let rho = match rho {
+                InputGain::NoInputs => quote!(InputGain::NoInputs),
+                InputGain::Corners(m) => {
+                    let m = matrix(m);
+                    quote!(InputGain::Corners(#m))
+                }
+                InputGain::Columns(m) => {
+                    let m = matrix(m);
+                    quote!(InputGain::Columns(#m))
+                }
+            };
+            quote!(Provenance::Certified { c: #c, sigma: #sigma, rho: #rho })
         }
     }
 }
@@ -1498,25 +1580,21 @@ fn info_doc(info: &ModelInfo) -> TokenStream {
     let one_line = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
     let mut list = Vec::new();
     for a in &info.analyses {
-        let method = match a.method {
-            Method::Contraction => "contraction",
-            Method::Interval => "interval",
-        };
-        let what = match (&a.constants, &a.constants_error) {
-            (Some(c), _) => format!(
+        let method = a.spec.method.name();
+        let what = match &a.constants {
+            Ok(c) => format!(
                 "c = {}, sigma = {}, rho = {}\n    {}",
-                match a.rate {
+                match a.spec.rate {
                     Rate::Certified => short(c.c),
                     Rate::Empirical { paths } => format!("empirical ({paths} paths)"),
                 },
                 short(c.sigma),
                 short(c.rho),
-                one_line(&c.how)
+                one_line(&c.provenance.to_string())
             ),
-            (None, Some(e)) => format!("no constants\n    {}", one_line(e)),
-            (None, None) => "no constants".to_string(),
+            Err(e) => format!("no constants\n    {}", one_line(e)),
         };
-        list.push(format!("{} ({method}): {what}", one_line(&a.name)));
+        list.push(format!("{} ({method}): {what}", one_line(&a.spec.name)));
     }
     if !list.is_empty() {
         text.push_str("\n\n");
@@ -1542,7 +1620,7 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
     let has_domain = info.has_domain;
     let unsafe_sets: Vec<TokenStream> = info.unsafe_sets.iter().map(|u| w.unsafe_set(u)).collect();
     let unsafe_sets = list(unsafe_sets);
-    let analyses: Vec<TokenStream> = info.analyses.iter().map(|a| w.analysis(a)).collect();
+    let analyses: Vec<TokenStream> = info.analyses.iter().map(|a| w.analysis(a, info)).collect();
     let analyses = list(analyses);
     let mut statics = w.statics;
     if w.uses_sparse {
@@ -1560,17 +1638,19 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
         #doc
         #lints
         #[must_use]
-        pub fn info() -> reachc_runtime::system::ModelInfo {
-            use reachc_runtime::system::*;
+        pub fn info() -> reachc_runtime::model::ModelInfo {
+            use reachc_runtime::model::*;
             #statics
+            let domain: Vec<Bounds> = #domain;
+            let input_box: Vec<Bounds> = #input_box;
             ModelInfo {
                 name: #name,
                 states: #states,
                 inputs: #inputs,
                 noises: #noises,
-                input_box: #input_box,
+                input_box: input_box.clone(),
                 initial: #initial,
-                domain: #domain,
+                domain: domain.clone(),
                 has_domain: #has_domain,
                 unsafe_sets: #unsafe_sets,
                 analyses: #analyses,

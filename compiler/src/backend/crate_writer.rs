@@ -210,7 +210,7 @@ pub fn generate_files(
         .info
         .analyses
         .iter()
-        .map(|a| a.name.as_str())
+        .map(|a| a.spec.name.as_str())
         .collect();
     Ok(CrateFiles {
         files: vec![

@@ -1,14 +1,14 @@
 //! What every backend needs: the Jacobians and the runtime's [`ModelInfo`], with the constants
 //! of Assumption 1 derived (and certified) for each analysis.
 
-use reachc_core::system::{self as rt, ModelInfo};
+use reachc_core::model::{Analysis, ModelInfo};
 
 use crate::analysis::{
     constants, constants_without_rate, synthesize_metric, ConstantsError, Derivatives, Frame,
 };
 use crate::diagnostics::Diagnostic;
 use crate::ir::Names;
-use crate::model::{self, Bounds, Model};
+use crate::model::{self, MetricChoice, Model, Rate};
 
 /// A model ready for code generation or interpretation.
 #[derive(Clone, Debug)]
@@ -16,7 +16,7 @@ pub struct Prepared {
     /// The Jacobians (their expressions live in the model's pool).
     pub derivatives: Derivatives,
     /// The transformed systems of the analyses' coordinate transforms (one per distinct `T`,
-    /// indexed by [`rt::Transform::frame`]).
+    /// indexed by [`Transform::frame`](reachc_core::model::Transform::frame)).
     pub frames: Vec<Frame>,
     /// Sets, analyses and derived constants, as the runtime consumes them.
     pub info: ModelInfo,
@@ -25,14 +25,10 @@ pub struct Prepared {
     pub warnings: Vec<Diagnostic>,
 }
 
-fn range(b: Bounds) -> rt::Range {
-    (b.lo, b.hi)
-}
-
 /// Differentiates the model and derives each analysis' constants.
 ///
 /// An analysis whose constants cannot be bounded (an unbounded Jacobian entry over the domain)
-/// gets `constants: None` with the reason, and a warning naming the entry; running it is then
+/// gets `constants: Err` with the reason, and a warning naming the entry; running it is then
 /// an error, but the rest of the model is still usable.
 pub fn prepare(model: &mut Model) -> Prepared {
     let derivatives = Derivatives::of(model);
@@ -41,116 +37,50 @@ pub fn prepare(model: &mut Model) -> Prepared {
     let mut analyses = Vec::new();
     let mut frames: Vec<Frame> = Vec::new();
     for a in model.analyses.clone() {
-        let metric = match &a.metric {
-            model::Metric::Identity => Ok(identity(n)),
-            model::Metric::Matrix(m) => Ok(m.iter().flatten().copied().collect()),
-            model::Metric::Auto => synthesize_metric(model, &derivatives),
+        let metric = match &a.spec.metric {
+            MetricChoice::Identity => Ok(identity(n)),
+            MetricChoice::Matrix(m) => Ok(m.clone()),
+            MetricChoice::Auto => synthesize_metric(model, &derivatives),
         };
         // An empirical rate needs only sigma and rho from here.
-        let derived = metric.and_then(|p| match a.rate {
-            rt::Rate::Certified => constants(model, &derivatives, &p),
-            _ => constants_without_rate(model, &derivatives, &p),
+        let derived = metric.and_then(|p| match a.spec.rate {
+            Rate::Certified => constants(model, &derivatives, &p),
+            Rate::Empirical { .. } => constants_without_rate(model, &derivatives, &p),
         });
-        let (constants, constants_error) = match derived {
-            Ok(c) => (Some(c), None),
-            Err(e) => {
-                let (message, help) = explain(model, &derivatives, &e);
-                warnings.push(
-                    Diagnostic::warning(
-                        format!("analysis `{}` cannot run: {message}", a.name),
-                        a.span.clone(),
-                        "its constants are unbounded",
-                    )
-                    .with_help(help),
-                );
-                (None, Some(message))
+        let constants = derived.map_err(|e| {
+            let (message, help) = explain(model, &derivatives, &e);
+            warnings.push(
+                Diagnostic::warning(
+                    format!("analysis `{}` cannot run: {message}", a.spec.name),
+                    a.span.clone(),
+                    "its constants are unbounded",
+                )
+                .with_help(help),
+            );
+            message
+        });
+        // One transformed system per distinct `T` (the checker numbered them).
+        if let Some(t) = &a.spec.transform {
+            if t.frame == frames.len() {
+                frames.push(Frame::of(model, t));
             }
-        };
-        analyses.push(rt::Analysis {
-            name: a.name.clone(),
-            method: a.method,
-            delta: a.delta,
-            horizon: a.horizon,
-            step: a.step,
-            radius: a.radius,
-            rate: a.rate,
-            integrator: a.integrator,
-            inclusion: a.inclusion,
-            outputs: a.outputs.clone(),
-            transform: a.transform.as_ref().map(|t| {
-                let frame = match frames.iter().position(|f| &f.transform == t) {
-                    Some(k) => k,
-                    None => {
-                        frames.push(Frame::of(model, t));
-                        frames.len() - 1
-                    }
-                };
-                rt::Transform {
-                    matrix: t.matrix.iter().flatten().copied().collect(),
-                    inverse: t.inverse.iter().flatten().copied().collect(),
-                    frame,
-                }
-            }),
+        }
+        analyses.push(Analysis {
+            spec: a.spec,
             constants,
-            constants_error,
         });
     }
+    let names = |v: &[model::Variable]| v.iter().map(|x| x.name.clone()).collect();
     let info = ModelInfo {
         name: model.name.clone(),
-        states: model.states.iter().map(|s| s.name.clone()).collect(),
-        inputs: model.inputs.iter().map(|u| u.name.clone()).collect(),
-        noises: model.noises.iter().map(|w| w.name.clone()).collect(),
-        input_box: model
-            .inputs
-            .iter()
-            .map(|u| range(u.bounds.unwrap_or(Bounds::ENTIRE)))
-            .collect(),
-        initial: rt::InitialSet {
-            boxes: model.states.iter().map(|s| s.bounds.map(range)).collect(),
-            balls: model
-                .initial
-                .balls
-                .iter()
-                .map(|b| rt::InitialBall {
-                    states: b.states.clone(),
-                    center: b.center.clone(),
-                    radius: b.radius,
-                    metric: b
-                        .metric
-                        .as_ref()
-                        .map(|m| m.iter().flatten().copied().collect()),
-                })
-                .collect(),
-        },
-        domain: model.domain.iter().map(|&b| range(b)).collect(),
+        states: names(&model.states),
+        inputs: names(&model.inputs),
+        noises: names(&model.noises),
+        input_box: model.input_box.clone(),
+        initial: model.initial.clone(),
+        domain: model.domain.clone(),
         has_domain: model.has_domain,
-        unsafe_sets: model
-            .unsafe_sets
-            .iter()
-            .map(|u| rt::UnsafeSet {
-                name: u.name.clone(),
-                shape: match &u.shape {
-                    model::UnsafeShape::Box(sides) => {
-                        rt::UnsafeShape::Box(sides.iter().map(|&(i, b)| (i, range(b))).collect())
-                    }
-                    model::UnsafeShape::Ball {
-                        states,
-                        center,
-                        radius,
-                    } => rt::UnsafeShape::Ball {
-                        states: states.clone(),
-                        center: center.clone(),
-                        radius: *radius,
-                    },
-                    model::UnsafeShape::HalfSpace { normal, offset } => {
-                        rt::UnsafeShape::HalfSpace {
-                            normal: normal.clone(),
-                            offset: *offset,
-                        }
-                    }
-                },
-            })
-            .collect(),
+        unsafe_sets: model.unsafe_sets.clone(),
         analyses,
     };
     Prepared {

@@ -11,7 +11,8 @@
 //! size of the expressions, not to `n^2`.
 
 use crate::interval::Interval;
-use crate::system::{Inclusion, Integrator, System};
+use crate::model::{Inclusion, Integrator};
+use crate::system::System;
 
 /// The embedding system on boxes `(lo, hi)`, with scratch space for its evaluations.
 pub(crate) struct Embedding<'a> {
@@ -23,7 +24,8 @@ pub(crate) struct Embedding<'a> {
 struct Field<'a> {
     sys: &'a dyn System,
     inclusion: Inclusion,
-    ubox: &'a [Interval],
+    /// The input box of the current step.
+    ubox: Vec<Interval>,
     /// The centre of the input box, as point intervals.
     uc: Vec<Interval>,
     /// `(row, column)` of the Jacobian entries `f_row` depends on.
@@ -47,8 +49,8 @@ struct Scratch {
 }
 
 impl<'a> Embedding<'a> {
-    /// The embedding of `sys` with the given inclusion over the input box `ubox`.
-    pub(crate) fn new(sys: &'a dyn System, inclusion: Inclusion, ubox: &'a [Interval]) -> Self {
+    /// The embedding of `sys` with the given inclusion (inputs: see [`Embedding::integrate`]).
+    pub(crate) fn new(sys: &'a dyn System, inclusion: Inclusion) -> Self {
         let (n, p) = (sys.n(), sys.p());
         let pattern = sys.jac_x_pattern();
         let mut by_column = vec![Vec::new(); n];
@@ -56,7 +58,6 @@ impl<'a> Embedding<'a> {
             by_column[j].push(k);
         }
         let colours = colour(&pattern, n);
-        let uc = ubox.iter().map(|u| Interval::point(u.mid())).collect();
         let zeros = |k: usize| vec![Interval::ZERO; k];
         Embedding {
             scratch: Scratch {
@@ -72,8 +73,8 @@ impl<'a> Embedding<'a> {
             field: Field {
                 sys,
                 inclusion,
-                ubox,
-                uc,
+                ubox: Vec::new(),
+                uc: Vec::new(),
                 pattern,
                 by_column,
                 colours,
@@ -111,14 +112,16 @@ impl<'a> Embedding<'a> {
         }
     }
 
-    /// Integrates the embedding system over the grid; per grid time the box `(lo, hi)`.
-    /// `Err(k)` if the box is not finite at grid index `k`.
+    /// Integrates the embedding system over the grid, with the inputs in `inputs[k]` on the
+    /// step `[t_k, t_(k+1)]`; per grid time the box `(lo, hi)`. `Err(k)` if the box is not
+    /// finite at grid index `k`.
     #[allow(clippy::type_complexity)]
     pub(crate) fn integrate(
         &mut self,
         lo: &[f64],
         hi: &[f64],
         grid: &[f64],
+        inputs: &[Vec<Interval>],
         integrator: Integrator,
     ) -> Result<Vec<(Vec<f64>, Vec<f64>)>, usize> {
         let n = lo.len();
@@ -133,6 +136,9 @@ impl<'a> Embedding<'a> {
         let mut tmp = vec![0.0; m];
         for (idx, win) in grid.windows(2).enumerate() {
             let (t, h) = (win[0], win[1] - win[0]);
+            if self.field.ubox != inputs[idx] {
+                self.field.set_inputs(&inputs[idx]);
+            }
             match integrator {
                 Integrator::Euler => {
                     self.rhs(&z, t, &mut k1);
@@ -172,11 +178,17 @@ impl<'a> Embedding<'a> {
 }
 
 impl Field<'_> {
+    /// The input box `ubox` from now on (and its centre).
+    fn set_inputs(&mut self, ubox: &[Interval]) {
+        self.ubox = ubox.to_vec();
+        self.uc = ubox.iter().map(|u| Interval::point(u.mid())).collect();
+    }
+
     /// The inclusion function on the box `s.face` at time `t`, into `s.out`.
     fn eval(&self, s: &mut Scratch, t: Interval) {
         let p = self.uc.len();
         if self.inclusion == Inclusion::Natural {
-            self.sys.drift_interval(&s.face, self.ubox, t, &mut s.out);
+            self.sys.drift_interval(&s.face, &self.ubox, t, &mut s.out);
             return;
         }
         // The enclosure of f at the centre (xc, uc) of the box x U.
@@ -190,7 +202,7 @@ impl Field<'_> {
                 // Mean value theorem on the segment from (xc, uc) to (x, u), inside the convex
                 // box x U: f(x, u) in f(xc, uc) + Jx([x], U)(x - xc) + Ju([x], U)(u - uc).
                 self.sys
-                    .jac_x_sparse_interval(&s.face, self.ubox, t, &mut s.jac);
+                    .jac_x_sparse_interval(&s.face, &self.ubox, t, &mut s.jac);
                 for (&(i, j), &jij) in self.pattern.iter().zip(&s.jac) {
                     let dj = s.face[j] - s.centre[j];
                     // A pinned coordinate contributes exactly 0 (also avoids 0 * inf).
@@ -199,8 +211,9 @@ impl Field<'_> {
                     }
                 }
                 if p > 0 {
-                    self.sys.jac_u_interval(&s.face, self.ubox, t, &mut s.jac_u);
-                    add_input_columns(&mut s.out, &s.jac_u, self.ubox, &self.uc, 0..p);
+                    self.sys
+                        .jac_u_interval(&s.face, &self.ubox, t, &mut s.jac_u);
+                    add_input_columns(&mut s.out, &s.jac_u, &self.ubox, &self.uc, 0..p);
                 }
             }
             Inclusion::Mixed => {
@@ -227,7 +240,7 @@ impl Field<'_> {
                     s.ub[j] = self.ubox[j];
                     if self.ubox[j] != self.uc[j] {
                         self.sys.jac_u_interval(&s.face, &s.ub, t, &mut s.jac_u);
-                        add_input_columns(&mut s.out, &s.jac_u, self.ubox, &self.uc, j..j + 1);
+                        add_input_columns(&mut s.out, &s.jac_u, &self.ubox, &self.uc, j..j + 1);
                     }
                 }
             }

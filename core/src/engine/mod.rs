@@ -1,47 +1,62 @@
 //! Engines computing delta-probabilistic reachable sets (method.md, sections 2, 4-6).
 //!
 //! A delta-PRS at time t is the Minkowski sum of a deterministic reachable set `Rbar_t` and the
-//! stochastic ball `B_P(r_t)`, `r_t = sqrt(Psi_t kappa(n, delta))` (Theorem 2). This module
-//! implements the contraction-based engine (Proposition 3), where `Rbar_t` is itself a P-ball
-//! `B_P(x*_t, R_t)` around the nominal trajectory, so the PRS is the P-ball
-//! `B_P(x*_t, R_t + r_t)`. The interval-based engine (Proposition 4, [`run_interval`]) propagates
-//! a box by an embedding system instead; its PRS is `box (+) B_P(r_t)`.
+//! stochastic ball `B_P(r_t)`, `r_t = sqrt(Psi_t kappa(n, delta))` (Theorem 2). Two engines
+//! compute `Rbar_t`: the contraction engine (Proposition 3, `contraction.rs`), a P-ball
+//! `B_P(x*_t, R_t)` around the nominal trajectory, and the interval engine (Proposition 4,
+//! `interval.rs`), a box of an embedding system (or a parallelotope in coordinates `y = T x`).
+//! Everything after `Rbar_t` is shared (`assemble.rs`): the stochastic radius, the safety
+//! margins (`safety.rs`), the verdicts and the typed result [`Prs`].
 //!
 //! What is rigorous: the constants come certified from the compiler; `kappa`, `Psi_t`, `r1`,
 //! `R_t`, `r_t` and the safety margins are computed in outward-rounded interval arithmetic with
-//! the conservative end kept. What is not: the nominal trajectory is integrated numerically
-//! (RK4 or Euler) and taken as exact. The result records this in [`Validation`].
+//! the conservative end kept. What is not: the nominal trajectory and the embedding system are
+//! integrated numerically (RK4 or Euler) and taken as exact. The result records this in its
+//! [`Validation`](crate::prs::Validation).
+//!
+//! Runs go through [`Reach`](crate::Reach), which checks the analysis and its constants once;
+//! [`run`] runs one analysis of a model as the spec wrote it.
 
+mod assemble;
+mod contraction;
 mod embedding;
-mod interval;
-mod linalg;
+pub(crate) mod interval;
+pub(crate) mod linalg;
 mod nominal;
 mod radius;
 mod rates;
-mod result;
 mod safety;
-mod transform;
+pub(crate) mod transform;
 
-pub use interval::{reach, run_interval};
+pub use interval::interval_boxes;
 pub use radius::MAX_VERTEX_COORDS;
-pub use result::{
-    AnalysisResult, ConstantsReport, DetSet, RadiusRuleReport, RateReport, StepRecord,
-    TransformReport, UnsafeReport, Validation, Verdict,
-};
 
 use crate::interval::Interval;
-use crate::system::{Analysis, Constants, Integrator, Method, ModelInfo, RadiusRule, Rate, System};
+use crate::model::{
+    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, RadiusRule,
+};
+use crate::prs::Prs;
+use crate::reach::InputPlan;
+use crate::system::System;
 use std::fmt;
 
 /// Why an analysis could not run.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RunError {
+    /// The model has no analysis of that name.
+    UnknownAnalysis {
+        /// The name asked for.
+        name: String,
+        /// The analyses the model has.
+        available: Vec<String>,
+    },
     /// The analysis asks for something this engine does not do (yet), e.g. a coordinate
-    /// transform for the interval method.
+    /// transform for a system without the transformed frame.
     Unsupported(String),
     /// The compiler could not bound the constants of Assumption 1.
     NoConstants(String),
-    /// The analysis or model data is inconsistent (bad delta, step, dimensions, metric...).
+    /// The analysis or model data is inconsistent (bad delta, step, dimensions, metric...), or
+    /// not covered by the certified constants.
     Invalid(String),
     /// The nominal trajectory left the finite numbers.
     NonFinite(String),
@@ -50,6 +65,11 @@ pub enum RunError {
 impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            RunError::UnknownAnalysis { name, available } => write!(
+                f,
+                "no analysis `{name}` (available: {})",
+                available.join(", ")
+            ),
             RunError::Unsupported(m) => write!(f, "unsupported: {m}"),
             RunError::NoConstants(m) => write!(f, "no constants: {m}"),
             RunError::Invalid(m) => write!(f, "invalid analysis: {m}"),
@@ -60,314 +80,149 @@ impl fmt::Display for RunError {
 
 impl std::error::Error for RunError {}
 
-/// What both engines check and derive before stepping: the constants (only those `used` must be
-/// finite), the dimensions, and the rigorous Cholesky factor of `P` with an enclosure of `P^-1`.
+/// Which constants an engine needs to be finite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Needs {
+    pub(crate) c: bool,
+    pub(crate) rho: bool,
+}
+
+/// What every run of an analysis shares, checked and derived once: the constants (covering the
+/// model data), the dimensions, the rigorous Cholesky factor of `P` with an enclosure of the
+/// diagonal of `P^-1`, and the precomputed safety checks.
 pub(crate) struct Setup<'a> {
     pub(crate) consts: &'a Constants,
     pub(crate) n: usize,
     pub(crate) p: usize,
-    pub(crate) chol: Vec<Interval>,
     /// Enclosure of the diagonal of `P^-1`.
     pub(crate) p_inv_diag: Vec<Interval>,
+    /// One check per unsafe set of the model.
+    pub(crate) checks: Vec<safety::Check>,
 }
 
-/// Builds the [`Setup`] of `analysis`; `used` names the constants the engine needs
-/// (`"c"`, `"sigma"`, `"rho"`).
-pub(crate) fn setup<'a>(
-    sys: &dyn System,
-    info: &ModelInfo,
-    analysis: &'a Analysis,
-    used: &[&str],
-) -> Result<Setup<'a>, RunError> {
-    let consts = analysis.constants.as_ref().ok_or_else(|| {
-        let why = analysis.constants_error.as_deref().unwrap_or(
-            "the compiler could not bound them; see its diagnostics (a `domain` box may help)",
-        );
-        RunError::NoConstants(format!(
-            "analysis `{}` has no constants ({}): {why}",
-            analysis.name,
-            used.join(", ")
-        ))
-    })?;
-    let (n, p) = (sys.n(), sys.p());
-    validate(info, analysis, n, p)?;
-    let metric = &consts.metric;
-    if metric.len() != n * n {
-        return Err(RunError::Invalid(format!(
-            "the metric has {} entries, expected {n} x {n}",
-            metric.len()
-        )));
-    }
-    for (what, v) in [
-        ("c", consts.c),
-        ("sigma", consts.sigma),
-        ("rho", consts.rho),
-    ] {
-        if used.contains(&what) && !v.is_finite() {
-            return Err(RunError::NoConstants(format!("{what} = {v} is not finite")));
-        }
-    }
-    // Rigorous factorisation of P, used by every P^-1 quantity.
-    let chol = linalg::cholesky(&linalg::to_intervals(metric), n).ok_or_else(|| {
-        RunError::Invalid("the metric P is not (certifiably) symmetric positive definite".into())
-    })?;
-    let p_inv_diag = linalg::inverse_diagonal(&chol, n);
-    Ok(Setup {
-        consts,
-        n,
-        p,
-        chol,
-        p_inv_diag,
-    })
-}
-
-/// Runs one analysis of the model.
-///
-/// [`Method::Interval`] runs [`run_interval`] with the analysis' inclusion function (a
-/// coordinate transform needs the system's transformed frame, [`RunError::Unsupported`]
-/// otherwise). The constants must be present ([`RunError::NoConstants`]). The contraction
-/// rate comes from the analysis' [`Rate`]: certified by the compiler, or estimated from sample
-/// paths (labelled so in the result).
-pub fn run(
-    sys: &dyn System,
-    info: &ModelInfo,
-    analysis: &Analysis,
-) -> Result<AnalysisResult, RunError> {
-    if analysis.method == Method::Interval {
-        if analysis.rate != Rate::Certified {
-            return Err(RunError::Unsupported(format!(
-                "a {} rate with the interval method (it uses the certified rate)",
-                analysis.rate.name()
-            )));
-        }
-        return interval::run_interval(sys, info, analysis, analysis.inclusion);
-    }
-    let Setup {
-        consts,
-        n,
-        p,
-        chol,
-        p_inv_diag,
-    } = match analysis.rate {
-        Rate::Certified => setup(sys, info, analysis, &["c", "sigma", "rho"])?,
-        Rate::Empirical { .. } => setup(sys, info, analysis, &["sigma", "rho"])?,
-    };
-    let metric = &consts.metric;
-
-    // Initial set and inputs.
-    let (x0, half) =
-        radius::initial_center_and_halfwidths(&info.initial, n).map_err(RunError::Invalid)?;
-    let r1 = radius::r1_bound(metric, &half);
-    let active = half.iter().filter(|&&h| h > 0.0).count();
-    let r1_how = if active <= radius::MAX_VERTEX_COORDS {
-        format!("max of |x0 - x*_0|_P over the vertices of the initial box ({active} non-degenerate coordinates)")
-    } else {
-        "sum_ij |P_ij| h_i h_j over the initial box (more than 16 coordinates)".to_string()
-    } + if info.initial.balls.is_empty() {
-        ""
-    } else {
-        "; balls replaced by their bounding boxes (conservative)"
-    };
-    let u_center: Vec<f64> = info
-        .input_box
-        .iter()
-        .map(|&(lo, hi)| Interval::new(lo, hi).mid())
-        .collect();
-    // The input box is the U-ball of radius 1 around its centre (Constants::rho).
-    let (rho, r2) = if p == 0 {
-        (0.0, 0.0)
-    } else {
-        (consts.rho, 1.0)
-    };
-
-    // Stochastic factor, computed once.
-    let (kappa, radius_rule) = radius::stochastic_factor(n, analysis);
-
-    // Nominal trajectory (not validated).
-    let grid = nominal::time_grid(analysis.horizon, analysis.step);
-    let traj =
-        nominal::integrate(sys, &x0, &u_center, &grid, analysis.integrator).map_err(|k| {
-            RunError::NonFinite(format!(
-                "the nominal trajectory is not finite at t = {}",
-                grid[k]
+impl<'a> Setup<'a> {
+    /// Checks `spec` and the model data against `sys` and the certified `constants`, and
+    /// derives what the engines share.
+    pub(crate) fn new(
+        sys: &dyn System,
+        info: &ModelInfo,
+        spec: &AnalysisSpec,
+        constants: &'a Result<Constants, String>,
+        needs: Needs,
+    ) -> Result<Setup<'a>, RunError> {
+        let consts = constants.as_ref().map_err(|why| {
+            let used: Vec<&str> = [("c", needs.c), ("sigma", true), ("rho", needs.rho)]
+                .iter()
+                .filter(|(_, used)| *used)
+                .map(|(name, _)| *name)
+                .collect();
+            RunError::NoConstants(format!(
+                "analysis `{}` has no constants ({}): {why}",
+                spec.name,
+                used.join(", ")
             ))
         })?;
-
-    // Safety checks, precomputed (they depend on P only).
-    let checks =
-        safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv_diag).map_err(RunError::Invalid)?;
-
-    // Per-step rates (None: the certified constant on every step).
-    let rates = match analysis.rate {
-        Rate::Certified => None,
-        Rate::Empirical { paths } => Some(rates::empirical(
-            sys, info, metric, &grid, &traj, &u_center, paths,
-        )?),
-    };
-    let det_radii = rates
-        .as_ref()
-        .map(|c| rates::det_radii(c, &grid, rho, r1, r2));
-
-    let mut stochastic = radius::Stochastic::new(kappa);
-    let mut steps = Vec::with_capacity(grid.len());
-    for (k, (&t, x)) in grid.iter().zip(traj).enumerate() {
-        // c_t, sigma_t on the step ending at t.
-        let c_k = rates.as_ref().map_or(consts.c, |c| c[k]);
-        let sigma_k = consts.sigma;
-        let prev = k.checked_sub(1).map(|j| grid[j]);
-        let (psi_hi, r_t) = stochastic.advance(prev, t, c_k, sigma_k);
-        let det = match &det_radii {
-            Some(radii) => radii[k],
-            None => radius::det_radius(consts.c, rho, r1, r2, t),
-        };
-        let prs = (Interval::point(det) + Interval::point(r_t)).hi();
-        let margins = checks.iter().map(|c| c.margin(&x, prs)).collect();
-        steps.push(StepRecord {
-            t,
-            det_set: DetSet {
-                shape: "p_ball",
-                center: x.clone(),
-                radius: det,
-                metric: "constants.metric",
-                lo: None,
-                hi: None,
-                hull_lo: None,
-                hull_hi: None,
-            },
-            nominal: x,
-            r_t,
-            psi: psi_hi,
-            c: c_k,
-            sigma: sigma_k,
-            prs_radius: prs,
-            margins,
-        });
+        let (n, p) = (sys.n(), sys.p());
+        validate(info, spec, n, p)?;
+        covered(info, spec, consts)?;
+        let metric = &consts.metric;
+        if metric.len() != n * n {
+            return Err(RunError::Invalid(format!(
+                "the metric has {} entries, expected {n} x {n}",
+                metric.len()
+            )));
+        }
+        for (what, v, used) in [
+            ("c", consts.c, needs.c),
+            ("sigma", consts.sigma, true),
+            ("rho", consts.rho, needs.rho),
+        ] {
+            if used && !v.is_finite() {
+                return Err(RunError::NoConstants(format!("{what} = {v} is not finite")));
+            }
+        }
+        // Rigorous factorisation of P, used by every P^-1 quantity.
+        let chol = linalg::cholesky(&linalg::to_intervals(metric), n).ok_or_else(|| {
+            RunError::Invalid(
+                "the metric P is not (certifiably) symmetric positive definite".into(),
+            )
+        })?;
+        let p_inv_diag = linalg::inverse_diagonal(&chol, n);
+        let checks = safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv_diag)
+            .map_err(RunError::Invalid)?;
+        Ok(Setup {
+            consts,
+            n,
+            p,
+            p_inv_diag,
+            checks,
+        })
     }
-
-    let (unsafe_sets, verdict) = verdicts(info, &checks, &steps);
-    let mut not_validated = vec![format!(
-        "nominal trajectory x*_t (numerical {} integration, step {}; taken as exact)",
-        integrator_name(analysis.integrator),
-        analysis.step
-    )];
-    if info.has_domain {
-        not_validated.push(
-            "conditional on staying in the domain: the constants hold only there, and the \
-             result assumes the state does not leave it"
-                .into(),
-        );
-    }
-    let (rate, rate_rigorous) = rate_report(analysis.rate, rates.as_deref(), consts.c);
-    if let Rate::Empirical { .. } = analysis.rate {
-        not_validated.insert(0, rate.note.clone());
-    }
-    Ok(AnalysisResult {
-        model: info.name.clone(),
-        analysis: analysis.name.clone(),
-        method: "contraction".into(),
-        inclusion: None,
-        delta: analysis.delta,
-        horizon: analysis.horizon,
-        step: analysis.step,
-        integrator: integrator_name(analysis.integrator).into(),
-        states: info.states.clone(),
-        outputs: analysis.outputs.clone(),
-        rate,
-        constants: ConstantsReport {
-            c: consts.c,
-            sigma: consts.sigma,
-            rho,
-            how: consts.how.clone(),
-            metric: metric.chunks(n).map(|r| r.to_vec()).collect(),
-        },
-        radius_rule,
-        kappa,
-        r1,
-        r2,
-        r1_how,
-        transform: None,
-        initial_center: x0,
-        input_center: u_center,
-        steps,
-        unsafe_sets,
-        verdict,
-        validated: Validation {
-            rigorous: vec![
-                format!("{rate_rigorous} ({})", consts.how),
-                "kappa (rounded up)".into(),
-                "Psi_t (exact per-step integration in interval arithmetic, upper end)".into(),
-                "radii r1, R_t, r_t, PRS radius (interval arithmetic, rounded up)".into(),
-                "safety margins given the nominal (P^-1 enclosed by interval Cholesky, rounded \
-                 down)"
-                    .into(),
-            ],
-            not_validated,
-            conditional_on_domain: info.has_domain,
-        },
-    })
 }
 
-/// The report of the rate's source and the "rigorous" line for the constants.
-pub(crate) fn rate_report(rate: Rate, rates: Option<&[f64]>, c: f64) -> (RateReport, String) {
-    let max_c = rates.map_or(c, |r| r.iter().copied().fold(f64::NEG_INFINITY, f64::max));
-    let (note, rigorous) = match rate {
-        Rate::Certified => (
-            "one rate c for the whole horizon, certified by the compiler over the domain".into(),
-            "constants c, sigma, rho",
-        ),
-        Rate::Empirical { paths } => (
-            format!(
-                "EMPIRICAL: c_t estimated from {paths} sample paths (largest one-sided Lipschitz \
-                 quotient between a sampled state and the nominal), not certified: the PRS is \
-                 an estimate, not a guarantee"
-            ),
-            "constants sigma, rho",
-        ),
-    };
-    let report = RateReport {
-        kind: rate.name().into(),
-        note,
-        paths: match rate {
-            Rate::Empirical { paths } => Some(paths),
-            Rate::Certified => None,
-        },
-        max_c,
-    };
-    (report, rigorous.to_string())
+/// The inputs of a run.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Inputs<'a> {
+    /// Anywhere in the input box (the nominal takes its centre).
+    Box,
+    /// Following a plan (inside the input box).
+    Plan(&'a InputPlan),
 }
 
-/// Whether `x` lies in the PRS `B_P(x*_t, R_t + r_t)` at report step `step_index` (for an
-/// interval-method result: in `box (+) B_P(r_t)`).
-///
-/// Decided in interval arithmetic and conservatively: `true` only if `|x - x*_t|_P^2` is
-/// certainly at most the squared PRS radius (a point within rounding of the boundary counts as
-/// outside). Panics if `step_index` is out of range or `x` has the wrong length.
-pub fn contains(result: &AnalysisResult, step_index: usize, x: &[f64]) -> bool {
-    let st = &result.steps[step_index];
-    if st.det_set.lo.is_some() {
-        return interval::contains(result, step_index, x);
-    }
-    let n = st.nominal.len();
-    assert_eq!(x.len(), n, "contains: x has the wrong dimension");
-    let d: Vec<Interval> = x
-        .iter()
-        .zip(&st.nominal)
-        .map(|(&a, &b)| Interval::point(a) - Interval::point(b))
-        .collect();
-    let p = &result.constants.metric;
-    let mut q = Interval::ZERO;
-    for i in 0..n {
-        q += p[i][i] * d[i].sqr();
-        for j in i + 1..n {
-            // Both off-diagonal entries, so a slightly asymmetric stored P is used as given.
-            q += Interval::point(p[i][j]) * d[i] * d[j] + Interval::point(p[j][i]) * d[j] * d[i];
+/// One run of an analysis: the model, the analysis as run, its setup, where it starts and its
+/// inputs.
+pub(crate) struct Run<'a> {
+    pub(crate) sys: &'a dyn System,
+    pub(crate) info: &'a ModelInfo,
+    pub(crate) spec: &'a AnalysisSpec,
+    pub(crate) setup: &'a Setup<'a>,
+    pub(crate) initial: &'a InitialSet,
+    pub(crate) inputs: Inputs<'a>,
+}
+
+impl Run<'_> {
+    /// The nominal input on each report step `[t_k, t_(k+1))` of `grid` (one entry per grid
+    /// time; the last is unused), and `r2`, the input uncertainty in the input norm.
+    pub(crate) fn nominal_inputs(&self, grid: &[f64]) -> (Vec<Vec<f64>>, f64) {
+        match self.inputs {
+            Inputs::Box => {
+                let centre: Vec<f64> = self
+                    .info
+                    .input_box
+                    .iter()
+                    .map(|b| Interval::new(b.lo, b.hi).mid())
+                    .collect();
+                // The input box is the U-ball of radius 1 around its centre (Constants::rho).
+                let r2 = if self.setup.p == 0 { 0.0 } else { 1.0 };
+                (vec![centre; grid.len()], r2)
+            }
+            Inputs::Plan(plan) => (grid.iter().map(|&t| plan.at(t).to_vec()).collect(), 0.0),
         }
     }
-    q.hi() <= Interval::point(st.prs_radius).sqr().lo()
+}
+
+/// Runs one analysis of the model as the spec wrote it (its initial set, inputs anywhere in
+/// the input box). The same as [`Reach::for_analysis`](crate::Reach::for_analysis) then
+/// [`Reach::run`](crate::Reach::run).
+pub fn run(sys: &dyn System, info: &ModelInfo, analysis: &Analysis) -> Result<Prs, RunError> {
+    crate::Reach::for_analysis(sys, info, analysis)?.run()
+}
+
+/// Runs the engine of the analysis' method.
+pub(crate) fn run_engine(run: &Run) -> Result<Prs, RunError> {
+    match run.spec.method {
+        Method::Contraction => contraction::run(run),
+        Method::Interval => interval::run(run, run.spec.inclusion),
+    }
 }
 
 /// Checks the analysis parameters and the model dimensions.
-fn validate(info: &ModelInfo, a: &Analysis, n: usize, p: usize) -> Result<(), RunError> {
+pub(crate) fn validate(
+    info: &ModelInfo,
+    a: &AnalysisSpec,
+    n: usize,
+    p: usize,
+) -> Result<(), RunError> {
     let bad = |m: String| Err(RunError::Invalid(m));
     if !(a.delta > 0.0 && a.delta < 1.0) {
         return bad(format!("delta = {} must lie in (0, 1)", a.delta));
@@ -407,10 +262,11 @@ fn validate(info: &ModelInfo, a: &Analysis, n: usize, p: usize) -> Result<(), Ru
             info.input_box.len()
         ));
     }
-    for (j, &(lo, hi)) in info.input_box.iter().enumerate() {
-        if Interval::try_new(lo, hi).is_none_or(|iv| !iv.is_bounded()) {
+    for (j, b) in info.input_box.iter().enumerate() {
+        if Interval::try_new(b.lo, b.hi).is_none_or(|iv| !iv.is_bounded()) {
             return bad(format!(
-                "input box of input {j} is [{lo}, {hi}] (must be bounded)"
+                "input box of input {j} is [{}, {}] (must be bounded)",
+                b.lo, b.hi
             ));
         }
     }
@@ -420,67 +276,49 @@ fn validate(info: &ModelInfo, a: &Analysis, n: usize, p: usize) -> Result<(), Ru
     Ok(())
 }
 
-/// Per-set verdicts and the overall verdict from the per-step margins.
-fn verdicts(
-    info: &ModelInfo,
-    checks: &[safety::Check],
-    steps: &[StepRecord],
-) -> (Vec<UnsafeReport>, Verdict) {
-    let mut reports = Vec::with_capacity(checks.len());
-    // (step, set index) of the earliest failure; ties at the same step go to the first set.
-    let mut first: Option<(usize, usize)> = None;
-    for (j, (set, check)) in info.unsafe_sets.iter().zip(checks).enumerate() {
-        let mut min_margin = f64::INFINITY;
-        let mut min_t = 0.0;
-        let mut first_bad: Option<usize> = None;
-        for (k, st) in steps.iter().enumerate() {
-            let m = st.margins[j];
-            // NaN (not expected: margins are interval ends) must never count as safe.
-            if (m.is_nan() || m <= 0.0) && first_bad.is_none() {
-                first_bad = Some(k);
-            }
-            if m < min_margin || (m.is_nan() && !min_margin.is_nan()) {
-                min_margin = m;
-                min_t = st.t;
-            }
-        }
-        if let Some(k) = first_bad {
-            if first.is_none_or(|(fk, _)| k < fk) {
-                first = Some((k, j));
-            }
-        }
-        reports.push(UnsafeReport {
-            name: set.name.clone(),
-            kind: check.kind().into(),
-            safe: first_bad.is_none(),
-            min_margin,
-            min_margin_t: min_t,
-            first_not_safe_t: first_bad.map(|k| steps[k].t),
-            margin_unit: match check {
-                safety::Check::Box { .. } => {
-                    "largest per-coordinate gap between the PRS's bounding box and the box".into()
-                }
-                _ => "Euclidean distance".into(),
-            },
-        });
-    }
-    let verdict = if checks.is_empty() {
-        Verdict::NoUnsafeSets
-    } else if let Some((k, j)) = first {
-        Verdict::NotShownSafe {
-            t: steps[k].t,
-            step: k,
-            set: info.unsafe_sets[j].name.clone(),
-        }
+/// Checks that the constants cover the model data: they were certified over its domain, its
+/// input box and times up to at least the horizon. Editing any of those in a [`ModelInfo`]
+/// after the compiler certified it gives this error, not a result labelled certified.
+fn covered(info: &ModelInfo, spec: &AnalysisSpec, consts: &Constants) -> Result<(), RunError> {
+    let region = &consts.region;
+    let what = if region.domain != info.domain {
+        "domain"
+    } else if region.input_box != info.input_box {
+        "input box"
+    } else if !(spec.horizon <= region.time.hi && region.time.lo <= 0.0) {
+        "time range"
     } else {
-        Verdict::Safe
+        return Ok(());
     };
-    (reports, verdict)
+    Err(RunError::Invalid(format!(
+        "the constants of analysis `{}` were certified for another {what} than the model's: \
+         change the spec and compile it again",
+        spec.name
+    )))
 }
 
-fn integrator_name(i: Integrator) -> &'static str {
-    match i {
-        Integrator::Rk4 => "rk4",
-        Integrator::Euler => "euler",
+/// Checks an initial set against the model: one entry per state, and inside the domain when the
+/// spec has one (the constants hold only there).
+pub(crate) fn check_initial(info: &ModelInfo, initial: &InitialSet) -> Result<(), RunError> {
+    let n = info.states.len();
+    let (center, half) =
+        radius::initial_center_and_halfwidths(initial, n).map_err(RunError::Invalid)?;
+    if info.has_domain {
+        for i in 0..n {
+            // Boxes as given; ball coordinates by their bounding boxes (rounded outward).
+            let Bounds { lo, hi } = initial.boxes[i].unwrap_or_else(|| {
+                let (c, h) = (Interval::point(center[i]), Interval::point(half[i]));
+                Bounds::new((c - h).lo(), (c + h).hi())
+            });
+            let domain = info.domain[i];
+            if lo < domain.lo || hi > domain.hi {
+                return Err(RunError::Invalid(format!(
+                    "the initial set leaves the domain in state `{}` ([{lo}, {hi}] is not in \
+                     [{}, {}]): the constants hold only in the domain",
+                    info.states[i], domain.lo, domain.hi
+                )));
+            }
+        }
     }
+    Ok(())
 }

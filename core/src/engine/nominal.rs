@@ -1,7 +1,8 @@
 //! The nominal trajectory `x*_t` of the deterministic system `x' = f(x, u_c, t)` (centre input),
 //! integrated numerically. Not validated: the report says so.
 
-use crate::system::{Integrator, System};
+use crate::model::Integrator;
+use crate::system::System;
 
 /// The report times `0 = t_0 < t_1 < ... < t_N = horizon`, spaced by `step`; the last step is
 /// shortened so the grid ends exactly on the horizon.
@@ -16,12 +17,13 @@ pub(crate) fn time_grid(horizon: f64, step: f64) -> Vec<f64> {
     ts
 }
 
-/// Integrates `x' = f(x, u, t)` over the grid with the integrator; `None` if a state became
-/// non-finite (returns the index of the first bad time in `Err`).
+/// Integrates `x' = f(x, u_k, t)` over the grid with the integrator, `u_k = inputs[k]` on the
+/// step `[t_k, t_(k+1)]`; `Err(k)` with the index of the first grid time where a state is not
+/// finite.
 pub(crate) fn integrate(
     sys: &dyn System,
     x0: &[f64],
-    u: &[f64],
+    inputs: &[Vec<f64>],
     grid: &[f64],
     integrator: Integrator,
 ) -> Result<Vec<Vec<f64>>, usize> {
@@ -36,6 +38,7 @@ pub(crate) fn integrate(
     let mut tmp = vec![0.0; n];
     for (idx, w) in grid.windows(2).enumerate() {
         let (t, h) = (w[0], w[1] - w[0]);
+        let u = &inputs[idx];
         match integrator {
             Integrator::Euler => {
                 sys.drift(&x, u, t, &mut k1);

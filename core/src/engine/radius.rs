@@ -4,7 +4,8 @@
 
 use super::linalg;
 use crate::interval::{Interval, ELEM_ULPS};
-use crate::system::InitialSet;
+use crate::model::{AnalysisSpec, Bounds, InitialSet, RadiusRule};
+use crate::prs::RuleUsed;
 
 /// Number of box coordinates (with non-zero width) up to which `r1` is the exact maximum over
 /// the box's vertices; above it the cheaper bound `sum_ij |P_ij| h_i h_j` is used.
@@ -131,7 +132,7 @@ pub(crate) fn initial_center_and_halfwidths(
     let mut center = vec![f64::NAN; n];
     let mut half = vec![f64::NAN; n];
     for (i, b) in init.boxes.iter().enumerate() {
-        if let Some((lo, hi)) = *b {
+        if let Some(Bounds { lo, hi }) = *b {
             let iv = Interval::try_new(lo, hi)
                 .filter(|iv| iv.is_bounded())
                 .ok_or_else(|| {
@@ -255,27 +256,22 @@ impl<'a> BoxRadius<'a> {
     }
 }
 
-/// `kappa(n, delta)` of the analysis' radius rule, and the rule as reported (with the
-/// minimising `eps` for `paper(optimal)`).
-pub(crate) fn stochastic_factor(
-    n: usize,
-    analysis: &crate::system::Analysis,
-) -> (f64, super::result::RadiusRuleReport) {
-    use crate::system::RadiusRule;
-    let kappa = crate::kappa::kappa(n, analysis.delta, analysis.radius);
-    let (rule, eps) = match analysis.radius {
-        RadiusRule::Amgf => ("amgf", None),
-        RadiusRule::Paper(eps) => ("paper", Some(eps)),
-        RadiusRule::PaperOptimal => (
-            "paper_optimal",
-            Some(crate::kappa::kappa_paper_optimal(n, analysis.delta).1),
-        ),
+/// `kappa(n, delta)` of the analysis' radius rule, and the rule as used (with the minimising
+/// `eps` for `paper(optimal)`).
+pub(crate) fn stochastic_factor(n: usize, spec: &AnalysisSpec) -> (f64, RuleUsed) {
+    let kappa = crate::kappa::kappa(n, spec.delta, spec.radius);
+    let eps = match spec.radius {
+        RadiusRule::Amgf => None,
+        RadiusRule::Paper(eps) => Some(eps),
+        RadiusRule::PaperOptimal => Some(crate::kappa::kappa_paper_optimal(n, spec.delta).1),
     };
-    let report = super::result::RadiusRuleReport {
-        rule: rule.into(),
-        eps,
-    };
-    (kappa, report)
+    (
+        kappa,
+        RuleUsed {
+            rule: spec.radius,
+            eps,
+        },
+    )
 }
 
 /// `Psi_t` and `r_t = sqrt(Psi_t kappa)` along the report grid: exact per-step Psi, reusing the

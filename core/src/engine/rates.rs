@@ -1,14 +1,14 @@
-//! Per-step contraction rates `c_k` of [`Rate::Empirical`](crate::system::Rate::Empirical)
+//! Per-step contraction rates `c_k` of [`Rate::Empirical`](crate::model::Rate::Empirical)
 //! analyses, and the deterministic radius `R_t` they give.
 //!
 //! `c_k` is the rate on the report step `(t_(k-1), t_k]`; `R_t` and `Psi_t` then follow the
 //! per-step recursions (Proposition 3 and eq. Psi with piecewise-constant rates).
 
 use super::radius::expm1_over;
-use super::RunError;
+use super::{Run, RunError};
 use crate::interval::Interval;
+use crate::model::ModelInfo;
 use crate::simulate::{self, InputMode};
-use crate::system::{ModelInfo, System};
 
 /// Seed of the empirical estimate's sample paths: fixed (the result is reproducible) and not
 /// `reachc simulate`'s default 0, so a coverage check runs on paths the estimate never saw.
@@ -21,14 +21,14 @@ pub(crate) const EMPIRICAL_SEED: u64 = 0x6361_6c69_6272_6174;
 /// `t_(k-1)` and `t_k`, with `x*` the nominal and `u_c` the input box's centre: the quantity the
 /// proof of Theorem 2 bounds by `c` along the pair `(X_t, x*_t)`. An estimate, not a bound.
 pub(crate) fn empirical(
-    sys: &dyn System,
-    info: &ModelInfo,
+    run: &Run,
     metric: &[f64],
     grid: &[f64],
     traj: &[Vec<f64>],
-    u_center: &[f64],
+    inputs: &[Vec<f64>],
     paths: u64,
 ) -> Result<Vec<f64>, RunError> {
+    let sys = run.sys;
     let n = sys.n();
     let opts = simulate::Options {
         paths,
@@ -36,13 +36,18 @@ pub(crate) fn empirical(
         inputs: InputMode::Random,
         ..simulate::Options::default()
     };
-    let sampled = simulate::sample_paths(sys, info, grid, Some(&traj[0]), &opts)
+    // The paths start in the run's initial set.
+    let info = ModelInfo {
+        initial: run.initial.clone(),
+        ..run.info.clone()
+    };
+    let sampled = simulate::sample_paths(sys, &info, grid, Some(&traj[0]), &opts)
         .map_err(|e| RunError::Invalid(format!("sampling paths for the empirical rate: {e}")))?;
     // Per report time, the pooled quotient over the paths.
     let mut at = vec![f64::NEG_INFINITY; grid.len()];
     let (mut fx, mut fn_) = (vec![0.0; n], vec![0.0; n]);
     let mut d = vec![0.0; n];
-    for (k, (&t, nominal)) in grid.iter().zip(traj).enumerate() {
+    for (k, ((&t, nominal), u_center)) in grid.iter().zip(traj).zip(inputs).enumerate() {
         sys.drift(nominal, u_center, t, &mut fn_);
         let (mut sum_num, mut sum_den) = (0.0, 0.0);
         for path in &sampled {

@@ -1,13 +1,25 @@
-//! Sound safety checks of a P-ball `B_P(x*, R)` against the spec's unsafe sets.
+//! Sound safety checks of a PRS `Rbar_t (+) B_P(r_t)` against the spec's unsafe sets, for every
+//! shape of deterministic set: a P-ball `B_P(x*, R)` (the PRS is then `B_P(x*, R + r_t)`), a
+//! box, or a parallelotope.
 //!
-//! "Sound" means one-sided: a check may fail to show safety for a ball that is safe, never the
+//! "Sound" means one-sided: a check may fail to show safety for a set that is safe, never the
 //! reverse. Everything depending on `P^-1` is enclosed rigorously (interval Cholesky, see
-//! [`super::linalg`]); the margins are rounded down. The nominal centre `x*` is taken as exact
-//! (it is the numerically integrated nominal, which the report marks as not validated).
+//! [`super::linalg`]); the margins are rounded down. The deterministic set is taken as given
+//! (the report marks how it was computed).
 
 use super::linalg;
+use super::transform::Frame;
 use crate::interval::Interval;
-use crate::system::{UnsafeSet, UnsafeShape};
+use crate::model::{UnsafeSet, UnsafeShape};
+use crate::prs::{DetSet, UnsafeKind};
+
+/// What the margins of box-shaped sets need besides the set.
+pub(crate) struct Context<'a> {
+    /// Upper bounds of `sqrt((P^-1)_ii)`: `B_P(r)` lies in the box `|d_i| <= r w_i`.
+    pub(crate) w: &'a [f64],
+    /// The transform of parallelotope sets.
+    pub(crate) frame: Option<&'a Frame>,
+}
 
 /// A precomputed check for one unsafe set (the `P^-1` quantities do not depend on time).
 #[derive(Clone, Debug)]
@@ -38,12 +50,41 @@ pub(crate) enum Check {
 }
 
 impl Check {
-    /// The kind, for the report.
-    pub(crate) fn kind(&self) -> &'static str {
+    /// The kind of the unsafe set.
+    pub(crate) fn kind(&self) -> UnsafeKind {
         match self {
-            Check::HalfSpace { .. } => "half_space",
-            Check::Box { .. } => "box",
-            Check::Ball { .. } => "ball",
+            Check::HalfSpace { .. } => UnsafeKind::HalfSpace,
+            Check::Box { .. } => UnsafeKind::Box,
+            Check::Ball { .. } => UnsafeKind::Ball,
+        }
+    }
+
+    /// A lower bound of the safety margin of the PRS `set (+) B_P(r_t)`; the PRS is shown safe
+    /// iff the margin is `> 0`. Units: Euclidean distance for half-spaces and balls; for boxes
+    /// the largest per-coordinate gap between the PRS's bounding box and the unsafe box (when
+    /// `<= 0` the bounding boxes overlap in every constrained coordinate).
+    pub(crate) fn margin(&self, set: &DetSet, r_t: f64, context: &Context) -> f64 {
+        match set {
+            // B_P(x, R) (+) B_P(r_t) = {x} (+) B_P(R + r_t): a box of width zero.
+            DetSet::Ball { center, radius } => {
+                let prs = (Interval::point(*radius) + Interval::point(r_t)).hi();
+                box_margin(self, center, center, prs, context.w, None)
+            }
+            DetSet::Box { lo, hi, .. } => box_margin(self, lo, hi, r_t, context.w, None),
+            DetSet::Parallelotope {
+                lo,
+                hi,
+                hull_lo,
+                hull_hi,
+                ..
+            } => {
+                // A half-space has an exact support function on the parallelotope.
+                let support = match (self, context.frame) {
+                    (Check::HalfSpace { normal, .. }, Some(f)) => Some(f.support(normal, lo, hi)),
+                    _ => None,
+                };
+                box_margin(self, hull_lo, hull_hi, r_t, context.w, support)
+            }
         }
     }
 
@@ -94,7 +135,7 @@ impl Check {
                     if i >= n {
                         return Err(bad(&format!("refers to state {i}, n = {n}")));
                     }
-                    out.push((i, range, p_inv_diag[i].sqrt().hi()));
+                    out.push((i, (range.lo, range.hi), p_inv_diag[i].sqrt().hi()));
                 }
                 Ok(Check::Box { coords: out })
             }
@@ -118,68 +159,113 @@ impl Check {
             }
         }
     }
+}
 
-    /// A lower bound of the safety margin of `B_P(x, r)`; the ball is shown safe iff the margin
-    /// is `> 0`. Units: Euclidean distance for half-spaces and balls; for boxes the largest
-    /// per-coordinate gap between the ball's bounding box and the unsafe box (when `<= 0` the
-    /// bounding boxes overlap in every constrained coordinate).
-    pub(crate) fn margin(&self, x: &[f64], r: f64) -> f64 {
-        let r = Interval::point(r);
-        match self {
-            Check::HalfSpace {
-                normal,
-                offset,
-                dual_norm,
-                norm,
-            } => {
-                if norm.hi() == 0.0 {
-                    // {0 >= b}: empty (safe everywhere) if b > 0, else the whole space.
-                    return if *offset > 0.0 {
-                        f64::INFINITY
-                    } else {
-                        f64::NEG_INFINITY
-                    };
+/// Lower bound of the distance from `c` to the box `[lo, hi]` over `states`.
+fn dist_to_box(states: &[usize], center: &[f64], lo: &[f64], hi: &[f64]) -> f64 {
+    states
+        .iter()
+        .zip(center)
+        .fold(Interval::ZERO, |acc, (&s, &c)| {
+            let c = Interval::point(c);
+            let gap = (Interval::point(lo[s]) - c)
+                .lo()
+                .max((c - Interval::point(hi[s])).lo())
+                .max(0.0);
+            acc + Interval::point(gap).sqr()
+        })
+        .sqrt()
+        .lo()
+}
+
+/// A lower bound of the safety margin of the PRS `[lo, hi] (+) B_P(r)` (same units as
+/// [`Check::margin`]; `> 0` means shown safe).
+///
+/// `B_P(r)` lies in the box `|d_i| <= r w_i` (`w_i >= sqrt((P^-1)_ii)`), so the PRS lies in the
+/// inflated box `[lo - r w, hi + r w]`. Half-spaces use the exact support function
+/// `max_box a.x + r sqrt(a' P^-1 a)` (and the inflated box, whichever bound is smaller); boxes
+/// the per-coordinate gaps to the inflated box; balls the larger of two lower bounds of the
+/// distance, `dist(c, inflated box)` and `dist(c, box) - r spread`.
+///
+/// `support`, for a half-space, is another upper bound of `max a.x` over the deterministic set
+/// (exact for a parallelotope whose hull is `[lo, hi]`); the smaller bound is used.
+fn box_margin(
+    check: &Check,
+    lo: &[f64],
+    hi: &[f64],
+    r: f64,
+    w: &[f64],
+    support: Option<f64>,
+) -> f64 {
+    let r = Interval::point(r);
+    let inf_lo = |i: usize| (Interval::point(lo[i]) - r * Interval::point(w[i])).lo();
+    let inf_hi = |i: usize| (Interval::point(hi[i]) + r * Interval::point(w[i])).hi();
+    match check {
+        Check::HalfSpace {
+            normal,
+            offset,
+            dual_norm,
+            norm,
+        } => {
+            if norm.hi() == 0.0 {
+                return if *offset > 0.0 {
+                    f64::INFINITY
+                } else {
+                    f64::NEG_INFINITY
+                };
+            }
+            let mut over_box = Interval::ZERO;
+            let mut over_inflated = Interval::ZERO;
+            for (i, &a) in normal.iter().enumerate() {
+                if a == 0.0 {
+                    continue;
                 }
-                let ax = normal.iter().zip(x).fold(Interval::ZERO, |acc, (&a, &xi)| {
-                    acc + Interval::point(a) * Interval::point(xi)
-                });
-                let reach = ax + r * Interval::point(*dual_norm);
-                ((Interval::point(*offset) - reach) / *norm).lo()
+                let ai = Interval::point(a);
+                let (b, ib) = if a > 0.0 {
+                    (hi[i], inf_hi(i))
+                } else {
+                    (lo[i], inf_lo(i))
+                };
+                over_box += ai * Interval::point(b);
+                over_inflated += ai * Interval::point(ib);
             }
-            Check::Box { coords } => coords
-                .iter()
-                .map(|&(i, (lo, hi), w)| {
-                    let half = r * Interval::point(w);
-                    let xi = Interval::point(x[i]);
-                    // Gap below the unsafe box, and gap above it.
-                    let below = if lo == f64::NEG_INFINITY {
-                        f64::NEG_INFINITY
-                    } else {
-                        (Interval::point(lo) - (xi + half)).lo()
-                    };
-                    let above = if hi == f64::INFINITY {
-                        f64::NEG_INFINITY
-                    } else {
-                        ((xi - half) - Interval::point(hi)).lo()
-                    };
-                    below.max(above)
-                })
-                .fold(f64::NEG_INFINITY, f64::max),
-            Check::Ball {
-                states,
-                center,
-                radius,
-                spread,
-            } => {
-                let dist = states
-                    .iter()
-                    .zip(center)
-                    .fold(Interval::ZERO, |acc, (&s, &c)| {
-                        acc + (Interval::point(x[s]) - Interval::point(c)).sqr()
-                    })
-                    .sqrt();
-                (dist - r * Interval::point(*spread) - Interval::point(*radius)).lo()
-            }
+            let over_set = support.map_or(over_box, |s| Interval::point(s.min(over_box.hi())));
+            let exact = over_set + r * Interval::point(*dual_norm);
+            let reach = exact.hi().min(over_inflated.hi());
+            ((Interval::point(*offset) - Interval::point(reach)) / *norm).lo()
+        }
+        Check::Box { coords } => coords
+            .iter()
+            .map(|&(i, (ulo, uhi), wi)| {
+                let half = r * Interval::point(wi);
+                let below = if ulo == f64::NEG_INFINITY {
+                    f64::NEG_INFINITY
+                } else {
+                    (Interval::point(ulo) - (Interval::point(hi[i]) + half)).lo()
+                };
+                let above = if uhi == f64::INFINITY {
+                    f64::NEG_INFINITY
+                } else {
+                    ((Interval::point(lo[i]) - half) - Interval::point(uhi)).lo()
+                };
+                below.max(above)
+            })
+            .fold(f64::NEG_INFINITY, f64::max),
+        Check::Ball {
+            states,
+            center,
+            radius,
+            spread,
+        } => {
+            let (ilo, ihi): (Vec<f64>, Vec<f64>) =
+                (0..lo.len()).map(|i| (inf_lo(i), inf_hi(i))).unzip();
+            let rad = Interval::point(*radius);
+            let m1 = (Interval::point(dist_to_box(states, center, &ilo, &ihi)) - rad).lo();
+            let m2 = (Interval::point(dist_to_box(states, center, lo, hi))
+                - r * Interval::point(*spread)
+                - rad)
+                .lo();
+            m1.max(m2)
         }
     }
 }

@@ -6,10 +6,10 @@
 //! with `R = I - S T` (interval), `T^-1 = (I - R)^-1 S`, hence
 //! `|T^-1 - S|_inf <= |R|_inf |S|_inf / (1 - |R|_inf)`, which bounds every entry.
 
-use super::result::TransformReport;
 use super::RunError;
 use crate::interval::Interval;
-use crate::system::Transform;
+use crate::model::Transform;
+use crate::prs::TransformUsed;
 
 /// A transform ready for the engine: `T` and an enclosure of `T^-1`, both n x n row-major.
 pub(crate) struct Frame {
@@ -176,12 +176,11 @@ impl Frame {
         (tx, q)
     }
 
-    /// The transform as reported in the result.
-    pub(crate) fn report(&self) -> TransformReport {
-        let rows = |m: &[f64]| m.chunks(self.n).map(<[f64]>::to_vec).collect();
-        TransformReport {
-            matrix: rows(&self.t),
-            inverse: rows(&self.s),
+    /// The transform as used, for the result.
+    pub(crate) fn used(&self) -> TransformUsed {
+        TransformUsed {
+            matrix: self.t.clone(),
+            inverse: self.s.clone(),
             inverse_error: self.e,
         }
     }

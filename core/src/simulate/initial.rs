@@ -2,8 +2,9 @@
 //! ellipsoids `{x_S : (x_S - c)' M (x_S - c) <= r^2}`).
 
 use super::normal::Ziggurat;
+use super::report::InitialSampling;
 use super::rng::PathRng;
-use crate::system::InitialSet;
+use crate::model::InitialSet;
 
 /// One ball of the initial set, ready for sampling: `x_S = c + r L^-T z` with `M = L L'` and
 /// `z` uniform in the unit ball, so that `(x_S - c)' M (x_S - c) = r^2 |z|^2 <= r^2`.
@@ -41,7 +42,7 @@ impl InitialSampler {
         let mut base = vec![0.0; n];
         let mut boxes = Vec::new();
         for (i, b) in set.boxes.iter().enumerate() {
-            if let Some((lo, hi)) = *b {
+            if let Some(crate::model::Bounds { lo, hi }) = *b {
                 if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
                     return Err(format!(
                         "the initial box of state {i} is [{lo}, {hi}]: it must be bounded"
@@ -94,12 +95,12 @@ impl InitialSampler {
     }
 
     /// What is sampled, for the report.
-    pub(crate) fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> InitialSampling {
         match (self.boxes.is_empty(), self.balls.is_empty()) {
-            (true, true) => "the initial point (the initial set is a single point)".into(),
-            (false, true) => "uniform in the initial box".into(),
-            (true, false) => "uniform in the initial ball(s)".into(),
-            (false, false) => "uniform in the initial box and ball(s)".into(),
+            (true, true) => InitialSampling::Point,
+            (false, true) => InitialSampling::Box,
+            (true, false) => InitialSampling::Balls,
+            (false, false) => InitialSampling::BoxAndBalls,
         }
     }
 
@@ -176,14 +177,14 @@ fn cholesky(a: &[f64], k: usize) -> Option<Vec<f64>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::system::InitialBall;
+    use crate::model::{Ball, Bounds};
 
     #[test]
     fn ellipsoid_samples_are_inside_and_fill_it_uniformly() {
         // {(x - c)' M (x - c) <= r^2} with M = [[4, 1], [1, 2]], r = 0.5, plus a box state.
         let set = InitialSet {
-            boxes: vec![None, Some((1.0, 3.0)), None],
-            balls: vec![InitialBall {
+            boxes: vec![None, Some(Bounds::new(1.0, 3.0)), None],
+            balls: vec![Ball {
                 states: vec![0, 2],
                 center: vec![1.0, -1.0],
                 radius: 0.5,
@@ -214,7 +215,7 @@ mod tests {
     #[test]
     fn unbounded_or_missing_initial_values_are_refused() {
         let set = InitialSet {
-            boxes: vec![Some((0.0, f64::INFINITY))],
+            boxes: vec![Some(Bounds::new(0.0, f64::INFINITY))],
             balls: vec![],
         };
         assert!(InitialSampler::new(&set, 1)

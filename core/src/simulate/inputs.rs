@@ -2,12 +2,10 @@
 //! hold time `h`, drawn afresh per path and interval.
 
 use super::rng::PathRng;
-use crate::system::Range;
-use serde::Serialize;
+use crate::model::Bounds;
 
 /// How the inputs of a sample path are chosen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum InputMode {
     /// Uniform in the input box, redrawn every hold time (the default).
     Random,
@@ -50,10 +48,10 @@ pub(crate) struct InputSchedule {
 
 impl InputSchedule {
     /// `hold > 0` is the hold time.
-    pub(crate) fn new(input_box: &[Range], mode: InputMode, hold: f64) -> Self {
+    pub(crate) fn new(input_box: &[Bounds], mode: InputMode, hold: f64) -> Self {
         InputSchedule {
-            lo: input_box.iter().map(|r| r.0).collect(),
-            width: input_box.iter().map(|r| r.1 - r.0).collect(),
+            lo: input_box.iter().map(|r| r.lo).collect(),
+            width: input_box.iter().map(|r| r.hi - r.lo).collect(),
             mode,
             hold,
         }
@@ -98,10 +96,15 @@ impl InputSchedule {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Bounds;
 
     #[test]
     fn inputs_change_only_at_hold_boundaries_and_stay_in_the_box() {
-        let s = InputSchedule::new(&[(-1.0, 1.0), (2.0, 2.5)], InputMode::Random, 0.1);
+        let s = InputSchedule::new(
+            &[Bounds::new(-1.0, 1.0), Bounds::new(2.0, 2.5)],
+            InputMode::Random,
+            0.1,
+        );
         let mut rng = PathRng::new(0, 0);
         let (mut u, mut iv) = (vec![0.0; 2], None);
         let mut changes = 0;
@@ -121,7 +124,7 @@ mod tests {
 
     #[test]
     fn corners_and_centre() {
-        let b = [(-1.0, 1.0)];
+        let b = [Bounds::new(-1.0, 1.0)];
         let corners = InputSchedule::new(&b, InputMode::Corners, 1.0);
         let centre = InputSchedule::new(&b, InputMode::Centre, 1.0);
         let mut rng = PathRng::new(0, 0);

@@ -1,10 +1,10 @@
 //! Monte Carlo validation of a delta-PRS: Euler-Maruyama sample paths of the SDE, checked
 //! against the sets an analysis computed.
 //!
-//! For every report time `t_k` of an [`AnalysisResult`] the simulation counts the paths whose
+//! For every report time `t_k` of an [`Prs`] the simulation counts the paths whose
 //! state `X_{t_k}` lies outside the PRS (decided by [`engine::contains`](crate::engine::contains))
 //! and computes the empirical `(1 - delta)` quantile of `|X_{t_k} - x*_{t_k}|_P` (the P-norm of
-//! the analysis' metric around the result's centre `steps[k].nominal`), to be read against the
+//! the analysis' metric around the result's centre `steps[k].nominal()`), to be read against the
 //! PRS radius and `r_t`. The coverage check fails when some time's violation probability is,
 //! with confidence, above `delta` (Clopper-Pearson lower bound, Bonferroni over the report
 //! times). A PRS holds `X_t` with probability `1 - delta` at each time `t`; it says nothing
@@ -35,12 +35,16 @@ mod workers;
 
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
 pub use inputs::InputMode;
-pub use report::{Coverage, HorizonReport, InputsReport, SimReport, SimStep, UnsafeHits};
+pub use report::{
+    Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SimReport, SimStep,
+    UnsafeHits,
+};
 pub use sample::{sample_paths, MAX_SAMPLE_PATHS};
 pub use workers::thread_count;
 
-use crate::engine::AnalysisResult;
-use crate::system::{ModelInfo, System, UnsafeShape};
+use crate::model::ModelInfo;
+use crate::prs::{Prs, UnsafeKind};
+use crate::system::System;
 use paths::{ChunkStats, Plan, Span};
 use std::collections::BTreeMap;
 use std::fmt;
@@ -113,7 +117,7 @@ impl std::error::Error for SimError {}
 pub fn simulate<S: System + Sync + ?Sized>(
     sys: &S,
     info: &ModelInfo,
-    result: &AnalysisResult,
+    result: &Prs,
     opts: &Options,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<SimReport, SimError> {
@@ -170,7 +174,7 @@ pub fn simulate<S: System + Sync + ?Sized>(
 fn make_plan<'a, S: System + ?Sized>(
     sys: &'a S,
     info: &ModelInfo,
-    result: &'a AnalysisResult,
+    result: &'a Prs,
     opts: &Options,
 ) -> Result<Plan<'a, S>, SimError> {
     let usage = |m: String| Err(SimError::Usage(m));
@@ -204,8 +208,11 @@ fn make_plan<'a, S: System + ?Sized>(
             result.steps.len()
         ));
     }
-    if result.constants.metric.len() != n || result.constants.metric.iter().any(|r| r.len() != n) {
+    if result.constants.metric.len() != n * n {
         return invalid("the result's metric is not n x n".into());
+    }
+    if result.input_plan.is_some() {
+        return invalid("sets under an input plan cannot be simulated (the paths draw inputs from the input box)".into());
     }
     if info.input_box.len() != p {
         return invalid(format!(
@@ -213,12 +220,12 @@ fn make_plan<'a, S: System + ?Sized>(
             info.input_box.len()
         ));
     }
-    if let Some(&(lo, hi)) = info
+    if let Some(b) = info
         .input_box
         .iter()
-        .find(|r| !(r.0.is_finite() && r.1.is_finite() && r.0 <= r.1))
+        .find(|r| !(r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi))
     {
-        return invalid(format!("the input box [{lo}, {hi}] is not bounded"));
+        return invalid(format!("the input box [{}, {}] is not bounded", b.lo, b.hi));
     }
     let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
     let mut spans = Vec::with_capacity(times.len().saturating_sub(1));
@@ -240,12 +247,12 @@ fn make_plan<'a, S: System + ?Sized>(
     let nominal: Vec<f64> = result
         .steps
         .iter()
-        .flat_map(|s| s.nominal.iter().copied())
+        .flat_map(|s| s.nominal().iter().copied())
         .collect();
     if nominal.len() != n * times.len() {
         return invalid("a nominal state has the wrong dimension".into());
     }
-    let metric = prs::Metric::new(&result.constants.metric);
+    let metric = prs::Metric::new(&result.constants.metric, n);
     let unsafe_sets = info
         .unsafe_sets
         .iter()
@@ -259,7 +266,8 @@ fn make_plan<'a, S: System + ?Sized>(
         nominal,
         membership: prs::Membership::new(result, &metric),
         metric,
-        initial: initial::InitialSampler::new(&info.initial, n).map_err(SimError::Invalid)?,
+        // The paths start where the sets start.
+        initial: initial::InitialSampler::new(&result.initial, n).map_err(SimError::Invalid)?,
         inputs: inputs::InputSchedule::new(&info.input_box, opts.inputs, hold),
         noise: noise::Noise::new(sys, *times.last().unwrap_or(&0.0), &result.initial_center),
         unsafe_sets,
@@ -280,7 +288,7 @@ fn make_plan<'a, S: System + ?Sized>(
 fn report<S: System + ?Sized>(
     plan: &Plan<'_, S>,
     info: &ModelInfo,
-    result: &AnalysisResult,
+    result: &Prs,
     opts: &Options,
     j: u64,
     total: &ChunkStats,
@@ -336,23 +344,11 @@ fn report<S: System + ?Sized>(
         .count();
     let hold = (!info.input_box.is_empty() && opts.inputs != InputMode::Centre)
         .then(|| opts.hold.unwrap_or(result.step));
-    let inputs_description = match (info.input_box.is_empty(), opts.inputs) {
-        (true, _) => "none (the model has no inputs)".to_string(),
-        (false, InputMode::Centre) => "the centre of the input box".to_string(),
-        (false, InputMode::Random) => format!(
-            "piecewise constant, uniform in the input box, redrawn every {}",
-            hold.unwrap_or(result.step)
-        ),
-        (false, InputMode::Corners) => format!(
-            "piecewise constant, a random corner of the input box, redrawn every {}",
-            hold.unwrap_or(result.step)
-        ),
-    };
     let dt = plan.spans.iter().map(|s| s.h).fold(0.0, f64::max);
     SimReport {
         model: result.model.clone(),
         analysis: result.analysis.clone(),
-        method: result.method.clone(),
+        method: result.method,
         delta: result.delta,
         paths: n_paths,
         seed: opts.seed,
@@ -362,16 +358,10 @@ fn report<S: System + ?Sized>(
         inputs: InputsReport {
             mode: opts.inputs,
             hold,
-            description: inputs_description,
+            any: !info.input_box.is_empty(),
+            hold_shown: hold.unwrap_or(result.step),
         },
         noise: plan.noise.describe(),
-        compared: "distance |X_t - x*_t|_P with P the analysis' metric and x*_t the result's \
-                   centre (nominal trajectory; box centre for the interval method), read against \
-                   the PRS radius (the PRS is the P-ball of that radius for the contraction \
-                   method; a P-ball containing the PRS for the interval method) and r_t (the \
-                   stochastic part: equal to the PRS radius when the deterministic set is a \
-                   point); outside = X_t not in the PRS (engine::contains)"
-            .into(),
         quantile_rank: j,
         steps,
         confidence: opts.confidence,
@@ -386,12 +376,7 @@ fn report<S: System + ?Sized>(
             .enumerate()
             .map(|(i, u)| UnsafeHits {
                 name: u.name.clone(),
-                kind: match u.shape {
-                    UnsafeShape::Box(_) => "box",
-                    UnsafeShape::Ball { .. } => "ball",
-                    UnsafeShape::HalfSpace { .. } => "half_space",
-                }
-                .into(),
+                kind: UnsafeKind::of(&u.shape),
                 hits: total.unsafe_hits[i],
                 fraction: frac(total.unsafe_hits[i]),
                 first_hit_t: Some(total.first_hit[i]).filter(|t| t.is_finite()),
@@ -400,7 +385,7 @@ fn report<S: System + ?Sized>(
         left_domain: info.has_domain.then_some(total.left_domain),
         diverged: total.diverged,
         verdict: Coverage {
-            status: if failing_steps == 0 { "pass" } else { "fail" },
+            passed: failing_steps == 0,
             alpha,
             alpha_per_step: alpha_step,
             failing_steps,
@@ -428,7 +413,7 @@ mod tests {
     use super::*;
     use crate::engine;
     use crate::interval::Interval;
-    use crate::system::*;
+    use crate::model::*;
 
     /// `dx = (-x + b u) dt + 0.3 dW` per state, two states and one input (unused if `b = 0`).
     struct Sys {
@@ -496,17 +481,21 @@ mod tests {
     /// With `b != 0`: an input in `[-0.5, 0.5]` and an unsafe half-space `x1 >= 0.4`.
     fn info(b: f64) -> ModelInfo {
         let inputs = b != 0.0;
-        ModelInfo {
+        let mut info = ModelInfo {
             name: "m".into(),
             states: vec!["x1".into(), "x2".into()],
             inputs: if inputs { vec!["u".into()] } else { vec![] },
             noises: vec!["w1".into(), "w2".into()],
-            input_box: if inputs { vec![(-0.5, 0.5)] } else { vec![] },
+            input_box: if inputs {
+                vec![Bounds::new(-0.5, 0.5)]
+            } else {
+                vec![]
+            },
             initial: InitialSet {
-                boxes: vec![Some((0.1, 0.3)), Some((-0.1, 0.1))],
+                boxes: vec![Some(Bounds::new(0.1, 0.3)), Some(Bounds::new(-0.1, 0.1))],
                 balls: vec![],
             },
-            domain: vec![(f64::NEG_INFINITY, f64::INFINITY); 2],
+            domain: vec![Bounds::ENTIRE; 2],
             has_domain: false,
             unsafe_sets: if inputs {
                 vec![UnsafeSet {
@@ -519,29 +508,21 @@ mod tests {
             } else {
                 vec![]
             },
-            analyses: vec![Analysis {
+            analyses: vec![],
+        };
+        // |(b u, b u)| <= sqrt(2) |b| / 2 over the input box.
+        let constants = Constants::given(&info, vec![1.0, 0.0, 0.0, 1.0], -1.0, 0.3, b.abs());
+        info.analyses.push(Analysis {
+            spec: AnalysisSpec {
                 name: "a".into(),
-                method: Method::Contraction,
                 delta: 0.05,
                 horizon: 0.5,
                 step: 0.01,
-                radius: RadiusRule::Amgf,
-                rate: Rate::Certified,
-                integrator: Integrator::Rk4,
-                inclusion: Inclusion::Jacobian,
-                outputs: vec![],
-                transform: None,
-                constants: Some(Constants {
-                    metric: vec![1.0, 0.0, 0.0, 1.0],
-                    c: -1.0,
-                    sigma: 0.3,
-                    // |(b u, b u)| <= sqrt(2) |b| / 2 over the input box.
-                    rho: b.abs(),
-                    how: "exact".into(),
-                }),
-                constants_error: None,
-            }],
-        }
+                ..AnalysisSpec::default()
+            },
+            constants: Ok(constants),
+        });
+        info
     }
 
     /// The loops compiled for AVX2 and BMI2 and the eight-lane AVX-512 loop (when the

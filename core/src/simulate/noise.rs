@@ -7,6 +7,7 @@
 //! (additive noise) and evaluated once instead of at every step. Both facts are proven by the
 //! enclosure, not guessed from samples, so the simulated increments are those of the model.
 
+use super::report::NoiseKind;
 use crate::interval::Interval;
 use crate::system::System;
 
@@ -78,17 +79,15 @@ impl Noise {
     }
 
     /// For the report.
-    pub(crate) fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> NoiseKind {
         match (self.constant, &self.diagonal) {
-            (true, Some(_)) => "additive (constant diagonal G, evaluated once)".into(),
-            (true, None) => format!(
-                "additive (constant G with {} non-zero entries, evaluated once)",
-                self.cols.len()
-            ),
-            (false, _) => format!(
-                "state-dependent (G evaluated at every step; {} entries not identically zero)",
-                self.cols.len()
-            ),
+            (true, Some(_)) => NoiseKind::AdditiveDiagonal,
+            (true, None) => NoiseKind::Additive {
+                entries: self.cols.len(),
+            },
+            (false, _) => NoiseKind::StateDependent {
+                entries: self.cols.len(),
+            },
         }
     }
 

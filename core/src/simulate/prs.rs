@@ -1,6 +1,6 @@
 //! Distances `|x - x*_t|_P` and PRS membership of sample states.
 //!
-//! Membership is decided by [`engine::contains`] (the engine's own, conservative test). It
+//! Membership is decided by [`Prs::contains_at`] (the engine's own, conservative test). It
 //! allocates and works in interval arithmetic, too slow for every path and step, so two
 //! shortcuts answer the clear cases first, each only where it provably agrees with `contains`:
 //!
@@ -18,7 +18,7 @@
 //! point for other shapes, go to `contains`.
 
 use super::paths::SMALL;
-use crate::engine::{self, AnalysisResult};
+use crate::prs::{DetSet, Prs};
 
 /// The quadratic form `d' P d` as a list of terms.
 #[derive(Clone, Debug)]
@@ -37,16 +37,16 @@ pub(crate) struct Metric {
 }
 
 impl Metric {
-    /// The metric `P` by rows.
-    pub(crate) fn new(p: &[Vec<f64>]) -> Self {
-        let n = p.len();
+    /// The metric `P`, `n x n` row-major.
+    pub(crate) fn new(p: &[f64], n: usize) -> Self {
+        let at = |i: usize, j: usize| p[i * n + j];
         let mut terms = Vec::new();
-        for (i, row) in p.iter().enumerate() {
-            if row[i] != 0.0 {
-                terms.push((i, i, row[i]));
+        for i in 0..n {
+            if at(i, i) != 0.0 {
+                terms.push((i, i, at(i, i)));
             }
-            for (j, other) in p.iter().enumerate().skip(i + 1) {
-                let w = row[j] + other[i];
+            for j in i + 1..n {
+                let w = at(i, j) + at(j, i);
                 if w != 0.0 {
                     terms.push((i, j, w));
                 }
@@ -57,7 +57,7 @@ impl Metric {
         // own (outward-rounded) evaluation.
         let gamma = 4.0 * (terms.len() as f64 + 8.0) * f64::EPSILON;
         let nonneg = terms.iter().all(|&(i, j, w)| i == j && w >= 0.0);
-        let diag = (0..n).map(|i| p[i][i]).collect();
+        let diag = (0..n).map(|i| at(i, i)).collect();
         Metric {
             terms,
             gamma,
@@ -157,10 +157,43 @@ enum Shape {
     Other,
 }
 
+impl Shape {
+    /// The shape of every step of `result` (the sets of one result all have one shape).
+    fn of(result: &Prs) -> Shape {
+        let n = result.states.len();
+        let all = |f: fn(&DetSet) -> bool| result.steps.iter().all(|s| f(&s.det));
+        if all(|d| matches!(d, DetSet::Ball { .. })) {
+            return Shape::PBall;
+        }
+        // Every step's box, flat (`n` per step).
+        let (mut lo, mut hi) = (Vec::new(), Vec::new());
+        for st in &result.steps {
+            match st.det.corners() {
+                Some((l, h)) if l.len() == n && h.len() == n => {
+                    lo.extend_from_slice(l);
+                    hi.extend_from_slice(h);
+                }
+                _ => return Shape::Other,
+            }
+        }
+        if all(|d| matches!(d, DetSet::Box { .. })) {
+            return Shape::Box { lo, hi };
+        }
+        match &result.transform {
+            Some(tr) if n > 0 && tr.matrix.len() == n * n => Shape::Parallelotope {
+                t: tr.matrix.clone(),
+                lo,
+                hi,
+            },
+            _ => Shape::Other,
+        }
+    }
+}
+
 /// Decides PRS membership at each report step of `result`.
 #[derive(Clone, Debug)]
 pub(crate) struct Membership<'a> {
-    result: &'a AnalysisResult,
+    result: &'a Prs,
     shape: Shape,
     /// Squared PRS radius per step.
     r2: Vec<f64>,
@@ -174,40 +207,9 @@ pub(crate) struct Membership<'a> {
 
 impl<'a> Membership<'a> {
     /// For `result` (its steps), with `metric` built from its metric.
-    pub(crate) fn new(result: &'a AnalysisResult, metric: &Metric) -> Self {
+    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Self {
         let n = result.states.len();
-        let corners = |f: fn(&engine::DetSet) -> &Option<Vec<f64>>| {
-            result
-                .steps
-                .iter()
-                .map(|s| f(&s.det_set).as_ref().filter(|v| v.len() == n))
-                .collect::<Option<Vec<_>>>()
-                .map(|v| v.into_iter().flatten().copied().collect::<Vec<f64>>())
-        };
-        let shapes = |name| result.steps.iter().all(|s| s.det_set.shape == name);
-        let transform = result
-            .transform
-            .as_ref()
-            .filter(|tr| n > 0 && tr.matrix.len() == n && tr.matrix.iter().all(|r| r.len() == n));
-        let shape = match (corners(|d| &d.lo), corners(|d| &d.hi)) {
-            _ if shapes("p_ball") && result.steps.iter().all(|s| s.det_set.lo.is_none()) => {
-                Shape::PBall
-            }
-            (Some(lo), Some(hi)) if shapes("box") && result.transform.is_none() => {
-                Shape::Box { lo, hi }
-            }
-            (Some(lo), Some(hi)) if shapes("parallelotope") && transform.is_some() => {
-                Shape::Parallelotope {
-                    t: transform
-                        .into_iter()
-                        .flat_map(|tr| tr.matrix.iter().flatten().copied())
-                        .collect(),
-                    lo,
-                    hi,
-                }
-            }
-            _ => Shape::Other,
-        };
+        let shape = Shape::of(result);
         let r2: Vec<f64> = result
             .steps
             .iter()
@@ -362,17 +364,19 @@ impl<'a> Membership<'a> {
             }
             Shape::Other => {}
         }
-        engine::contains(self.result, k, x)
+        self.result.contains_at(k, x)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::TransformReport;
+    use crate::engine;
     use crate::interval::Interval;
+    use crate::model::*;
+    use crate::prs::TransformUsed;
     use crate::simulate::rng::PathRng;
-    use crate::system::*;
+    use crate::system::System;
 
     /// `dx = A x dt + 0.2 dW` with a non-symmetric stable `A`.
     struct Sys;
@@ -437,29 +441,7 @@ mod tests {
         }
     }
 
-    fn result(method: Method, metric: Vec<f64>) -> AnalysisResult {
-        let analysis = Analysis {
-            name: "a".into(),
-            method,
-            delta: 0.01,
-            horizon: 1.0,
-            step: 0.1,
-            radius: RadiusRule::Amgf,
-            rate: Rate::Certified,
-            integrator: Integrator::Rk4,
-            inclusion: Inclusion::Jacobian,
-            outputs: vec![],
-            transform: None,
-            // Valid for P = I and for the skewed P below (generous c, sigma).
-            constants: Some(Constants {
-                metric,
-                c: -0.2,
-                sigma: 0.5,
-                rho: 0.0,
-                how: "test".into(),
-            }),
-            constants_error: None,
-        };
+    fn result(method: Method, metric: Vec<f64>) -> Prs {
         let info = ModelInfo {
             name: "m".into(),
             states: vec!["x".into(), "y".into()],
@@ -467,57 +449,82 @@ mod tests {
             noises: vec!["w1".into(), "w2".into()],
             input_box: vec![],
             initial: InitialSet {
-                boxes: vec![Some((0.9, 1.1)), Some((-0.1, 0.2))],
+                boxes: vec![Some(Bounds::new(0.9, 1.1)), Some(Bounds::new(-0.1, 0.2))],
                 balls: vec![],
             },
-            domain: vec![(f64::NEG_INFINITY, f64::INFINITY); 2],
+            domain: vec![Bounds::ENTIRE; 2],
             has_domain: false,
             unsafe_sets: vec![],
             analyses: vec![],
+        };
+        let analysis = Analysis {
+            spec: AnalysisSpec {
+                name: "a".into(),
+                method,
+                delta: 0.01,
+                horizon: 1.0,
+                step: 0.1,
+                ..AnalysisSpec::default()
+            },
+            // Valid for P = I and for the skewed P below (generous c, sigma).
+            constants: Ok(Constants::given(&info, metric, -0.2, 0.5, 0.0)),
         };
         engine::run(&Sys, &info, &analysis).unwrap()
     }
 
     /// The interval method's box result turned into a parallelotope `{x : lo <= T x <= hi}`
     /// inside each box (the pendulum's `T`), so that the box's enclosing P-ball still holds it.
-    fn parallelotope(metric: Vec<f64>) -> AnalysisResult {
+    fn parallelotope(metric: Vec<f64>) -> Prs {
         let mut r = result(Method::Interval, metric);
         let t = [[1.0, 0.2], [1.0, 0.0]];
-        r.transform = Some(TransformReport {
-            matrix: t.iter().map(|row| row.to_vec()).collect(),
-            inverse: vec![vec![0.0, 1.0], vec![5.0, -5.0]],
+        r.transform = Some(TransformUsed {
+            matrix: t.concat(),
+            inverse: vec![0.0, 1.0, 5.0, -5.0],
             inverse_error: 1e-15,
         });
         for st in &mut r.steps {
-            let d = &mut st.det_set;
-            let (lo, hi) = (d.lo.clone().unwrap(), d.hi.clone().unwrap());
+            let DetSet::Box {
+                lo,
+                hi,
+                center,
+                radius,
+            } = st.det.clone()
+            else {
+                panic!("a box")
+            };
             // T^-1 = [[0, 1], [5, -5]] maps a y-box of half-width e into x within 10 e.
             let e = (0..2).map(|i| hi[i] - lo[i]).fold(f64::INFINITY, f64::min) / 40.0;
-            let c = &st.nominal;
-            let y: Vec<f64> = t.iter().map(|row| row[0] * c[0] + row[1] * c[1]).collect();
-            d.shape = "parallelotope";
-            d.lo = Some(y.iter().map(|v| v - e).collect());
-            d.hi = Some(y.iter().map(|v| v + e).collect());
+            let y: Vec<f64> = t
+                .iter()
+                .map(|row| row[0] * center[0] + row[1] * center[1])
+                .collect();
+            st.det = DetSet::Parallelotope {
+                lo: y.iter().map(|v| v - e).collect(),
+                hi: y.iter().map(|v| v + e).collect(),
+                hull_lo: lo,
+                hull_hi: hi,
+                center,
+                radius,
+            };
         }
         r
     }
 
     /// Points near the faces of the parallelotopes, just inside and just outside: the
-    /// shortcut's "inside" always agrees with `engine::contains`.
+    /// shortcut's "inside" always agrees with `Prs::contains_at`.
     #[test]
     fn the_parallelotope_shortcut_agrees_with_contains() {
         let mut rng = PathRng::new(6, 0);
         let mut shortcut = 0;
         for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
             let r = parallelotope(metric);
-            let m = Metric::new(&r.constants.metric);
+            let m = Metric::new(&r.constants.metric, 2);
             let mem = Membership::new(&r, &m);
             assert!(mem.has_shortcuts());
             for (k, st) in r.steps.iter().enumerate() {
-                let (lo, hi) = (
-                    st.det_set.lo.as_ref().unwrap(),
-                    st.det_set.hi.as_ref().unwrap(),
-                );
+                let DetSet::Parallelotope { lo, hi, .. } = &st.det else {
+                    panic!("a parallelotope")
+                };
                 for i in 0..400 {
                     // y uniform in the box, then one coordinate moved to a face, off by a few
                     // ulps to a relative 1e-6 either way.
@@ -529,9 +536,9 @@ mod tests {
                     let off = (rng.uniform() - 0.5) * [1e-15, 1e-12, 1e-6, 0.0][i / 2 % 4];
                     y[j] = face * (1.0 + off);
                     let x = [y[1], 5.0 * (y[0] - y[1])];
-                    let (q, a) = m.quad(&x, &st.nominal);
-                    let exact = engine::contains(&r, k, &x);
-                    assert_eq!(mem.inside(&m, k, &x, &st.nominal, q, a), exact, "k = {k}");
+                    let (q, a) = m.quad(&x, st.nominal());
+                    let exact = r.contains_at(k, &x);
+                    assert_eq!(mem.inside(&m, k, &x, st.nominal(), q, a), exact, "k = {k}");
                     if mem.inside_by_shortcut(&m, k, &x, q, a) {
                         assert!(exact, "k = {k}: shortcut");
                         shortcut += 1;
@@ -544,7 +551,7 @@ mod tests {
     }
 
     /// Points at relative P-distances from far inside to far outside, many within rounding of
-    /// the boundary: the shortcuts never disagree with `engine::contains`.
+    /// the boundary: the shortcuts never disagree with `Prs::contains_at`.
     #[test]
     fn shortcuts_agree_with_contains() {
         let mut rng = PathRng::new(5, 0);
@@ -555,10 +562,10 @@ mod tests {
             (Method::Interval, vec![2.0, 0.7, 0.7, 1.0]),
         ] {
             let r = result(method, metric);
-            let m = Metric::new(&r.constants.metric);
+            let m = Metric::new(&r.constants.metric, 2);
             let mem = Membership::new(&r, &m);
             for (k, st) in r.steps.iter().enumerate() {
-                let c = &st.nominal;
+                let c = st.nominal();
                 for i in 0..400 {
                     // A random direction, scaled to a P-distance s * prs_radius.
                     let dir = [rng.uniform() - 0.5, rng.uniform() - 0.5];
@@ -574,7 +581,7 @@ mod tests {
                     let (q, a) = m.quad(&x, c);
                     assert_eq!((q, a), quad_small(&m.upper(), &x, c));
                     let fast = mem.inside(&m, k, &x, c, q, a);
-                    let exact = engine::contains(&r, k, &x);
+                    let exact = r.contains_at(k, &x);
                     assert_eq!(fast, exact, "{method:?} k = {k} s = {s}");
                     if mem.inside_by_shortcut(&m, k, &x, q, a)
                         || mem.inside_below(k).is_some_and(|b| q < b)

@@ -1,7 +1,7 @@
 //! Point membership in the spec's unsafe sets and domain, for counting the paths that enter an
 //! unsafe set or leave the domain. Sets are closed (a point on the boundary is in the set).
 
-use crate::system::{Range, UnsafeShape};
+use crate::model::{Bounds, UnsafeShape};
 
 /// A region of the state space.
 #[derive(Clone, Debug)]
@@ -30,7 +30,7 @@ impl Region {
                 if ranges.iter().any(|&(i, _)| i >= n) {
                     return bad("a state index out of range");
                 }
-                Region::Box(ranges.iter().map(|&(i, (lo, hi))| (i, lo, hi)).collect())
+                Region::Box(ranges.iter().map(|&(i, b)| (i, b.lo, b.hi)).collect())
             }
             UnsafeShape::Ball {
                 states,
@@ -64,13 +64,13 @@ impl Region {
     }
 
     /// The domain box (states with an unbounded range are not constrained).
-    pub(crate) fn domain(domain: &[Range]) -> Region {
+    pub(crate) fn domain(domain: &[Bounds]) -> Region {
         Region::Box(
             domain
                 .iter()
                 .enumerate()
-                .filter(|(_, r)| r.0.is_finite() || r.1.is_finite())
-                .map(|(i, r)| (i, r.0, r.1))
+                .filter(|(_, r)| r.lo.is_finite() || r.hi.is_finite())
+                .map(|(i, r)| (i, r.lo, r.hi))
                 .collect(),
         )
     }
@@ -98,10 +98,11 @@ impl Region {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Bounds;
 
     #[test]
     fn shapes() {
-        let b = Region::unsafe_set(&UnsafeShape::Box(vec![(1, (0.0, 1.0))]), 2).unwrap();
+        let b = Region::unsafe_set(&UnsafeShape::Box(vec![(1, Bounds::new(0.0, 1.0))]), 2).unwrap();
         assert!(b.contains(&[9.0, 1.0]) && !b.contains(&[0.0, 1.5]));
         let ball = Region::unsafe_set(
             &UnsafeShape::Ball {
@@ -122,8 +123,13 @@ mod tests {
         )
         .unwrap();
         assert!(h.contains(&[1.0, 0.0]) && !h.contains(&[1.0, 0.5]));
-        let d = Region::domain(&[(-1.0, 1.0), (f64::NEG_INFINITY, f64::INFINITY)]);
+        let d = Region::domain(&[
+            Bounds::new(-1.0, 1.0),
+            Bounds::new(f64::NEG_INFINITY, f64::INFINITY),
+        ]);
         assert!(d.contains(&[0.5, 1e300]) && !d.contains(&[1.5, 0.0]));
-        assert!(Region::unsafe_set(&UnsafeShape::Box(vec![(2, (0.0, 1.0))]), 2).is_err());
+        assert!(
+            Region::unsafe_set(&UnsafeShape::Box(vec![(2, Bounds::new(0.0, 1.0))]), 2).is_err()
+        );
     }
 }

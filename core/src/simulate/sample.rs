@@ -8,7 +8,8 @@ use super::noise::Noise;
 use super::normal::Ziggurat;
 use super::rng::{PathRng, DRAWS_PER_PATH, MAX_PATHS};
 use super::{Options, SimError};
-use crate::system::{ModelInfo, System};
+use crate::model::ModelInfo;
+use crate::system::System;
 
 /// Most paths [`sample_paths`] records: they are all kept in memory.
 pub const MAX_SAMPLE_PATHS: u64 = 100_000;
@@ -60,7 +61,7 @@ pub fn sample_paths<S: System + ?Sized>(
         || info
             .input_box
             .iter()
-            .any(|r| !(r.0.is_finite() && r.1.is_finite() && r.0 <= r.1))
+            .any(|r| !(r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi))
     {
         return Err(SimError::Invalid(
             "the input box must be bounded, one range per input".into(),
@@ -125,7 +126,7 @@ pub fn sample_paths<S: System + ?Sized>(
 mod tests {
     use super::*;
     use crate::interval::Interval;
-    use crate::system::{InitialSet, ModelInfo};
+    use crate::model::{Bounds, InitialSet, ModelInfo};
 
     /// `dx = -x dt + 0.5 dW`, x(0) uniform in [1, 2]; input-free.
     struct Ou;
@@ -182,10 +183,10 @@ mod tests {
             noises: vec!["w".into()],
             input_box: vec![],
             initial: InitialSet {
-                boxes: vec![Some((1.0, 2.0))],
+                boxes: vec![Some(Bounds::new(1.0, 2.0))],
                 balls: vec![],
             },
-            domain: vec![(f64::NEG_INFINITY, f64::INFINITY)],
+            domain: vec![Bounds::ENTIRE],
             has_domain: false,
             unsafe_sets: vec![],
             analyses: vec![],

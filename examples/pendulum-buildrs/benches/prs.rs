@@ -12,11 +12,7 @@ fn main() {
 #[divan::bench]
 fn contraction_prs_compiled(bencher: divan::Bencher) {
     let info = info();
-    let analysis = info
-        .analyses
-        .iter()
-        .find(|a| a.name == "contraction")
-        .unwrap();
+    let analysis = info.analysis("contraction").unwrap();
     bencher.bench(|| {
         reachc_runtime::engine::run(&Pendulum, &info, analysis)
             .unwrap()
@@ -39,14 +35,14 @@ fn interval_prs_compiled(bencher: divan::Bencher, inclusion: &str) {
     });
 }
 
-/// The boxes alone (`engine::reach`: the embedding system's 400 Euler steps in y = T x), per
-/// inclusion function: what immrax computes per reach.
+/// The boxes alone (`engine::interval_boxes`: the embedding system's 400 Euler steps in
+/// y = T x), per inclusion function: what immrax computes per reach.
 #[divan::bench(args = ["natural", "jacobian", "mixed"])]
 fn interval_reach_compiled(bencher: divan::Bencher, inclusion: &str) {
     let info = info();
     let analysis = interval_analysis(&info, inclusion);
     bencher.bench(|| {
-        reachc_runtime::engine::reach(&Pendulum, &info, &analysis)
+        reachc_runtime::engine::interval_boxes(&Pendulum, &info, &analysis.spec)
             .unwrap()
             .len()
     });
@@ -54,17 +50,12 @@ fn interval_reach_compiled(bencher: divan::Bencher, inclusion: &str) {
 
 /// The pendulum's analysis `interval` with the given inclusion function.
 fn interval_analysis(
-    info: &reachc_runtime::system::ModelInfo,
+    info: &reachc_runtime::ModelInfo,
     inclusion: &str,
-) -> reachc_runtime::system::Analysis {
-    use reachc_runtime::system::Inclusion;
-    let mut analysis = info
-        .analyses
-        .iter()
-        .find(|a| a.name == "interval")
-        .unwrap()
-        .clone();
-    analysis.inclusion = match inclusion {
+) -> reachc_runtime::model::Analysis {
+    use reachc_runtime::model::Inclusion;
+    let mut analysis = info.analysis("interval").unwrap().clone();
+    analysis.spec.inclusion = match inclusion {
         "natural" => Inclusion::Natural,
         "mixed" => Inclusion::Mixed,
         _ => Inclusion::Jacobian,

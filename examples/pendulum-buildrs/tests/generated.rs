@@ -38,6 +38,6 @@ fn info_lists_the_two_analyses() {
     let info = info();
     assert_eq!(info.name, "pendulum");
     assert_eq!(info.states, ["theta", "omega"]);
-    let names: Vec<&str> = info.analyses.iter().map(|a| a.name.as_str()).collect();
+    let names: Vec<&str> = info.analyses.iter().map(|a| a.spec.name.as_str()).collect();
     assert_eq!(names, ["contraction", "interval"]);
 }

@@ -5,7 +5,10 @@ use super::scope::did_you_mean;
 use super::sets::Fields;
 use super::Checker;
 use crate::diagnostics::{Diagnostic, Span};
-use crate::model::{Analysis, Inclusion, Integrator, Method, Metric, RadiusRule, Rate, Transform};
+use crate::model::{
+    Analysis, AnalysisSpec, Inclusion, Integrator, Method, MetricChoice as Metric, RadiusRule,
+    Rate, Transform,
+};
 use crate::syntax::ast::{Block, Expr, ExprKind, Ident};
 
 /// Most sample paths of an empirical rate estimate (they are all kept in memory).
@@ -27,7 +30,7 @@ const KEYS: &[&str] = &[
 
 impl Checker<'_> {
     pub(super) fn analysis(&mut self, name: &Ident, body: &Block, span: Span) {
-        let first = self.analyses.iter().find(|a| a.name == name.name);
+        let first = self.analyses.iter().find(|a| a.spec.name == name.name);
         if self.defined_twice("analysis", name, first.map(|a| a.span.clone())) {
             return;
         }
@@ -94,7 +97,9 @@ impl Checker<'_> {
             Some((e, _)) => match &e.kind {
                 ExprKind::Name(id) if id.name == "identity" => Some(Metric::Identity),
                 ExprKind::Name(id) if id.name == "auto" => Some(Metric::Auto),
-                ExprKind::List(_) => self.square(e, n, "metric", true).map(Metric::Matrix),
+                ExprKind::List(_) => self
+                    .square(e, n, "metric", true)
+                    .map(|m| Metric::Matrix(m.concat())),
                 _ => self.fail(Diagnostic::error(
                     "unknown metric",
                     e.span.clone(),
@@ -178,19 +183,21 @@ impl Checker<'_> {
             }
         }
         self.analyses.push(Analysis {
-            name: name.name.clone(),
+            spec: AnalysisSpec {
+                name: name.name.clone(),
+                method,
+                delta,
+                horizon,
+                step,
+                metric,
+                radius,
+                rate,
+                inclusion,
+                integrator,
+                transform,
+                outputs,
+            },
             span,
-            method,
-            delta,
-            horizon,
-            step,
-            metric,
-            radius,
-            rate,
-            inclusion,
-            integrator,
-            transform,
-            outputs,
         });
     }
 
@@ -249,12 +256,26 @@ impl Checker<'_> {
         }
     }
 
-    /// A coordinate transform: an invertible n x n matrix, with its inverse.
+    /// A coordinate transform: an invertible n x n matrix, with its inverse. Analyses with the
+    /// same `T` share one frame (the transformed system backends generate once).
     fn transform(&mut self, e: &Expr, n: usize) -> Option<Transform> {
         let matrix = self.square(e, n, "transform", false)?;
         // `square` checked invertibility by the same elimination, so this succeeds.
-        let inverse = matrix::inverse(&matrix).ok()?;
-        Some(Transform { matrix, inverse })
+        let inverse = matrix::inverse(&matrix).ok()?.concat();
+        let matrix = matrix.concat();
+        let frames = self
+            .analyses
+            .iter()
+            .filter_map(|a| a.spec.transform.as_ref());
+        let frame = match frames.clone().find(|t| t.matrix == matrix) {
+            Some(t) => t.frame,
+            None => frames.map(|t| t.frame + 1).max().unwrap_or(0),
+        };
+        Some(Transform {
+            matrix,
+            inverse,
+            frame,
+        })
     }
 
     /// An n x n matrix, symmetric positive definite (`spd`) or non-singular.

@@ -442,7 +442,7 @@ impl<'a> Checker<'a> {
             ));
             return;
         }
-        if let Some(init) = self.states[i].bounds {
+        if let Some(init) = self.boxes[i] {
             if init.lo < b.lo || init.hi > b.hi {
                 self.diags.push(Diagnostic::error(
                     format!(

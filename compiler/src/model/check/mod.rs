@@ -17,7 +17,7 @@ use std::path::Path;
 
 use scope::{Scope, Symbol, VarKind};
 
-use super::{Bounds, InitialSet, Model, Variable};
+use super::{Ball, Bounds, InitialSet, Model, UnsafeSet, Variable};
 use crate::diagnostics::{has_errors, Diagnostic, Span};
 use crate::ir::{ExprId, Pool, Table};
 use crate::syntax::ast::{Ident, Init, Item, Spec, VarDecl};
@@ -40,7 +40,9 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         diffusion: Vec::new(),
         domain: Vec::new(),
         has_domain: false,
-        initial: InitialSet::default(),
+        boxes: Vec::new(),
+        input_box: Vec::new(),
+        balls: Vec::new(),
         unsafe_sets: Vec::new(),
         analyses: Vec::new(),
         constants: Vec::new(),
@@ -75,12 +77,20 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         pool: c.pool,
         states: c.states,
         inputs: c.inputs,
+        input_box: c
+            .input_box
+            .iter()
+            .map(|b| b.unwrap_or(Bounds::ENTIRE))
+            .collect(),
         noises: c.noises,
-        initial: c.initial,
+        initial: InitialSet {
+            boxes: c.boxes,
+            balls: c.balls.into_iter().map(|(b, _)| b).collect(),
+        },
         domain: c.domain,
         has_domain: c.has_domain,
         tables: c.tables,
-        unsafe_sets: c.unsafe_sets,
+        unsafe_sets: c.unsafe_sets.into_iter().map(|(u, _)| u).collect(),
         analyses: c.analyses,
         constants: c.constants,
     };
@@ -107,8 +117,14 @@ struct Checker<'a> {
     diffusion: Vec<Option<Vec<ExprId>>>,
     domain: Vec<Bounds>,
     has_domain: bool,
-    initial: InitialSet,
-    unsafe_sets: Vec<super::UnsafeSet>,
+    /// Per state: the box or point written in its declaration.
+    boxes: Vec<Option<Bounds>>,
+    /// Per input: its range.
+    input_box: Vec<Option<Bounds>>,
+    /// Initial balls, with the `initial` block of each.
+    balls: Vec<(Ball, Span)>,
+    /// Unsafe sets, with the `unsafe` item of each.
+    unsafe_sets: Vec<(UnsafeSet, Span)>,
     analyses: Vec<super::Analysis>,
     constants: Vec<(String, f64)>,
 }
@@ -278,14 +294,20 @@ impl Checker<'_> {
             self.init_failed
                 .extend(first as usize..first as usize + names.len());
         }
+        let count = names.len();
         let vars = names.into_iter().map(|name| Variable {
             name,
             span: d.span.clone(),
-            bounds,
         });
         match kind {
-            VarKind::State => self.states.extend(vars),
-            VarKind::Input => self.inputs.extend(vars),
+            VarKind::State => {
+                self.states.extend(vars);
+                self.boxes.extend(std::iter::repeat_n(bounds, count));
+            }
+            VarKind::Input => {
+                self.inputs.extend(vars);
+                self.input_box.extend(std::iter::repeat_n(bounds, count));
+            }
             VarKind::Noise => self.noises.extend(vars),
         }
     }
@@ -327,7 +349,7 @@ impl Checker<'_> {
             return; // the parser already reported it; the rest would be noise
         }
         let mut in_ball = vec![false; self.states.len()];
-        for b in &self.initial.balls {
+        for (b, _) in &self.balls {
             for &s in &b.states {
                 in_ball[s] = true;
             }
@@ -343,7 +365,7 @@ impl Checker<'_> {
                     .with_help(format!("add `{}' = ...` to the drift block", s.name)),
                 );
             }
-            if s.bounds.is_none() && !in_ball[i] && !self.init_failed.contains(&i) {
+            if self.boxes[i].is_none() && !in_ball[i] && !self.init_failed.contains(&i) {
                 self.diags.push(
                     Diagnostic::error(
                         format!("state `{}` has no initial set", s.name),

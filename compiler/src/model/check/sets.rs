@@ -212,12 +212,11 @@ impl Checker<'_> {
         };
         for &s in &states {
             let earlier = self
-                .initial
                 .balls
                 .iter()
-                .find(|b| b.states.contains(&s))
-                .map(|b| b.span.clone());
-            if self.states[s].bounds.is_some() || earlier.is_some() {
+                .find(|(b, _)| b.states.contains(&s))
+                .map(|(_, span)| span.clone());
+            if self.boxes[s].is_some() || earlier.is_some() {
                 let mut d = Diagnostic::error(
                     format!("state `{}` gets two initial sets", self.states[s].name),
                     span.clone(),
@@ -233,19 +232,21 @@ impl Checker<'_> {
                 return;
             }
         }
-        self.initial.balls.push(Ball {
-            states,
-            center,
-            radius,
-            metric,
+        self.balls.push((
+            Ball {
+                states,
+                center,
+                radius,
+                metric: metric.map(|m| m.concat()),
+            },
             span,
-        });
+        ));
     }
 
     /// `unsafe NAME box|ball|halfspace { ... }`.
     pub(super) fn unsafe_set(&mut self, name: &Ident, kind: &Ident, body: &Block, span: Span) {
-        let first = self.unsafe_sets.iter().find(|u| u.name == name.name);
-        if self.defined_twice("unsafe set", name, first.map(|u| u.span.clone())) {
+        let first = self.unsafe_sets.iter().find(|(u, _)| u.name == name.name);
+        if self.defined_twice("unsafe set", name, first.map(|(_, span)| span.clone())) {
             return;
         }
         let shape = match kind.name.as_str() {
@@ -273,11 +274,13 @@ impl Checker<'_> {
             }
         };
         if let Some(shape) = shape {
-            self.unsafe_sets.push(UnsafeSet {
-                name: name.name.clone(),
+            self.unsafe_sets.push((
+                UnsafeSet {
+                    name: name.name.clone(),
+                    shape,
+                },
                 span,
-                shape,
-            });
+            ));
         }
     }
 

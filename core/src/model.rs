@@ -1,0 +1,490 @@
+//! The data model of a spec: its sets, inputs and analyses, and the constants the compiler
+//! certified for each analysis. The compiler lowers a spec straight into these types; generated
+//! code writes them as the literal returned by `info()`; the engines read them.
+//!
+//! Matrices are flat row-major vectors: entry `(i, j)` of an `r x c` matrix is `[i * c + j]`.
+
+use std::fmt;
+
+/// A closed interval `[lo, hi]` of reals given by its ends (`-inf` and `inf` allowed), as plain
+/// data (no rounding: see [`Interval`](crate::Interval) for arithmetic).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// Lower end.
+    pub lo: f64,
+    /// Upper end.
+    pub hi: f64,
+}
+
+impl Bounds {
+    /// All of R.
+    pub const ENTIRE: Bounds = Bounds {
+        lo: f64::NEG_INFINITY,
+        hi: f64::INFINITY,
+    };
+
+    /// `[lo, hi]` (not checked: see [`Interval::try_new`](crate::Interval::try_new)).
+    pub const fn new(lo: f64, hi: f64) -> Bounds {
+        Bounds { lo, hi }
+    }
+}
+
+/// Everything about a model that is not code: names, sets and analyses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelInfo {
+    /// `model NAME`.
+    pub name: String,
+    /// State names (family elements as `x[3]`).
+    pub states: Vec<String>,
+    /// Input names.
+    pub inputs: Vec<String>,
+    /// Noise channel names.
+    pub noises: Vec<String>,
+    /// The input box, one range per input.
+    pub input_box: Vec<Bounds>,
+    /// The initial set.
+    pub initial: InitialSet,
+    /// Per state, the box where the constants were derived ([`Bounds::ENTIRE`] when unbounded).
+    pub domain: Vec<Bounds>,
+    /// Whether the spec gave a domain (results then hold while the state stays in it).
+    pub has_domain: bool,
+    /// Unsafe sets.
+    pub unsafe_sets: Vec<UnsafeSet>,
+    /// The analyses, with their certified constants.
+    pub analyses: Vec<Analysis>,
+}
+
+impl ModelInfo {
+    /// The analysis named `name`.
+    pub fn analysis(&self, name: &str) -> Option<&Analysis> {
+        self.analyses.iter().find(|a| a.spec.name == name)
+    }
+
+    /// The model's domain and input box over times `[0, horizon]`: the region constants for
+    /// this model must cover.
+    pub fn region(&self, horizon: f64) -> Region {
+        Region {
+            domain: self.domain.clone(),
+            input_box: self.input_box.clone(),
+            time: Bounds::new(0.0, horizon),
+        }
+    }
+}
+
+/// The initial set: per-state boxes (points are degenerate boxes) times balls over groups of
+/// states.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct InitialSet {
+    /// Per state: its box, or `None` if the state belongs to a ball.
+    pub boxes: Vec<Option<Bounds>>,
+    /// Balls `{x_S : (x_S - c)' M (x_S - c) <= r^2}`.
+    pub balls: Vec<Ball>,
+}
+
+impl InitialSet {
+    /// The box `x0` (one range per state, no balls).
+    pub fn from_box(x0: &[Bounds]) -> InitialSet {
+        InitialSet {
+            boxes: x0.iter().map(|&b| Some(b)).collect(),
+            balls: Vec::new(),
+        }
+    }
+}
+
+/// A ball `{x_S : (x_S - center)' M (x_S - center) <= radius^2}` over the states `S`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ball {
+    /// State indices `S`.
+    pub states: Vec<usize>,
+    /// Centre, one entry per state in `states`.
+    pub center: Vec<f64>,
+    /// Radius (`>= 0`).
+    pub radius: f64,
+    /// Metric `M`, `k x k` row-major (`k = states.len()`); the identity when `None`.
+    pub metric: Option<Vec<f64>>,
+}
+
+/// A named unsafe set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnsafeSet {
+    /// Its name.
+    pub name: String,
+    /// Its shape.
+    pub shape: UnsafeShape,
+}
+
+/// Shapes of unsafe sets.
+#[derive(Clone, Debug, PartialEq)]
+pub enum UnsafeShape {
+    /// A box over some states (the others unconstrained): `(state, bounds)` pairs.
+    Box(Vec<(usize, Bounds)>),
+    /// A Euclidean ball over some states.
+    Ball {
+        /// State indices.
+        states: Vec<usize>,
+        /// Centre.
+        center: Vec<f64>,
+        /// Radius.
+        radius: f64,
+    },
+    /// `{x : normal . x >= offset}` (`normal` has one entry per state).
+    HalfSpace {
+        /// One entry per state.
+        normal: Vec<f64>,
+        /// Offset.
+        offset: f64,
+    },
+}
+
+/// How the deterministic reachable set is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Proposition 3: a P-ball around the nominal trajectory.
+    Contraction,
+    /// Proposition 4: an embedding system on boxes.
+    Interval,
+}
+
+impl Method {
+    /// Its name in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Contraction => "contraction",
+            Method::Interval => "interval",
+        }
+    }
+}
+
+/// The stochastic radius rule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RadiusRule {
+    /// The averaged-MGF bound (default).
+    Amgf,
+    /// Theorem 1 with a given eps in (0, 1).
+    Paper(f64),
+    /// Theorem 1 with eps minimising the radius.
+    PaperOptimal,
+}
+
+impl RadiusRule {
+    /// Its name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            RadiusRule::Amgf => "amgf",
+            RadiusRule::Paper(_) => "paper",
+            RadiusRule::PaperOptimal => "paper_optimal",
+        }
+    }
+}
+
+/// The inclusion function of the drift used by the interval method's embedding system.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Inclusion {
+    /// Natural inclusion: `System::drift_interval` on the (pinned) box and the input box.
+    Natural,
+    /// Jacobian-based (mean-value) inclusion around the centre `(xc, uc)` of the pinned box and
+    /// the input box: `f(xc, uc) + J_x([x], U) ([x] - xc) + J_u([x], U) (U - uc)`.
+    #[default]
+    Jacobian,
+    /// Mixed Jacobian (one column at a time, as immrax's `mjacif`).
+    Mixed,
+}
+
+impl Inclusion {
+    /// Its name in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Inclusion::Natural => "natural",
+            Inclusion::Jacobian => "jacobian",
+            Inclusion::Mixed => "mixed",
+        }
+    }
+}
+
+/// Time integrator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Classical Runge-Kutta of order 4.
+    Rk4,
+    /// Forward Euler.
+    Euler,
+}
+
+impl Integrator {
+    /// Its name in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Rk4 => "rk4",
+            Integrator::Euler => "euler",
+        }
+    }
+}
+
+/// Where the contraction rate `c_t` of a contraction analysis comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Rate {
+    /// One rate for the whole run, certified by the compiler over the domain ([`Constants::c`]).
+    #[default]
+    Certified,
+    /// Estimated per report step from sample paths (the paper's approach for the unicycle):
+    /// the pooled one-sided Lipschitz quotient between sampled states and the nominal. Not a
+    /// guarantee, and labelled so.
+    Empirical {
+        /// Number of sample paths of the estimate.
+        paths: u64,
+    },
+}
+
+impl Rate {
+    /// Its name in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Rate::Certified => "certified",
+            Rate::Empirical { .. } => "empirical",
+        }
+    }
+}
+
+/// The metric `P` an analysis asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MetricChoice {
+    /// `P = I`.
+    Identity,
+    /// A given symmetric positive definite matrix, `n x n` row-major.
+    Matrix(Vec<f64>),
+    /// Synthesised by the compiler.
+    Auto,
+}
+
+/// A coordinate transform `y = T x` of an interval analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transform {
+    /// `T`, `n x n` row-major.
+    pub matrix: Vec<f64>,
+    /// `T^-1` as computed by the compiler in floating point, `n x n` row-major (the engine
+    /// encloses the exact inverse around it).
+    pub inverse: Vec<f64>,
+    /// Which [`System::frame`](crate::System::frame) holds the transformed system (analyses
+    /// with the same `T` share one).
+    pub frame: usize,
+}
+
+/// An `analysis NAME { ... }` block as written, with the defaults filled in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnalysisSpec {
+    /// Its name.
+    pub name: String,
+    /// Contraction or interval.
+    pub method: Method,
+    /// Probability level: the PRS holds the state with probability `>= 1 - delta`.
+    pub delta: f64,
+    /// Final time.
+    pub horizon: f64,
+    /// Time step of the nominal trajectory and of the report.
+    pub step: f64,
+    /// The metric asked for (the one used is [`Constants::metric`]).
+    pub metric: MetricChoice,
+    /// Radius rule.
+    pub radius: RadiusRule,
+    /// Where the contraction rate comes from (contraction method).
+    pub rate: Rate,
+    /// Inclusion function of the interval method.
+    pub inclusion: Inclusion,
+    /// Integrator.
+    pub integrator: Integrator,
+    /// The coordinate transform `y = T x` of the interval method, if given. An engine that
+    /// cannot honour it must refuse the analysis rather than ignore it.
+    pub transform: Option<Transform>,
+    /// States to report (indices; all when empty).
+    pub outputs: Vec<usize>,
+}
+
+impl Default for AnalysisSpec {
+    /// The language's defaults (docs/language.md) with a horizon of 1: contraction method,
+    /// `delta = 1e-3`, `step = horizon / 100`, identity metric, amgf rule, certified rate,
+    /// Jacobian inclusion, RK4, no transform, every state reported.
+    fn default() -> Self {
+        AnalysisSpec {
+            name: String::new(),
+            method: Method::Contraction,
+            delta: 1e-3,
+            horizon: 1.0,
+            step: 0.01,
+            metric: MetricChoice::Identity,
+            radius: RadiusRule::Amgf,
+            rate: Rate::Certified,
+            inclusion: Inclusion::Jacobian,
+            integrator: Integrator::Rk4,
+            transform: None,
+            outputs: Vec::new(),
+        }
+    }
+}
+
+/// One analysis of a model, with the constants certified for it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analysis {
+    /// The analysis as written.
+    pub spec: AnalysisSpec,
+    /// The certified constants, or why the compiler could not bound them (e.g. "`d f[omega] /
+    /// d theta` is unbounded over the domain"); an engine refuses to run without them.
+    pub constants: Result<Constants, String>,
+}
+
+/// Constants of Assumption 1 for one metric, certified by the compiler over a [`Region`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Constants {
+    /// The metric `P`, `n x n` row-major, symmetric positive definite.
+    pub metric: Vec<f64>,
+    /// Contraction rate: `mu_P(D_x f) <= c` over the region, for all inputs and times (`inf`
+    /// for a [`Rate::Empirical`] analysis: the compiler does not bound it then).
+    pub c: f64,
+    /// Noise level: `P^(1/2) G G' P^(1/2) <= sigma^2 I`.
+    pub sigma: f64,
+    /// Input gain: `|D_u f v|_P <= rho |v|_U`, where `|v|_U = max_j |v_j| / h_j` for the input
+    /// box half-widths `h_j` (so the input box is the U-ball of radius 1 around its centre).
+    pub rho: f64,
+    /// How each constant was bounded.
+    pub provenance: Provenance,
+    /// What the constants hold for.
+    pub region: Region,
+}
+
+impl Constants {
+    /// Constants given by hand for the model `info` (a hand-written system, a test): labelled
+    /// [`Provenance::Given`], not certified by reachc, and taken to hold over the model's domain
+    /// and input box at all times.
+    pub fn given(info: &ModelInfo, metric: Vec<f64>, c: f64, sigma: f64, rho: f64) -> Constants {
+        Constants {
+            metric,
+            c,
+            sigma,
+            rho,
+            provenance: Provenance::Given,
+            region: info.region(f64::INFINITY),
+        }
+    }
+}
+
+/// The states, inputs and times over which [`Constants`] were certified. A run whose model
+/// data differs (another domain or input box, a longer horizon) is not covered by them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Region {
+    /// Per state (the model's domain).
+    pub domain: Vec<Bounds>,
+    /// Per input (the model's input box).
+    pub input_box: Vec<Bounds>,
+    /// Times `[0, longest horizon of the spec]`.
+    pub time: Bounds,
+}
+
+/// Where the constants of [`Constants`] come from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Provenance {
+    /// Certified by the compiler: how it bounded each constant.
+    Certified {
+        /// The matrices `c` is the largest `mu_P` over; `None` when the compiler did not bound
+        /// `c` ([`Rate::Empirical`]).
+        c: Option<MatrixBound>,
+        /// The matrices `sigma` is taken over.
+        sigma: MatrixBound,
+        /// How `rho` was bounded.
+        rho: InputGain,
+    },
+    /// Given by hand (a hand-written system, a test): not certified by reachc.
+    Given,
+}
+
+/// The set of matrices (`D_x f`, `G` or `D_u f` over the region) a constant is the worst case
+/// of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MatrixBound {
+    /// The vertex matrices of the atom decomposition `M = M0 + sum a_k M_k`.
+    Vertices {
+        /// Number of vertex matrices.
+        count: usize,
+        /// Number of atoms with a non-degenerate range.
+        atoms: usize,
+        /// How many of them were fixed at one end by semidefiniteness.
+        fixed: usize,
+    },
+    /// One interval matrix enclosing every entry (too many atoms for vertices).
+    Hull {
+        /// Number of atoms with a non-degenerate range.
+        atoms: usize,
+        /// How many of them were fixed at one end by semidefiniteness.
+        fixed: usize,
+        /// The most free atoms handled by vertices.
+        vertex_limit: usize,
+    },
+}
+
+/// How the input gain `rho` was bounded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputGain {
+    /// The model has no inputs (`rho = 0`).
+    NoInputs,
+    /// The maximum over the input box's corners, for the matrices of `D_u f`.
+    Corners(MatrixBound),
+    /// Column by column (many inputs), for the matrices of `D_u f`.
+    Columns(MatrixBound),
+}
+
+impl fmt::Display for MatrixBound {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let fixed_note = |fixed: usize| {
+            if fixed == 0 {
+                String::new()
+            } else {
+                format!(", {fixed} fixed at one end by semidefiniteness")
+            }
+        };
+        match *self {
+            MatrixBound::Vertices {
+                count,
+                atoms,
+                fixed,
+            } => write!(
+                f,
+                "max over {count} vertex matri{} ({atoms} atom{}{})",
+                if count == 1 { "x" } else { "ces" },
+                if atoms == 1 { "" } else { "s" },
+                fixed_note(fixed)
+            ),
+            MatrixBound::Hull {
+                atoms,
+                fixed,
+                vertex_limit,
+            } => write!(
+                f,
+                "interval-matrix bound ({atoms} atoms{}, {} free > {vertex_limit}, too many \
+                 vertices)",
+                fixed_note(fixed),
+                atoms - fixed
+            ),
+        }
+    }
+}
+
+impl fmt::Display for InputGain {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InputGain::NoInputs => f.write_str("no inputs"),
+            InputGain::Corners(m) => write!(f, "{m}, max over the input box's corners"),
+            InputGain::Columns(m) => write!(f, "{m}, column bound (many inputs)"),
+        }
+    }
+}
+
+impl fmt::Display for Provenance {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let Provenance::Certified { c, sigma, rho } = self else {
+            return f.write_str("given by hand, not certified by reachc");
+        };
+        match c {
+            Some(c) => write!(f, "c: {c}; ")?,
+            None => f.write_str("c: not bounded by the compiler; ")?,
+        }
+        write!(f, "sigma: {sigma}; rho: {rho}; certified by interval LDL'")
+    }
+}

@@ -1,0 +1,486 @@
+//! The typed result of an analysis: a delta-PRS at every report time, how it was computed, and
+//! what of it is proved. Renderings (JSON, CSV, text) live in `reachc-runtime`'s `report`.
+//!
+//! A delta-PRS at time `t` is `Rbar_t (+) B_P(r_t)`: a deterministic reachable set ([`DetSet`])
+//! plus the stochastic ball of radius `r_t` in the metric `P` of the analysis' constants.
+
+use crate::engine::{interval, linalg};
+use crate::interval::Interval;
+use crate::model::{
+    Bounds, Inclusion, InitialSet, Integrator, Method, Provenance, RadiusRule, Rate, UnsafeShape,
+};
+use crate::reach::InputPlan;
+
+/// Everything an analysis computed.
+///
+/// The fields are plain data; [`Prs::at`], [`Prs::contains`] and [`Prs::hull`] answer questions
+/// about the sets soundly (in outward-rounded arithmetic).
+#[derive(Clone, Debug)]
+pub struct Prs {
+    /// `model NAME`.
+    pub model: String,
+    /// The analysis' name.
+    pub analysis: String,
+    /// How the deterministic sets were computed.
+    pub method: Method,
+    /// The inclusion function of an interval analysis (`None` for the contraction method).
+    pub inclusion: Option<Inclusion>,
+    /// Probability level: each PRS holds `X_t` with probability `>= 1 - delta`.
+    pub delta: f64,
+    /// Final time.
+    pub horizon: f64,
+    /// Nominal report step (the last step may be shorter).
+    pub step: f64,
+    /// Integrator of the nominal trajectory or of the embedding system.
+    pub integrator: Integrator,
+    /// All state names (the order of every vector of states).
+    pub states: Vec<String>,
+    /// Indices of the states reports show (all when empty).
+    pub outputs: Vec<usize>,
+    /// Where the contraction rate came from.
+    pub rate: RateUsed,
+    /// The constants of Assumption 1 used.
+    pub constants: ConstantsUsed,
+    /// The stochastic radius rule.
+    pub radius_rule: RuleUsed,
+    /// `kappa(n, delta)` of the rule: `r_t = sqrt(Psi_t kappa)`.
+    pub kappa: f64,
+    /// Upper bound of `|x0 - x*_0|_P` over the initial set.
+    pub r1: f64,
+    /// Radius of the input uncertainty in the input norm (1 for the input box; 0 without
+    /// inputs or with a known input plan).
+    pub r2: f64,
+    /// How `r1` was bounded.
+    pub r1_bound: R1Bound,
+    /// The coordinate transform of an interval analysis (`None` otherwise); the boxes of
+    /// [`DetSet::Parallelotope`] are then in `y = T x`.
+    pub transform: Option<TransformUsed>,
+    /// Centre of the initial set (the nominal's start).
+    pub initial_center: Vec<f64>,
+    /// The nominal's input at `t = 0` (the centre of the input box, or the plan's value).
+    pub input_center: Vec<f64>,
+    /// The initial set the sets start from.
+    pub initial: InitialSet,
+    /// The input plan the sets follow (`None`: any input in the input box).
+    pub input_plan: Option<InputPlan>,
+    /// One record per report time.
+    pub steps: Vec<Step>,
+    /// Per unsafe set, its verdict over the whole horizon.
+    pub unsafe_sets: Vec<UnsafeVerdict>,
+    /// The overall verdict.
+    pub verdict: Verdict,
+    /// Which parts are proved and which are not.
+    pub validation: Validation,
+}
+
+/// Where the contraction rate `c_t` came from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RateUsed {
+    /// Certified, or estimated from sample paths (no guarantee).
+    pub rate: Rate,
+    /// The largest rate used on any step (the certified `c` for a certified rate).
+    pub max_c: f64,
+}
+
+/// The constants of Assumption 1, as used.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConstantsUsed {
+    /// Contraction rate.
+    pub c: f64,
+    /// Noise level.
+    pub sigma: f64,
+    /// Input gain (0 without inputs for the contraction method).
+    pub rho: f64,
+    /// How the compiler bounded them.
+    pub provenance: Provenance,
+    /// The metric `P`, `n x n` row-major.
+    pub metric: Vec<f64>,
+}
+
+/// The stochastic radius rule used.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RuleUsed {
+    /// The rule.
+    pub rule: RadiusRule,
+    /// `eps` of Theorem 1 (the given one, or the minimiser), for the paper rules.
+    pub eps: Option<f64>,
+}
+
+/// How `r1` was bounded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct R1Bound {
+    /// The bound over the initial box (or the balls' bounding boxes).
+    pub how: R1Method,
+    /// Initial balls were replaced by their bounding boxes (conservative).
+    pub balls_as_boxes: bool,
+}
+
+/// The bound of `r1` over a box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum R1Method {
+    /// The maximum of `|x0 - x*_0|_P` over the box's vertices.
+    Vertices {
+        /// Non-degenerate coordinates of the box.
+        active: usize,
+    },
+    /// `sum_ij |P_ij| h_i h_j` (more than [`crate::engine::MAX_VERTEX_COORDS`] coordinates).
+    AbsoluteSum,
+    /// The P-radius of the initial box, reported only (the interval method propagates the box
+    /// itself).
+    ReportedOnly,
+}
+
+/// A coordinate transform `y = T x`, as used.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransformUsed {
+    /// `T`, `n x n` row-major.
+    pub matrix: Vec<f64>,
+    /// `T^-1` computed in floating point, `n x n` row-major (`x = T^-1 y`).
+    pub inverse: Vec<f64>,
+    /// A rigorous bound of `|(T^-1)_ij - inverse_ij|` over all entries (0 when exact).
+    pub inverse_error: f64,
+}
+
+/// The sets at one report time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    /// Time.
+    pub t: f64,
+    /// The deterministic reachable set `Rbar_t`.
+    pub det: DetSet,
+    /// Stochastic radius `r_t` (in `|.|_P`).
+    pub r_t: f64,
+    /// `Psi_t` (upper bound).
+    pub psi: f64,
+    /// Contraction rate on the step ending here.
+    pub c: f64,
+    /// Noise level on the step ending here.
+    pub sigma: f64,
+    /// Radius of a P-ball around [`DetSet::center`] containing the PRS: the PRS itself for
+    /// [`DetSet::Ball`] (`R_t + r_t`), coarser than the PRS for boxes.
+    pub prs_radius: f64,
+    /// Safety margin per unsafe set (the order of [`Prs::unsafe_sets`]; `> 0` means shown
+    /// safe).
+    pub margins: Vec<f64>,
+}
+
+/// A deterministic reachable set.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DetSet {
+    /// `{x : |x - center|_P <= radius}` (contraction method; `radius` is `R_t`).
+    Ball {
+        /// The nominal state.
+        center: Vec<f64>,
+        /// `R_t` (upper bound).
+        radius: f64,
+    },
+    /// `{x : lo <= x <= hi}` (interval method), inside the P-ball `(center, radius)`.
+    Box {
+        /// Lower corner.
+        lo: Vec<f64>,
+        /// Upper corner.
+        hi: Vec<f64>,
+        /// Centre of the box.
+        center: Vec<f64>,
+        /// Upper bound of the box's P-radius around `center`.
+        radius: f64,
+    },
+    /// `{x : lo <= T x <= hi}` (interval method with the transform `T` of
+    /// [`Prs::transform`]), with its interval hull `[hull_lo, hull_hi]` in `x`, inside the
+    /// P-ball `(center, radius)` of the hull.
+    Parallelotope {
+        /// Lower corner of the box in `y = T x`.
+        lo: Vec<f64>,
+        /// Upper corner of the box in `y`.
+        hi: Vec<f64>,
+        /// Lower corner of the interval hull in `x`.
+        hull_lo: Vec<f64>,
+        /// Upper corner of the interval hull in `x`.
+        hull_hi: Vec<f64>,
+        /// Centre of the hull.
+        center: Vec<f64>,
+        /// Upper bound of the hull's P-radius around `center`.
+        radius: f64,
+    },
+}
+
+impl Step {
+    /// The nominal state `x*_t` (all states); for the interval method the centre of the set's
+    /// hull.
+    pub fn nominal(&self) -> &[f64] {
+        self.det.center()
+    }
+}
+
+impl DetSet {
+    /// The centre of the set (of its hull for a parallelotope).
+    pub fn center(&self) -> &[f64] {
+        match self {
+            DetSet::Ball { center, .. }
+            | DetSet::Box { center, .. }
+            | DetSet::Parallelotope { center, .. } => center,
+        }
+    }
+
+    /// The radius of a P-ball around [`DetSet::center`] containing the set (`R_t` for a ball).
+    pub fn radius(&self) -> f64 {
+        match self {
+            DetSet::Ball { radius, .. }
+            | DetSet::Box { radius, .. }
+            | DetSet::Parallelotope { radius, .. } => *radius,
+        }
+    }
+
+    /// The box of an interval method's set, `(lo, hi)`: in `x` for [`DetSet::Box`], in
+    /// `y = T x` for [`DetSet::Parallelotope`]; `None` for a ball.
+    pub fn corners(&self) -> Option<(&[f64], &[f64])> {
+        match self {
+            DetSet::Ball { .. } => None,
+            DetSet::Box { lo, hi, .. } | DetSet::Parallelotope { lo, hi, .. } => Some((lo, hi)),
+        }
+    }
+
+    /// An interval hull of the set in `x`: `None` for a ball (its hull needs `P^-1`, see
+    /// [`Prs::hull`]).
+    pub fn box_hull(&self) -> Option<(&[f64], &[f64])> {
+        match self {
+            DetSet::Ball { .. } => None,
+            DetSet::Box { lo, hi, .. } => Some((lo, hi)),
+            DetSet::Parallelotope {
+                hull_lo, hull_hi, ..
+            } => Some((hull_lo, hull_hi)),
+        }
+    }
+}
+
+/// The kind of an unsafe set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnsafeKind {
+    /// `{x : a.x >= b}`; margins are Euclidean distances.
+    HalfSpace,
+    /// A box; margins are the largest per-coordinate gap between the PRS's bounding box and it.
+    Box,
+    /// A Euclidean ball; margins are Euclidean distances.
+    Ball,
+}
+
+impl UnsafeKind {
+    /// The kind of an unsafe set's shape.
+    pub fn of(shape: &UnsafeShape) -> UnsafeKind {
+        match shape {
+            UnsafeShape::HalfSpace { .. } => UnsafeKind::HalfSpace,
+            UnsafeShape::Box(_) => UnsafeKind::Box,
+            UnsafeShape::Ball { .. } => UnsafeKind::Ball,
+        }
+    }
+}
+
+/// One unsafe set's verdict over the horizon.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnsafeVerdict {
+    /// Its name.
+    pub name: String,
+    /// Its kind (what the margins measure).
+    pub kind: UnsafeKind,
+    /// Shown safe at every report time.
+    pub safe: bool,
+    /// Smallest margin over the report times.
+    pub min_margin: f64,
+    /// Time of the smallest margin.
+    pub min_margin_t: f64,
+    /// First report time at which safety was not shown.
+    pub first_not_safe_t: Option<f64>,
+}
+
+/// The overall verdict. A PRS touching an unsafe set does not prove a violation, hence "not
+/// shown safe" rather than "unsafe".
+#[derive(Clone, Debug, PartialEq)]
+pub enum Verdict {
+    /// Every PRS is disjoint from every unsafe set.
+    Safe,
+    /// The spec has no unsafe sets.
+    NoUnsafeSets,
+    /// The first report time and set for which safety was not shown.
+    NotShownSafe {
+        /// Time.
+        t: f64,
+        /// Step index.
+        step: usize,
+        /// Index of the unsafe set in [`Prs::unsafe_sets`].
+        set: usize,
+    },
+}
+
+/// Which parts of the result are proved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Validation {
+    /// Proved parts (outward-rounded, or certified by the compiler).
+    pub rigorous: Vec<Proved>,
+    /// Parts that are not validated.
+    pub not_validated: Vec<Unproved>,
+    /// The result holds only while the state stays in the spec's domain.
+    pub conditional_on_domain: bool,
+}
+
+/// A proved part of a result.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Proved {
+    /// The constants certified by the compiler: which of `c`, `sigma`, `rho` the engine used.
+    Constants {
+        /// `c` (certified rate).
+        c: bool,
+        /// `rho` (contraction method).
+        rho: bool,
+        /// How the compiler bounded them.
+        provenance: Provenance,
+    },
+    /// The inclusion function of the drift on each face (interval method).
+    Inclusion(Inclusion),
+    /// `kappa`, rounded up.
+    Kappa,
+    /// `Psi_t`, exact per-step integration in interval arithmetic.
+    Psi,
+    /// `r1`, `R_t`, `r_t` and the PRS radius (contraction method).
+    Radii,
+    /// `r_t` (interval method).
+    StochasticRadius,
+    /// The safety margins given the deterministic set (`P^-1` enclosed by interval Cholesky).
+    Margins {
+        /// Given the nominal (contraction) or the box (interval).
+        given: Method,
+    },
+    /// The initial box in `y = T x` and the map back to `x`.
+    TransformMaps {
+        /// The bound of `T^-1`'s entries around the floating-point inverse.
+        inverse_error: f64,
+    },
+}
+
+/// A part of a result that is not proved.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Unproved {
+    /// The contraction rate is an estimate from sample paths.
+    EmpiricalRate {
+        /// Number of sample paths.
+        paths: u64,
+    },
+    /// The nominal trajectory is integrated numerically and taken as exact.
+    Nominal {
+        /// The integrator.
+        integrator: Integrator,
+        /// Its step.
+        step: f64,
+    },
+    /// The embedding system is integrated numerically (no remainder bound).
+    Embedding {
+        /// The integrator.
+        integrator: Integrator,
+        /// Its step.
+        step: f64,
+    },
+    /// The transformed drift `T f(T^-1 y)` was formed with rounded coefficients.
+    TransformedDrift,
+    /// The constants hold only in the domain, and the result assumes the state stays in it.
+    Domain,
+}
+
+impl Prs {
+    /// The dimension `n`.
+    pub fn n(&self) -> usize {
+        self.states.len()
+    }
+
+    /// The index of the report time `t` (within `1e-9` relative to the horizon, so grid times
+    /// such as `0.3` written as literals are found); `None` between report times (the sets are
+    /// only computed at report times).
+    pub fn step_index(&self, t: f64) -> Option<usize> {
+        let tol = 1e-9 * self.horizon.abs().max(1.0);
+        let k = self.steps.partition_point(|s| s.t < t - tol);
+        self.steps
+            .get(k)
+            .filter(|s| (s.t - t).abs() <= tol)
+            .map(|_| k)
+    }
+
+    /// The sets at report time `t` (see [`Prs::step_index`]).
+    pub fn at(&self, t: f64) -> Option<&Step> {
+        self.step_index(t).map(|k| &self.steps[k])
+    }
+
+    /// The overall verdict.
+    pub fn verdict(&self) -> &Verdict {
+        &self.verdict
+    }
+
+    /// Whether `x` lies in the PRS at report time `t`: `Some(true)` only if certainly
+    /// (decided in interval arithmetic; a point within rounding of the boundary counts as
+    /// outside), `None` if `t` is not a report time. Panics if `x` has the wrong length.
+    pub fn contains(&self, x: &[f64], t: f64) -> Option<bool> {
+        self.step_index(t).map(|k| self.contains_at(k, x))
+    }
+
+    /// Whether `x` lies in the PRS at report step `k` (see [`Prs::contains`]). Panics if `k` is
+    /// out of range or `x` has the wrong length.
+    pub fn contains_at(&self, k: usize, x: &[f64]) -> bool {
+        let st = &self.steps[k];
+        let n = self.n();
+        assert_eq!(x.len(), n, "contains: x has the wrong dimension");
+        let p = &self.constants.metric;
+        match &st.det {
+            DetSet::Ball { center, .. } => {
+                let d: Vec<Interval> = x
+                    .iter()
+                    .zip(center)
+                    .map(|(&a, &b)| Interval::point(a) - Interval::point(b))
+                    .collect();
+                let mut q = Interval::ZERO;
+                for i in 0..n {
+                    q += p[i * n + i] * d[i].sqr();
+                    for j in i + 1..n {
+                        // Both off-diagonal entries, so a slightly asymmetric P is used as given.
+                        q += Interval::point(p[i * n + j]) * d[i] * d[j]
+                            + Interval::point(p[j * n + i]) * d[j] * d[i];
+                    }
+                }
+                q.hi() <= Interval::point(st.prs_radius).sqr().lo()
+            }
+            DetSet::Box { lo, hi, .. } => interval::box_contains(p, n, x, lo, hi, st.r_t),
+            DetSet::Parallelotope { lo, hi, .. } => match &self.transform {
+                Some(tr) => interval::parallelotope_contains(p, tr, x, lo, hi, st.r_t),
+                None => false,
+            },
+        }
+    }
+
+    /// A rigorous bounding box of the PRS at report time `t` (`None` between report times):
+    /// the deterministic set's hull inflated by `r_t sqrt((P^-1)_ii)` (for a ball, the ball
+    /// `B_P(x*, R_t + r_t)`'s own hull), rounded outward.
+    pub fn hull(&self, t: f64) -> Option<Vec<Bounds>> {
+        let k = self.step_index(t)?;
+        let st = &self.steps[k];
+        let n = self.n();
+        let w = linalg::inverse_diagonal_sqrt(&self.constants.metric, n)?;
+        let spread = |r: f64, i: usize| Interval::point(r) * Interval::point(w[i]);
+        Some(match st.det.box_hull() {
+            None => {
+                let c = st.det.center();
+                (0..n)
+                    .map(|i| {
+                        let d = spread(st.prs_radius, i);
+                        let c = Interval::point(c[i]);
+                        Bounds::new((c - d).lo(), (c + d).hi())
+                    })
+                    .collect()
+            }
+            Some((lo, hi)) => (0..n)
+                .map(|i| {
+                    let d = spread(st.r_t, i);
+                    Bounds::new(
+                        (Interval::point(lo[i]) - d).lo(),
+                        (Interval::point(hi[i]) + d).hi(),
+                    )
+                })
+                .collect(),
+        })
+    }
+}

@@ -1,0 +1,225 @@
+//! [`Reach`]: one analysis of a model, checked once, run from any initial set inside what its
+//! constants were certified for.
+
+use crate::engine::{self, check_initial, Inputs, Needs, Run, RunError, Setup};
+use crate::interval::Interval;
+use crate::model::{
+    Analysis, AnalysisSpec, Bounds, Inclusion, InitialSet, Method, ModelInfo, Rate,
+};
+use crate::prs::Prs;
+use crate::system::System;
+
+/// An analysis of a model, ready to run: its parameters checked, its certified constants
+/// checked against the model data (domain, input box, horizon) and kept private, the metric
+/// factorised and the unsafe sets prepared, once.
+///
+/// Through it a caller chooses where the sets start ([`Reach::from_box`], [`Reach::from_set`])
+/// and, optionally, a known input signal ([`Reach::from_box_with`]); what the constants were
+/// certified for cannot be changed: an initial set outside the spec's domain, or an input plan
+/// outside the input box, is an error.
+///
+/// ```ignore
+/// let reach = Reach::new(&sys, &info, "contraction")?;
+/// let prs = reach.from_box(&[Bounds::new(-0.1, 0.1), Bounds::new(-0.2, 0.2)])?;
+/// let radius_at_1 = prs.at(1.0).unwrap().prs_radius;
+/// ```
+pub struct Reach<'a> {
+    sys: &'a dyn System,
+    info: &'a ModelInfo,
+    spec: AnalysisSpec,
+    setup: Setup<'a>,
+}
+
+impl<'a> Reach<'a> {
+    /// The analysis `name` of the model (`info` as generated with `sys`).
+    pub fn new(
+        sys: &'a dyn System,
+        info: &'a ModelInfo,
+        name: &str,
+    ) -> Result<Reach<'a>, RunError> {
+        let analysis = info
+            .analysis(name)
+            .ok_or_else(|| RunError::UnknownAnalysis {
+                name: name.to_string(),
+                available: info.analyses.iter().map(|a| a.spec.name.clone()).collect(),
+            })?;
+        Reach::for_analysis(sys, info, analysis)
+    }
+
+    /// `analysis` (one of `info.analyses`, or one built like it) of the model.
+    pub fn for_analysis(
+        sys: &'a dyn System,
+        info: &'a ModelInfo,
+        analysis: &'a Analysis,
+    ) -> Result<Reach<'a>, RunError> {
+        let spec = &analysis.spec;
+        let needs = match (spec.method, spec.rate) {
+            (Method::Interval, Rate::Certified) => Needs {
+                c: true,
+                rho: false,
+            },
+            (Method::Interval, rate) => {
+                return Err(RunError::Unsupported(format!(
+                    "a {} rate with the interval method (it uses the certified rate)",
+                    rate.name()
+                )))
+            }
+            (Method::Contraction, Rate::Certified) => Needs { c: true, rho: true },
+            (Method::Contraction, Rate::Empirical { .. }) => Needs {
+                c: false,
+                rho: true,
+            },
+        };
+        let setup = Setup::new(sys, info, spec, &analysis.constants, needs)?;
+        Ok(Reach {
+            sys,
+            info,
+            spec: spec.clone(),
+            setup,
+        })
+    }
+
+    /// The same analysis at another probability level `delta` in `(0, 1)` (the constants do
+    /// not depend on it).
+    pub fn with_delta(mut self, delta: f64) -> Result<Reach<'a>, RunError> {
+        self.spec.delta = delta;
+        engine::validate(self.info, &self.spec, self.setup.n, self.setup.p)?;
+        Ok(self)
+    }
+
+    /// The same analysis with another inclusion function (interval method; the constants do
+    /// not depend on it).
+    pub fn with_inclusion(mut self, inclusion: Inclusion) -> Reach<'a> {
+        self.spec.inclusion = inclusion;
+        self
+    }
+
+    /// The analysis as it runs.
+    pub fn analysis(&self) -> &AnalysisSpec {
+        &self.spec
+    }
+
+    /// The model.
+    pub fn model(&self) -> &ModelInfo {
+        self.info
+    }
+
+    /// The PRS from the spec's initial set, for any input in the input box.
+    pub fn run(&self) -> Result<Prs, RunError> {
+        self.from_set(&self.info.initial)
+    }
+
+    /// The PRS from the initial box `x0` (one range per state), for any input in the input box.
+    pub fn from_box(&self, x0: &[Bounds]) -> Result<Prs, RunError> {
+        self.from_set(&self.initial_box(x0)?)
+    }
+
+    /// The PRS from the initial box `x0` under the known input signal `plan`.
+    pub fn from_box_with(&self, x0: &[Bounds], plan: &InputPlan) -> Result<Prs, RunError> {
+        self.from_set_with(&self.initial_box(x0)?, plan)
+    }
+
+    /// The PRS from the initial set `x0`, for any input in the input box.
+    pub fn from_set(&self, x0: &InitialSet) -> Result<Prs, RunError> {
+        self.run_from(x0, Inputs::Box)
+    }
+
+    /// The PRS from the initial set `x0` under the known input signal `plan`.
+    pub fn from_set_with(&self, x0: &InitialSet, plan: &InputPlan) -> Result<Prs, RunError> {
+        plan.check(&self.info.input_box)?;
+        if let Rate::Empirical { .. } = self.spec.rate {
+            return Err(RunError::Unsupported(
+                "an input plan with an empirical rate (its sample paths draw random inputs)".into(),
+            ));
+        }
+        self.run_from(x0, Inputs::Plan(plan))
+    }
+
+    fn initial_box(&self, x0: &[Bounds]) -> Result<InitialSet, RunError> {
+        if x0.len() != self.setup.n {
+            return Err(RunError::Invalid(format!(
+                "the initial box has {} ranges, the model {} states",
+                x0.len(),
+                self.setup.n
+            )));
+        }
+        Ok(InitialSet::from_box(x0))
+    }
+
+    fn run_from(&self, initial: &InitialSet, inputs: Inputs) -> Result<Prs, RunError> {
+        check_initial(self.info, initial)?;
+        let run = Run {
+            sys: self.sys,
+            info: self.info,
+            spec: &self.spec,
+            setup: &self.setup,
+            initial,
+            inputs,
+        };
+        engine::run_engine(&run)
+    }
+}
+
+/// A known input signal: piecewise constant on the analysis' report steps, `u(t) = f(t_k)` on
+/// `[t_k, t_(k+1))`. With a plan the sets cover the trajectories under exactly that input (no
+/// input uncertainty, `r2 = 0`); its values must lie in the spec's input box, where the
+/// constants hold.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputPlan {
+    /// Switching times, increasing, the first 0.
+    times: Vec<f64>,
+    /// The input from each switching time on.
+    values: Vec<Vec<f64>>,
+}
+
+impl InputPlan {
+    /// The same input `u` at all times.
+    pub fn constant(u: &[f64]) -> InputPlan {
+        InputPlan {
+            times: vec![0.0],
+            values: vec![u.to_vec()],
+        }
+    }
+
+    /// The input `values[k]` from `times[k]` on (until `times[k + 1]`); `times` increasing,
+    /// starting at 0. The engines hold the value in force at the start of each report step for
+    /// the whole step.
+    pub fn steps(times: Vec<f64>, values: Vec<Vec<f64>>) -> Result<InputPlan, RunError> {
+        let increasing = times.windows(2).all(|w| w[0] < w[1]);
+        if times.first() != Some(&0.0) || !increasing || times.len() != values.len() {
+            return Err(RunError::Invalid(
+                "an input plan needs increasing times starting at 0, one value per time".into(),
+            ));
+        }
+        Ok(InputPlan { times, values })
+    }
+
+    /// The input at time `t >= 0`.
+    pub fn at(&self, t: f64) -> &[f64] {
+        let k = self.times.partition_point(|&s| s <= t).saturating_sub(1);
+        &self.values[k]
+    }
+
+    /// Checks the values against the input box.
+    fn check(&self, input_box: &[Bounds]) -> Result<(), RunError> {
+        for u in &self.values {
+            if u.len() != input_box.len() {
+                return Err(RunError::Invalid(format!(
+                    "an input plan value has {} entries, the model {} inputs",
+                    u.len(),
+                    input_box.len()
+                )));
+            }
+            let inside = u
+                .iter()
+                .zip(input_box)
+                .all(|(&v, b)| Interval::try_new(b.lo, b.hi).is_some_and(|iv| iv.contains(v)));
+            if !inside {
+                return Err(RunError::Invalid(format!(
+                    "the input plan value {u:?} leaves the input box, where the constants hold"
+                )));
+            }
+        }
+        Ok(())
+    }
+}

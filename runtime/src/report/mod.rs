@@ -1,0 +1,39 @@
+//! Renderings of typed results, the one place where results become text: JSON (documented in
+//! docs/results.md), CSV and text summaries of a [`Prs`](reachc_core::Prs)
+//! ([`result`]) and of a Monte Carlo [`SimReport`](reachc_core::simulate::SimReport)
+//! ([`simulation`]).
+
+pub mod result;
+pub mod simulation;
+
+pub use result::{summary, to_json, write_csv};
+
+/// A number for a summary: 6 decimals, or scientific notation where that would be long.
+fn num(v: f64) -> String {
+    if v.is_finite() && v.abs() >= 1e6 {
+        format!("{v:.6e}")
+    } else {
+        format!("{v:.6}")
+    }
+}
+
+/// About ten evenly spaced step indices, always including the first and the last.
+fn summary_indices(len: usize) -> Vec<usize> {
+    if len == 0 {
+        return Vec::new();
+    }
+    let last = len - 1;
+    let mut idx: Vec<usize> = (0..10).map(|k| k * last / 10).collect();
+    idx.push(last);
+    idx.dedup();
+    idx
+}
+
+/// Quotes a CSV field when it needs it (state names are identifiers, possibly `x[3]`).
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}

@@ -1,0 +1,632 @@
+//! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
+
+use super::{csv_field, num, summary_indices};
+use reachc_core::model::{Method, Rate};
+use reachc_core::prs::{
+    DetSet, Proved, Prs, R1Method, Step, Unproved, UnsafeKind, UnsafeVerdict, Verdict,
+};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::io::{self, Write};
+
+/// Pretty-printed JSON of a result. Non-finite numbers (e.g. an infinite margin) are `null`.
+pub fn to_json(prs: &Prs) -> String {
+    // Plain data with string keys: serialising cannot fail.
+    serde_json::to_string_pretty(&Json::of(prs)).expect("a result serialises")
+}
+
+/// The JSON document, field for field (the order is the documented one).
+#[derive(Serialize)]
+struct Json<'a> {
+    model: &'a str,
+    analysis: &'a str,
+    method: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    inclusion: Option<&'static str>,
+    delta: f64,
+    horizon: f64,
+    step: f64,
+    integrator: &'static str,
+    states: &'a [String],
+    outputs: &'a [usize],
+    rate: RateJson,
+    constants: ConstantsJson<'a>,
+    radius_rule: RuleJson,
+    kappa: f64,
+    r1: f64,
+    r2: f64,
+    r1_how: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    transform: Option<TransformJson<'a>>,
+    initial_center: &'a [f64],
+    input_center: &'a [f64],
+    steps: Vec<StepJson<'a>>,
+    unsafe_sets: Vec<UnsafeJson<'a>>,
+    verdict: VerdictJson<'a>,
+    validated: ValidationJson,
+}
+
+#[derive(Serialize)]
+struct RateJson {
+    kind: &'static str,
+    note: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    paths: Option<u64>,
+    max_c: f64,
+}
+
+#[derive(Serialize)]
+struct ConstantsJson<'a> {
+    c: f64,
+    sigma: f64,
+    rho: f64,
+    how: String,
+    metric: Vec<&'a [f64]>,
+}
+
+#[derive(Serialize)]
+struct RuleJson {
+    rule: &'static str,
+    eps: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct TransformJson<'a> {
+    matrix: Vec<&'a [f64]>,
+    inverse: Vec<&'a [f64]>,
+    inverse_error: f64,
+}
+
+#[derive(Serialize)]
+struct StepJson<'a> {
+    t: f64,
+    nominal: &'a [f64],
+    det_set: DetSetJson<'a>,
+    r_t: f64,
+    psi: f64,
+    c: f64,
+    sigma: f64,
+    prs_radius: f64,
+    margins: &'a [f64],
+}
+
+#[derive(Serialize)]
+struct DetSetJson<'a> {
+    shape: &'static str,
+    center: &'a [f64],
+    radius: f64,
+    metric: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lo: Option<&'a [f64]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hi: Option<&'a [f64]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hull_lo: Option<&'a [f64]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hull_hi: Option<&'a [f64]>,
+}
+
+#[derive(Serialize)]
+struct UnsafeJson<'a> {
+    name: &'a str,
+    kind: &'static str,
+    safe: bool,
+    min_margin: f64,
+    min_margin_t: f64,
+    first_not_safe_t: Option<f64>,
+    margin_unit: &'static str,
+}
+
+#[derive(Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+enum VerdictJson<'a> {
+    Safe,
+    NoUnsafeSets,
+    NotShownSafe { t: f64, step: usize, set: &'a str },
+}
+
+#[derive(Serialize)]
+struct ValidationJson {
+    rigorous: Vec<String>,
+    not_validated: Vec<String>,
+    conditional_on_domain: bool,
+}
+
+impl<'a> Json<'a> {
+    fn of(prs: &'a Prs) -> Json<'a> {
+        let n = prs.n();
+        let rows = |m: &'a [f64]| -> Vec<&'a [f64]> { m.chunks(n.max(1)).collect() };
+        Json {
+            model: &prs.model,
+            analysis: &prs.analysis,
+            method: prs.method.name(),
+            inclusion: prs.inclusion.map(|i| i.name()),
+            delta: prs.delta,
+            horizon: prs.horizon,
+            step: prs.step,
+            integrator: prs.integrator.name(),
+            states: &prs.states,
+            outputs: &prs.outputs,
+            rate: RateJson {
+                kind: prs.rate.rate.name(),
+                note: rate_note(prs.rate.rate),
+                paths: match prs.rate.rate {
+                    Rate::Empirical { paths } => Some(paths),
+                    Rate::Certified => None,
+                },
+                max_c: prs.rate.max_c,
+            },
+            constants: ConstantsJson {
+                c: prs.constants.c,
+                sigma: prs.constants.sigma,
+                rho: prs.constants.rho,
+                how: prs.constants.provenance.to_string(),
+                metric: rows(&prs.constants.metric),
+            },
+            radius_rule: RuleJson {
+                rule: prs.radius_rule.rule.name(),
+                eps: prs.radius_rule.eps,
+            },
+            kappa: prs.kappa,
+            r1: prs.r1,
+            r2: prs.r2,
+            r1_how: r1_how(prs),
+            transform: prs.transform.as_ref().map(|tr| TransformJson {
+                matrix: rows(&tr.matrix),
+                inverse: rows(&tr.inverse),
+                inverse_error: tr.inverse_error,
+            }),
+            initial_center: &prs.initial_center,
+            input_center: &prs.input_center,
+            steps: prs.steps.iter().map(StepJson::of).collect(),
+            unsafe_sets: prs.unsafe_sets.iter().map(UnsafeJson::of).collect(),
+            verdict: match prs.verdict {
+                Verdict::Safe => VerdictJson::Safe,
+                Verdict::NoUnsafeSets => VerdictJson::NoUnsafeSets,
+                Verdict::NotShownSafe { t, step, set } => VerdictJson::NotShownSafe {
+                    t,
+                    step,
+                    set: &prs.unsafe_sets[set].name,
+                },
+            },
+            validated: ValidationJson {
+                rigorous: prs.validation.rigorous.iter().map(proved).collect(),
+                not_validated: prs.validation.not_validated.iter().map(unproved).collect(),
+                conditional_on_domain: prs.validation.conditional_on_domain,
+            },
+        }
+    }
+}
+
+impl<'a> StepJson<'a> {
+    fn of(st: &'a Step) -> StepJson<'a> {
+        let (shape, lo, hi, hull_lo, hull_hi) = match &st.det {
+            DetSet::Ball { .. } => ("p_ball", None, None, None, None),
+            DetSet::Box { lo, hi, .. } => ("box", Some(&lo[..]), Some(&hi[..]), None, None),
+            DetSet::Parallelotope {
+                lo,
+                hi,
+                hull_lo,
+                hull_hi,
+                ..
+            } => (
+                "parallelotope",
+                Some(&lo[..]),
+                Some(&hi[..]),
+                Some(&hull_lo[..]),
+                Some(&hull_hi[..]),
+            ),
+        };
+        StepJson {
+            t: st.t,
+            nominal: st.nominal(),
+            det_set: DetSetJson {
+                shape,
+                center: st.det.center(),
+                radius: st.det.radius(),
+                metric: "constants.metric",
+                lo,
+                hi,
+                hull_lo,
+                hull_hi,
+            },
+            r_t: st.r_t,
+            psi: st.psi,
+            c: st.c,
+            sigma: st.sigma,
+            prs_radius: st.prs_radius,
+            margins: &st.margins,
+        }
+    }
+}
+
+impl<'a> UnsafeJson<'a> {
+    fn of(u: &'a UnsafeVerdict) -> UnsafeJson<'a> {
+        UnsafeJson {
+            name: &u.name,
+            kind: unsafe_kind(u.kind),
+            safe: u.safe,
+            min_margin: u.min_margin,
+            min_margin_t: u.min_margin_t,
+            first_not_safe_t: u.first_not_safe_t,
+            margin_unit: match u.kind {
+                UnsafeKind::Box => {
+                    "largest per-coordinate gap between the PRS's bounding box and the box"
+                }
+                UnsafeKind::HalfSpace | UnsafeKind::Ball => "Euclidean distance",
+            },
+        }
+    }
+}
+
+/// An unsafe set's kind in reports.
+pub(crate) fn unsafe_kind(kind: UnsafeKind) -> &'static str {
+    match kind {
+        UnsafeKind::HalfSpace => "half_space",
+        UnsafeKind::Box => "box",
+        UnsafeKind::Ball => "ball",
+    }
+}
+
+/// One sentence on where the rate came from; an empirical rate says plainly that it is no
+/// guarantee.
+fn rate_note(rate: Rate) -> String {
+    match rate {
+        Rate::Certified => {
+            "one rate c for the whole horizon, certified by the compiler over the domain".into()
+        }
+        Rate::Empirical { paths } => format!(
+            "EMPIRICAL: c_t estimated from {paths} sample paths (largest one-sided Lipschitz \
+             quotient between a sampled state and the nominal), not certified: the PRS is an \
+             estimate, not a guarantee"
+        ),
+    }
+}
+
+/// How `r1` was bounded, in words.
+fn r1_how(prs: &Prs) -> String {
+    let b = prs.r1_bound;
+    let (how, balls) = match b.how {
+        R1Method::Vertices { active } => (
+            format!(
+                "max of |x0 - x*_0|_P over the vertices of the initial box ({active} \
+                 non-degenerate coordinates)"
+            ),
+            "; balls replaced by their bounding boxes (conservative)",
+        ),
+        R1Method::AbsoluteSum => (
+            format!(
+                "sum_ij |P_ij| h_i h_j over the initial box (more than {} coordinates)",
+                reachc_core::engine::MAX_VERTEX_COORDS
+            ),
+            "; balls replaced by their bounding boxes (conservative)",
+        ),
+        R1Method::ReportedOnly => (
+            "P-radius of the initial box around its centre (reported only: the interval method \
+             propagates the box itself)"
+                .to_string(),
+            "; initial balls replaced by their bounding boxes (conservative)",
+        ),
+    };
+    if b.balls_as_boxes {
+        how + balls
+    } else {
+        how
+    }
+}
+
+/// A proved part, in words.
+fn proved(p: &Proved) -> String {
+    match p {
+        Proved::Constants { c, rho, provenance } => {
+            let mut names = Vec::new();
+            if *c {
+                names.push("c");
+            }
+            names.push("sigma");
+            if *rho {
+                names.push("rho");
+            }
+            format!("constants {} ({provenance})", names.join(", "))
+        }
+        Proved::Inclusion(inclusion) => format!(
+            "{} inclusion function of the drift on each face (outward-rounded interval \
+             arithmetic)",
+            inclusion.name()
+        ),
+        Proved::Kappa => "kappa (rounded up)".into(),
+        Proved::Psi => {
+            "Psi_t (exact per-step integration in interval arithmetic, upper end)".into()
+        }
+        Proved::Radii => "radii r1, R_t, r_t, PRS radius (interval arithmetic, rounded up)".into(),
+        Proved::StochasticRadius => "r_t (interval arithmetic, rounded up)".into(),
+        Proved::Margins { given } => format!(
+            "safety margins given the {} (P^-1 enclosed by interval Cholesky, rounded down)",
+            match given {
+                Method::Contraction => "nominal",
+                Method::Interval => "box",
+            }
+        ),
+        Proved::TransformMaps { inverse_error } => format!(
+            "the initial box in y = T x (interval hull of T X0) and the map back to x (T^-1 \
+             enclosed entry-wise within {inverse_error:.1e} of the floating-point inverse)"
+        ),
+    }
+}
+
+/// A part that is not proved, in words.
+fn unproved(u: &Unproved) -> String {
+    match u {
+        Unproved::EmpiricalRate { paths } => rate_note(Rate::Empirical { paths: *paths }),
+        Unproved::Nominal { integrator, step } => format!(
+            "nominal trajectory x*_t (numerical {} integration, step {step}; taken as exact)",
+            integrator.name()
+        ),
+        Unproved::Embedding { integrator, step } => format!(
+            "time discretisation of the embedding system (numerical {} integration, step \
+             {step}, no remainder bound): the box encloses the deterministic reachable set only \
+             up to the integration error",
+            integrator.name()
+        ),
+        Unproved::TransformedDrift => {
+            "the transformed drift T f(T^-1 y) is formed symbolically with T^-1 and the combined \
+             coefficients rounded to floating point (relative errors ~1e-16, not bounded; far \
+             below the integration error)"
+                .into()
+        }
+        Unproved::Domain => {
+            "conditional on staying in the domain: the constants hold only there, and the \
+             result assumes the state does not leave it"
+                .into()
+        }
+    }
+}
+
+/// State indices the CSV and the summary show: the outputs, or all states if there are none.
+fn shown_states(prs: &Prs) -> Vec<usize> {
+    if prs.outputs.is_empty() {
+        (0..prs.states.len()).collect()
+    } else {
+        prs.outputs.clone()
+    }
+}
+
+/// CSV with header `t,<output state names...>,det_radius,r_t,psi,c,sigma,prs_radius` and one
+/// row per report time (the nominal state in the state columns). For the interval method (box
+/// sets) the header is `t,<state>_lo,<state>_hi,...,r_t,psi` instead; with a coordinate
+/// transform, `t,y1_lo,y1_hi,...,yn_lo,yn_hi,<state>_lo,<state>_hi,...,r_t,psi` (the box in
+/// `y = T x`, then the parallelotope's interval hull in the output states).
+pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
+    let shown = shown_states(prs);
+    if prs.method == Method::Interval {
+        let mut header = String::from("t");
+        if let Some(first) = prs.steps.first() {
+            for (label, _, _) in box_columns(prs, first) {
+                let _ = write!(
+                    header,
+                    ",{},{}",
+                    csv_field(&format!("{label}_lo")),
+                    csv_field(&format!("{label}_hi"))
+                );
+            }
+        }
+        header.push_str(",r_t,psi");
+        writeln!(w, "{header}")?;
+        for s in &prs.steps {
+            let mut row = format!("{}", s.t);
+            for (_, a, b) in box_columns(prs, s) {
+                let _ = write!(row, ",{a},{b}");
+            }
+            let _ = write!(row, ",{},{}", s.r_t, s.psi);
+            writeln!(w, "{row}")?;
+        }
+        return Ok(());
+    }
+    let mut header = String::from("t");
+    for &i in &shown {
+        header.push(',');
+        header.push_str(&csv_field(&prs.states[i]));
+    }
+    header.push_str(",det_radius,r_t,psi,c,sigma,prs_radius");
+    writeln!(w, "{header}")?;
+    for s in &prs.steps {
+        let mut row = format!("{}", s.t);
+        for &i in &shown {
+            let _ = write!(row, ",{}", s.nominal()[i]);
+        }
+        let _ = write!(
+            row,
+            ",{},{},{},{},{},{}",
+            s.det.radius(),
+            s.r_t,
+            s.psi,
+            s.c,
+            s.sigma,
+            s.prs_radius
+        );
+        writeln!(w, "{row}")?;
+    }
+    Ok(())
+}
+
+/// The ranges shown for a box step, `(label, lo, hi)`: the box over the shown states, or with a
+/// transform the box in `y` (`y1`, `y2`, ...) and then the parallelotope's interval hull over
+/// the shown states.
+fn box_columns(prs: &Prs, st: &Step) -> Vec<(String, f64, f64)> {
+    let at = |v: &[f64], i: usize| v.get(i).copied().unwrap_or(f64::NAN);
+    let shown = shown_states(prs).into_iter();
+    match &st.det {
+        DetSet::Parallelotope {
+            lo,
+            hi,
+            hull_lo,
+            hull_hi,
+            ..
+        } => {
+            let ys = (0..prs.states.len()).map(|i| (format!("y{}", i + 1), at(lo, i), at(hi, i)));
+            ys.chain(shown.map(|i| (prs.states[i].clone(), at(hull_lo, i), at(hull_hi, i))))
+                .collect()
+        }
+        DetSet::Box { lo, hi, .. } => shown
+            .map(|i| (prs.states[i].clone(), at(lo, i), at(hi, i)))
+            .collect(),
+        DetSet::Ball { .. } => Vec::new(),
+    }
+}
+
+/// A readable text summary: constants, radius rule and kappa, a table at about ten evenly
+/// spaced times plus the final time, and the safety verdicts with margins.
+pub fn summary(prs: &Prs) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "analysis `{}` of model `{}` ({} method, delta = {})",
+        prs.analysis,
+        prs.model,
+        prs.method.name(),
+        prs.delta
+    );
+    let k = &prs.constants;
+    let c = match prs.rate.rate {
+        Rate::Certified => format!("{:.6}", k.c),
+        rate => format!(
+            "c_t ({} rate, at most {})",
+            rate.name(),
+            num(prs.rate.max_c)
+        ),
+    };
+    let _ = writeln!(
+        s,
+        "  constants: c = {c}, sigma = {:.6}, rho = {:.6} ({})",
+        k.sigma, k.rho, k.provenance
+    );
+    if prs.rate.rate != Rate::Certified {
+        let _ = writeln!(s, "  rate: {}", rate_note(prs.rate.rate));
+    }
+    let n = prs.n().max(1);
+    let rows: Vec<String> = k
+        .metric
+        .chunks(n)
+        .map(|r| {
+            let cells: Vec<String> = r.iter().map(|v| format!("{v:.6}")).collect();
+            format!("[{}]", cells.join(", "))
+        })
+        .collect();
+    let _ = writeln!(s, "  metric P = [{}]", rows.join(", "));
+    let rule = match prs.radius_rule.eps {
+        Some(eps) => format!("{} (eps = {eps:.6})", prs.radius_rule.rule.name()),
+        None => prs.radius_rule.rule.name().to_string(),
+    };
+    let _ = writeln!(
+        s,
+        "  radius rule: {rule}, kappa(n = {}, delta = {}) = {:.6}",
+        prs.states.len(),
+        prs.delta,
+        prs.kappa
+    );
+    if prs.method == Method::Interval {
+        summary_boxes(prs, &mut s);
+    } else {
+        let _ = writeln!(s, "  r1 = {:.6} ({}), r2 = {}", prs.r1, r1_how(prs), prs.r2);
+        let _ = writeln!(
+            s,
+            "  {:>10}  {:>12}  {:>12}  {:>12}",
+            "t", "R_t", "r_t", "PRS radius"
+        );
+        for i in summary_indices(prs.steps.len()) {
+            let st = &prs.steps[i];
+            let _ = writeln!(
+                s,
+                "  {:>10.4}  {:>12}  {:>12}  {:>12}",
+                st.t,
+                num(st.det.radius()),
+                num(st.r_t),
+                num(st.prs_radius)
+            );
+        }
+    }
+    if prs.unsafe_sets.is_empty() {
+        let _ = writeln!(s, "  safety: no unsafe sets");
+    } else {
+        for u in &prs.unsafe_sets {
+            let status = if u.safe {
+                "safe".to_string()
+            } else {
+                format!(
+                    "NOT SHOWN SAFE (first at t = {:.4})",
+                    u.first_not_safe_t.unwrap_or(f64::NAN)
+                )
+            };
+            let unit = UnsafeJson::of(u).margin_unit;
+            let _ = writeln!(
+                s,
+                "  unsafe set `{}` ({}): {status}; min margin {} at t = {:.4} ({unit})",
+                u.name,
+                unsafe_kind(u.kind),
+                num(u.min_margin),
+                u.min_margin_t,
+            );
+        }
+    }
+    let verdict = match &prs.verdict {
+        Verdict::Safe if matches!(prs.rate.rate, Rate::Empirical { .. }) => {
+            "safe by the EMPIRICAL estimate (every estimated PRS misses every unsafe set; not a \
+             guarantee)"
+                .to_string()
+        }
+        Verdict::Safe => "safe (every PRS misses every unsafe set)".to_string(),
+        Verdict::NoUnsafeSets => "no unsafe sets to check".to_string(),
+        Verdict::NotShownSafe { t, set, .. } => format!(
+            "not shown safe: the PRS at t = {t:.4} meets `{}` (this does not prove a violation)",
+            prs.unsafe_sets[*set].name
+        ),
+    };
+    let _ = writeln!(s, "  verdict: {verdict}");
+    let not_validated: Vec<String> = prs.validation.not_validated.iter().map(unproved).collect();
+    let _ = writeln!(s, "  not validated: {}", not_validated.join("; "));
+    s
+}
+
+/// The table of the summary for box sets: per column of [`box_columns`] the range `[lo, hi]`,
+/// and `r_t`.
+fn summary_boxes(prs: &Prs, s: &mut String) {
+    let inclusion = prs.inclusion.map_or("?", |i| i.name());
+    match &prs.transform {
+        None => {
+            let _ = writeln!(
+                s,
+                "  deterministic sets: boxes of the embedding system ({inclusion} inclusion); \
+                 PRS = box (+) B_P(r_t)"
+            );
+        }
+        Some(tr) => {
+            let n = prs.n().max(1);
+            let rows: Vec<String> = tr.matrix.chunks(n).map(|r| format!("{r:?}")).collect();
+            let _ = writeln!(
+                s,
+                "  deterministic sets: parallelotopes {{x : T x in box}}, T = [{}], box of the \
+                 embedding system in y = T x ({inclusion} inclusion); PRS = parallelotope (+) \
+                 B_P(r_t); columns: the box in y, then the parallelotope's hull in x",
+                rows.join(", ")
+            );
+        }
+    }
+    let Some(first) = prs.steps.first() else {
+        return;
+    };
+    let mut head = format!("  {:>10}", "t");
+    for (label, _, _) in box_columns(prs, first) {
+        let _ = write!(head, "  {:>27}", format!("{label} [lo, hi]"));
+    }
+    let _ = write!(head, "  {:>12}", "r_t");
+    let _ = writeln!(s, "{head}");
+    for k in summary_indices(prs.steps.len()) {
+        let st = &prs.steps[k];
+        let mut row = format!("  {:>10.4}", st.t);
+        for (_, a, b) in box_columns(prs, st) {
+            let _ = write!(row, "  [{a:>12.6}, {b:>12.6}]");
+        }
+        let _ = write!(row, "  {:>12.6}", st.r_t);
+        let _ = writeln!(s, "{row}");
+    }
+}

@@ -1,0 +1,294 @@
+//! Renderings of a Monte Carlo [`SimReport`]: JSON (documented in docs/results.md) and a text
+//! summary.
+
+use super::result::unsafe_kind;
+use reachc_core::simulate::{InitialSampling, InputMode, NoiseKind, SimReport};
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// Pretty-printed JSON of a report (non-finite numbers as `null`).
+pub fn to_json(r: &SimReport) -> String {
+    // Plain data with string keys: serialising cannot fail.
+    serde_json::to_string_pretty(&Json::of(r)).expect("a Monte Carlo report serialises")
+}
+
+/// The JSON document, field for field.
+#[derive(Serialize)]
+struct Json<'a> {
+    model: &'a str,
+    analysis: &'a str,
+    method: &'static str,
+    delta: f64,
+    paths: u64,
+    seed: u64,
+    dt: f64,
+    steps_per_path: u64,
+    initial_states: &'static str,
+    inputs: InputsJson,
+    noise: String,
+    compared: &'static str,
+    quantile_rank: u64,
+    confidence: f64,
+    steps: Vec<StepJson>,
+    horizon: HorizonJson,
+    unsafe_sets: Vec<UnsafeJson<'a>>,
+    left_domain: Option<u64>,
+    diverged: u64,
+    verdict: CoverageJson,
+}
+
+#[derive(Serialize)]
+struct InputsJson {
+    mode: &'static str,
+    hold: Option<f64>,
+    description: String,
+}
+
+#[derive(Serialize)]
+struct StepJson {
+    t: f64,
+    r_t: f64,
+    prs_radius: f64,
+    quantile: f64,
+    max: f64,
+    outside: u64,
+    fraction: f64,
+    cp_upper: f64,
+}
+
+#[derive(Serialize)]
+struct HorizonJson {
+    outside_any: u64,
+    fraction: f64,
+    cp_upper: f64,
+}
+
+#[derive(Serialize)]
+struct UnsafeJson<'a> {
+    name: &'a str,
+    kind: &'static str,
+    hits: u64,
+    fraction: f64,
+    first_hit_t: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct CoverageJson {
+    status: &'static str,
+    alpha: f64,
+    alpha_per_step: f64,
+    failing_steps: usize,
+    worst_step: usize,
+    worst_t: f64,
+    worst_outside: u64,
+    worst_cp_lower: f64,
+}
+
+/// What the distances and the outside counts measure.
+const COMPARED: &str = "distance |X_t - x*_t|_P with P the analysis' metric and x*_t the \
+    result's centre (nominal trajectory; box centre for the interval method), read against the \
+    PRS radius (the PRS is the P-ball of that radius for the contraction method; a P-ball \
+    containing the PRS for the interval method) and r_t (the stochastic part: equal to the PRS \
+    radius when the deterministic set is a point); outside = X_t not in the PRS \
+    (engine::contains)";
+
+impl<'a> Json<'a> {
+    fn of(r: &'a SimReport) -> Json<'a> {
+        Json {
+            model: &r.model,
+            analysis: &r.analysis,
+            method: r.method.name(),
+            delta: r.delta,
+            paths: r.paths,
+            seed: r.seed,
+            dt: r.dt,
+            steps_per_path: r.steps_per_path,
+            initial_states: initial_states(r.initial_states),
+            inputs: InputsJson {
+                mode: r.inputs.mode.name(),
+                hold: r.inputs.hold,
+                description: inputs(r),
+            },
+            noise: noise(r.noise),
+            compared: COMPARED,
+            quantile_rank: r.quantile_rank,
+            confidence: r.confidence,
+            steps: r
+                .steps
+                .iter()
+                .map(|s| StepJson {
+                    t: s.t,
+                    r_t: s.r_t,
+                    prs_radius: s.prs_radius,
+                    quantile: s.quantile,
+                    max: s.max,
+                    outside: s.outside,
+                    fraction: s.fraction,
+                    cp_upper: s.cp_upper,
+                })
+                .collect(),
+            horizon: HorizonJson {
+                outside_any: r.horizon.outside_any,
+                fraction: r.horizon.fraction,
+                cp_upper: r.horizon.cp_upper,
+            },
+            unsafe_sets: r
+                .unsafe_sets
+                .iter()
+                .map(|u| UnsafeJson {
+                    name: &u.name,
+                    kind: unsafe_kind(u.kind),
+                    hits: u.hits,
+                    fraction: u.fraction,
+                    first_hit_t: u.first_hit_t,
+                })
+                .collect(),
+            left_domain: r.left_domain,
+            diverged: r.diverged,
+            verdict: CoverageJson {
+                status: if r.passed() { "pass" } else { "fail" },
+                alpha: r.verdict.alpha,
+                alpha_per_step: r.verdict.alpha_per_step,
+                failing_steps: r.verdict.failing_steps,
+                worst_step: r.verdict.worst_step,
+                worst_t: r.verdict.worst_t,
+                worst_outside: r.verdict.worst_outside,
+                worst_cp_lower: r.verdict.worst_cp_lower,
+            },
+        }
+    }
+}
+
+/// How the initial states were drawn, in words.
+fn initial_states(s: InitialSampling) -> &'static str {
+    match s {
+        InitialSampling::Point => "the initial point (the initial set is a single point)",
+        InitialSampling::Box => "uniform in the initial box",
+        InitialSampling::Balls => "uniform in the initial ball(s)",
+        InitialSampling::BoxAndBalls => "uniform in the initial box and ball(s)",
+    }
+}
+
+/// How the inputs were drawn, in words.
+fn inputs(r: &SimReport) -> String {
+    let hold = r.inputs.hold_shown;
+    match (r.inputs.any, r.inputs.mode) {
+        (false, _) => "none (the model has no inputs)".to_string(),
+        (true, InputMode::Centre) => "the centre of the input box".to_string(),
+        (true, InputMode::Random) => {
+            format!("piecewise constant, uniform in the input box, redrawn every {hold}")
+        }
+        (true, InputMode::Corners) => {
+            format!("piecewise constant, a random corner of the input box, redrawn every {hold}")
+        }
+    }
+}
+
+/// How the noise was applied, in words.
+fn noise(kind: NoiseKind) -> String {
+    match kind {
+        NoiseKind::AdditiveDiagonal => "additive (constant diagonal G, evaluated once)".into(),
+        NoiseKind::Additive { entries } => {
+            format!("additive (constant G with {entries} non-zero entries, evaluated once)")
+        }
+        NoiseKind::StateDependent { entries } => format!(
+            "state-dependent (G evaluated at every step; {entries} entries not identically zero)"
+        ),
+    }
+}
+
+/// A readable summary: what was simulated, a table at about ten report times plus the last, the
+/// horizon-wide and unsafe-set counts, and the verdict.
+pub fn summary(r: &SimReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Monte Carlo check of analysis `{}` of model `{}` ({} method, delta = {})",
+        r.analysis,
+        r.model,
+        r.method.name(),
+        r.delta
+    );
+    // dt is a quotient (step / substeps): show it without its last-digit noise.
+    let dt: f64 = format!("{:.10e}", r.dt).parse().unwrap_or(r.dt);
+    let _ = writeln!(
+        s,
+        "  {} paths (seed {}), Euler-Maruyama with dt = {dt} ({} steps per path)",
+        r.paths, r.seed, r.steps_per_path
+    );
+    let _ = writeln!(s, "  initial states: {}", initial_states(r.initial_states));
+    let _ = writeln!(s, "  inputs: {}", inputs(r));
+    let _ = writeln!(s, "  noise: {}", noise(r.noise));
+    let _ = writeln!(s, "  compared: {COMPARED}");
+    let _ = writeln!(
+        s,
+        "  {:>9}  {:>11}  {:>11}  {:>11}  {:>7}  {:>8}  {:>10}  {:>10}",
+        "t", "r_t", "PRS radius", "quantile", "q/PRS", "outside", "fraction", "CP upper"
+    );
+    // About ten evenly spaced report times, the first and the last included.
+    let last = r.steps.len().saturating_sub(1);
+    let mut rows: Vec<usize> = (0..=10).map(|i| i * last / 10).collect();
+    rows.dedup();
+    for &k in rows.iter().filter(|&&k| k < r.steps.len()) {
+        let st = &r.steps[k];
+        let _ = writeln!(
+            s,
+            "  {:>9.4}  {:>11.5e}  {:>11.5e}  {:>11.5e}  {:>7.4}  {:>8}  {:>10.3e}  {:>10.3e}",
+            st.t,
+            st.r_t,
+            st.prs_radius,
+            st.quantile,
+            // 0 / 0 at t = 0 for a point initial set.
+            if st.prs_radius > 0.0 {
+                st.quantile / st.prs_radius
+            } else {
+                0.0
+            },
+            st.outside,
+            st.fraction,
+            st.cp_upper
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  over the horizon: {} paths ({:.3e}) outside the PRS at some report time (CP upper \
+         {:.3e}); the PRS bounds each time separately, not uniformly in time",
+        r.horizon.outside_any, r.horizon.fraction, r.horizon.cp_upper
+    );
+    for u in &r.unsafe_sets {
+        let first = u
+            .first_hit_t
+            .map_or(String::new(), |t| format!(", first at t = {t:.4}"));
+        let _ = writeln!(
+            s,
+            "  unsafe set `{}` ({}): entered by {} paths ({:.3e}){first}",
+            u.name,
+            unsafe_kind(u.kind),
+            u.hits,
+            u.fraction
+        );
+    }
+    if let Some(left) = r.left_domain {
+        let _ = writeln!(
+            s,
+            "  left the domain: {left} paths (the PRS holds only while the state stays in it)"
+        );
+    }
+    if r.diverged > 0 {
+        let _ = writeln!(s, "  diverged (non-finite state): {} paths", r.diverged);
+    }
+    let v = &r.verdict;
+    let _ = writeln!(
+        s,
+        "  coverage: {} ({} of {} report times with a Clopper-Pearson lower bound above delta at \
+         level 1 - {:.1e}; worst t = {:.4}: {} outside, lower bound {:.3e})",
+        if r.passed() { "PASS" } else { "FAIL" },
+        v.failing_steps,
+        r.steps.len(),
+        v.alpha_per_step,
+        v.worst_t,
+        v.worst_outside,
+        v.worst_cp_lower
+    );
+    s
+}
