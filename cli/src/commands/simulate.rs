@@ -41,7 +41,7 @@ pub struct SimulateArgs {
     /// Worker threads (default: all cores); the results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Do not print the summaries.
+    /// Do not print the summaries (nor cargo's progress).
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -136,7 +136,7 @@ pub fn run_simulate(
             )
         }
         Backend::Compiled => {
-            let binary = compiled_binary(&mut loaded, color)?;
+            let binary = compiled_binary(&mut loaded, color, sim.quiet)?;
             run_binary(&binary, &args, show_bar)?
         }
     };
