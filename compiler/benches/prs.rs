@@ -112,9 +112,9 @@ fn build_chain1000_without_cargo() -> usize {
     let mut model = reachc_compiler::driver::load(&spec("chain1000.sde"))
         .unwrap()
         .model;
-    let files = reachc_compiler::backend::crate_writer::generate_files(
+    let files = reachc_compiler::package::generate_files(
         &mut model,
-        &reachc_compiler::backend::crate_writer::CrateOptions::default(),
+        &reachc_compiler::package::CrateOptions::default(),
     )
     .unwrap();
     files.files.len()

@@ -18,8 +18,7 @@ use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::backend::crate_writer::prepared;
-use crate::backend::{codegen, mangle};
+use crate::backend::{codegen, mangle, prepared};
 use crate::diagnostics::render;
 use crate::driver::load;
 use crate::syntax::{ast::Item, parse};

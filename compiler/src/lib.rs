@@ -15,5 +15,6 @@ pub mod diagnostics;
 pub mod driver;
 pub mod ir;
 pub mod model;
+pub mod package;
 pub mod syntax;
 pub use config::Config;

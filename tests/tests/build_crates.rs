@@ -1,22 +1,27 @@
-//! Generated crates (`reachc build`): deterministic bytes for every shipped spec; for small
-//! specs, the crate compiles clippy-clean with cargo and its binary runs; and the generated
-//! code computes what the IR interpreter computes.
+//! Generated crates (`reachc build`): deterministic bytes for every shipped spec, no absolute
+//! path in any of them; for small specs, the crate compiles clippy-clean with cargo (its
+//! `Cargo.lock` as cargo would write it) and its binary runs; a vendored crate moved elsewhere
+//! builds with plain cargo; the cache runs an unchanged spec's binary without cargo; and the
+//! generated code computes what the IR interpreter computes.
 //!
-//! Every crate compiles in one shared target directory, `<workspace>/target/reachc-crates`, so
-//! the runtime is compiled once (per profile) for all of them.
+//! Every crate compiles in one shared target directory, `<workspace>/target/reachc-crates`,
+//! against one shared copy of the runtime, `<workspace>/target/reachc-e2e-cache/runtime`, so the
+//! runtime is compiled once (per profile) for all of them.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::sync::OnceLock;
 
 use reachc_compiler::backend::codegen;
-use reachc_compiler::backend::crate_writer::{
-    compile_crate_in, write_crate, CrateOptions, WrittenCrate,
-};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_compiler::driver::load;
 use reachc_compiler::model::Model;
+use reachc_compiler::package::{
+    compile_crate_in, install_runtime, write_crate, BuildError, Cache, CrateOptions,
+    InstalledRuntime, Profile, RuntimeDep, WrittenCrate,
+};
 use reachc_e2e::{relative, shipped_specs, workspace, Rng};
 use reachc_runtime::{Interval, System};
 
@@ -34,6 +39,26 @@ fn cargo_lock() -> std::sync::MutexGuard<'static, ()> {
 /// The shared target directory of the generated crates.
 fn target_dir() -> PathBuf {
     workspace().join("target").join("reachc-crates")
+}
+
+/// The cache of the tests (its runtime is the one every test crate shares; its target
+/// directory is [`target_dir`]).
+fn cache() -> Cache {
+    Cache::new(
+        workspace().join("target").join("reachc-e2e-cache"),
+        target_dir(),
+    )
+}
+
+/// The runtime shared by the crates of the tests, installed once.
+fn runtime() -> &'static InstalledRuntime {
+    static RUNTIME: OnceLock<InstalledRuntime> = OnceLock::new();
+    RUNTIME.get_or_init(|| install_runtime(&cache().runtime_parent(), true).unwrap())
+}
+
+/// Compiles the crate at `dir` (dev profile) in the shared target directory.
+fn compile(dir: &Path) -> Result<PathBuf, BuildError> {
+    compile_crate_in(dir, Profile::Dev, &target_dir(), &mut |_| {})
 }
 
 /// A fresh scratch directory for one test (removed by [`Scratch`]'s drop).
@@ -67,9 +92,9 @@ fn write(spec: &Path, out: &Path) -> WrittenCrate {
 fn write_with(spec: &Path, out: &Path, codegen: codegen::Options) -> WrittenCrate {
     let mut loaded = load(spec).unwrap_or_else(|e| panic!("{}:\n{e}", relative(spec)));
     let options = CrateOptions {
+        runtime: RuntimeDep::shared(runtime(), out).unwrap(),
         spec_label: Some(format!("`{}`", relative(spec))),
         codegen,
-        ..CrateOptions::default()
     };
     write_crate(&mut loaded, out, &options)
         .unwrap_or_else(|e| panic!("{}: writing the crate:\n{e}", relative(spec)))
@@ -111,7 +136,13 @@ fn every_shipped_spec_generates_the_same_bytes_twice() {
         let names: Vec<&str> = ta.iter().map(|(p, _)| p.as_str()).collect();
         assert_eq!(
             names,
-            ["Cargo.toml", "README.md", "src/lib.rs", "src/main.rs"],
+            [
+                "Cargo.lock",
+                "Cargo.toml",
+                "README.md",
+                "src/lib.rs",
+                "src/main.rs"
+            ],
             "{}",
             relative(&spec)
         );
@@ -123,19 +154,235 @@ fn every_shipped_spec_generates_the_same_bytes_twice() {
                 relative(&spec)
             );
         }
-        // The manifest names the package, the binary and the runtime by absolute path.
-        let manifest = String::from_utf8(ta[0].1.clone()).unwrap();
+        // The manifest names the package, the binary and the shared runtime by relative path.
+        let manifest = String::from_utf8(ta[1].1.clone()).unwrap();
         assert!(manifest.contains(&format!("name = \"{}\"", written.crate_name)));
         assert!(manifest.contains("[[bin]]") && manifest.contains("\n[workspace]\n"));
-        let runtime = workspace().join("runtime").canonicalize().unwrap();
+        let RuntimeDep::Shared(path) = RuntimeDep::shared(runtime(), &a).unwrap() else {
+            unreachable!()
+        };
+        assert!(!Path::new(&path).is_absolute());
         assert!(
-            manifest.contains(&format!("path = \"{}\"", runtime.display())),
+            manifest.contains(&format!("reachc-runtime = {{ path = \"{path}\" }}")),
             "{manifest}"
+        );
+        assert_eq!(
+            a.join(&path).canonicalize().unwrap(),
+            runtime().runtime_crate().canonicalize().unwrap()
         );
         // Writing again over the first crate replaces it in place.
         write(&spec, &a);
         assert_eq!(tree(&a), ta);
     }
+}
+
+/// Every file under `dir` whose bytes contain one of `needles`, with the needle.
+fn files_containing(dir: &Path, needles: &[String]) -> Vec<(String, String)> {
+    let mut found = Vec::new();
+    for (rel, bytes) in tree(dir) {
+        for needle in needles {
+            if bytes.windows(needle.len()).any(|w| w == needle.as_bytes()) {
+                found.push((rel.clone(), needle.clone()));
+            }
+        }
+    }
+    found
+}
+
+/// The paths no generated file may contain: the workspace, the temporary directory, the
+/// scratch directory and the cache (as given and canonical).
+fn absolute_paths(scratch: &Path) -> Vec<String> {
+    let mut paths = vec![
+        workspace(),
+        std::env::temp_dir(),
+        scratch.to_path_buf(),
+        cache().root().to_path_buf(),
+    ];
+    paths.extend(paths.clone().iter().filter_map(|p| p.canonicalize().ok()));
+    let mut out: Vec<String> = paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .filter(|p| p.len() > 1)
+        .collect();
+    out.sort();
+    out.dedup();
+    out
+}
+
+#[test]
+fn no_generated_file_names_an_absolute_path() {
+    let scratch = Scratch::new("absolute");
+    let needles = absolute_paths(&scratch.0);
+    // The spec by absolute path: the README names its file name only.
+    let pendulum = spec("pendulum.sde");
+    assert!(pendulum.is_absolute());
+    let vendored = scratch.0.join("vendored");
+    let mut loaded = load(&pendulum).unwrap();
+    let written = write_crate(&mut loaded, &vendored, &CrateOptions::default()).unwrap();
+    assert!(written.vendored && written.changed);
+    assert!(vendored.join("vendor/reachc-runtime/src/lib.rs").is_file());
+    assert!(vendored.join("vendor/reachc-core/Cargo.toml").is_file());
+    // A crate of the cache, beside the runtime it shares.
+    let shared = cache().crate_dir("no-absolute-paths");
+    let _ = std::fs::remove_dir_all(&shared);
+    std::fs::create_dir_all(shared.parent().unwrap()).unwrap();
+    let options = CrateOptions {
+        runtime: RuntimeDep::shared(runtime(), &shared).unwrap(),
+        ..CrateOptions::default()
+    };
+    write_crate(&mut loaded, &shared, &options).unwrap();
+    for dir in [&vendored, &shared, &runtime().dir().to_path_buf()] {
+        let found = files_containing(dir, &needles);
+        assert!(found.is_empty(), "{}: {found:?}", dir.display());
+    }
+    let readme = std::fs::read_to_string(vendored.join("README.md")).unwrap();
+    assert!(readme.contains("from `pendulum.sde`"), "{readme}");
+    std::fs::remove_dir_all(&shared).unwrap();
+}
+
+#[test]
+fn a_vendored_crate_moves_and_builds_with_plain_cargo() {
+    let _cargo = cargo_lock();
+    let scratch = Scratch::new("vendored");
+    let written_at = scratch.0.join("written").join("pendulum");
+    std::fs::create_dir_all(written_at.parent().unwrap()).unwrap();
+    let mut loaded = load(&spec("pendulum.sde")).unwrap();
+    write_crate(&mut loaded, &written_at, &CrateOptions::default()).unwrap();
+    // Moved elsewhere, the original gone: it still builds, offline, with its own lock.
+    let moved = scratch.0.join("elsewhere").join("moved");
+    std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
+    std::fs::rename(&written_at, &moved).unwrap();
+    let build = cargo(
+        "build",
+        &moved.join("Cargo.toml"),
+        &["--locked", "--offline", "--message-format=short"],
+    );
+    assert!(
+        build.status.success(),
+        "cargo build --locked --offline of a moved vendored crate:\n{}",
+        String::from_utf8_lossy(&build.stderr)
+    );
+    let binary = target_dir()
+        .join("debug")
+        .join(format!("pendulum{}", std::env::consts::EXE_SUFFIX));
+    let results = scratch.0.join("out");
+    let run = Command::new(&binary)
+        .args(["--quiet", "-o"])
+        .arg(&results)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(results.join("contraction.json").is_file());
+}
+
+/// Modification times of every file under `dir`, relative paths sorted.
+fn mtimes(dir: &Path) -> Vec<(String, std::time::SystemTime)> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<(String, std::time::SystemTime)>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let meta = std::fs::metadata(&path).unwrap();
+            if meta.is_dir() {
+                walk(root, &path, out);
+            } else {
+                let rel = path.strip_prefix(root).unwrap().display().to_string();
+                out.push((rel, meta.modified().unwrap()));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+#[test]
+fn the_cache_runs_an_unchanged_spec_without_cargo() {
+    let _cargo = cargo_lock();
+    let scratch = Scratch::new("cache");
+    // A model name of its own: its crate and binary are this test's alone.
+    let text = std::fs::read_to_string(spec("pendulum.sde"))
+        .unwrap()
+        .replace("model pendulum", "model cache_probe");
+    let spec_path = scratch.0.join("cache_probe.sde");
+    std::fs::write(&spec_path, &text).unwrap();
+    let cache = cache();
+    let mut events = Vec::new();
+    let first = cache
+        .binary(&mut load(&spec_path).unwrap(), Profile::Dev, &mut |p| {
+            events.push(p.clone())
+        })
+        .unwrap();
+    assert!(first.compiled);
+    assert!(first.crate_dir.join(".reachc-stamp").is_file());
+    assert!(first.path.is_file());
+    assert!(matches!(
+        events.first(),
+        Some(reachc_compiler::package::Progress::Started { package }) if package == "cache-probe"
+    ));
+    let crate_before = mtimes(&first.crate_dir);
+    let runtime_before = mtimes(runtime().dir());
+    let binary_before = std::fs::metadata(&first.path).unwrap().modified().unwrap();
+
+    // Unchanged: no file written, no cargo (a program that cannot run), no progress.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    let no_cargo = cache.clone().with_cargo_program(scratch.0.join("no-cargo"));
+    let mut events = Vec::new();
+    let second = no_cargo
+        .binary(&mut load(&spec_path).unwrap(), Profile::Dev, &mut |p| {
+            events.push(p.clone())
+        })
+        .unwrap();
+    assert!(!second.compiled);
+    assert_eq!(second.path, first.path);
+    assert!(events.is_empty(), "{events:?}");
+    assert_eq!(mtimes(&first.crate_dir), crate_before);
+    assert_eq!(mtimes(runtime().dir()), runtime_before);
+    assert_eq!(
+        std::fs::metadata(&first.path).unwrap().modified().unwrap(),
+        binary_before
+    );
+
+    // A changed spec needs cargo (which cannot run here: an error, exit code 2) ...
+    std::fs::write(&spec_path, text.replace("const K1 = -20", "const K1 = -21")).unwrap();
+    let err = no_cargo
+        .binary(&mut load(&spec_path).unwrap(), Profile::Dev, &mut |_| {})
+        .unwrap_err();
+    assert!(matches!(err, BuildError::Cargo { .. }), "{err:?}");
+    assert_eq!(err.exit_code(), 2);
+    // ... and builds with it.
+    let third = cache
+        .binary(&mut load(&spec_path).unwrap(), Profile::Dev, &mut |_| {})
+        .unwrap();
+    assert!(third.compiled);
+    assert!(
+        !cache
+            .binary(&mut load(&spec_path).unwrap(), Profile::Dev, &mut |_| {})
+            .unwrap()
+            .compiled
+    );
+    // A binary replaced by someone else (another crate of the same name in the same target
+    // directory) is not trusted: cargo runs again and puts this crate's binary back.
+    std::fs::remove_file(&third.path).unwrap();
+    std::fs::write(&third.path, b"replaced").unwrap();
+    let fourth = cache
+        .binary(&mut load(&spec_path).unwrap(), Profile::Dev, &mut |_| {})
+        .unwrap();
+    assert!(fourth.compiled);
+    let run = Command::new(&fourth.path)
+        .args(["--quiet", "-o"])
+        .arg(scratch.0.join("out"))
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 }
 
 /// Runs `cargo SUBCOMMAND --manifest-path MANIFEST ARGS` (the cargo running the tests) in the
@@ -172,9 +419,14 @@ fn small_crates_compile_clippy_clean_and_run() {
         let written = write_with(&spec(&format!("{stem}.sde")), &dir, options);
         let lib = std::fs::read_to_string(dir.join("src/lib.rs")).unwrap();
         assert_eq!(lib.contains("_part0("), options == chunked, "{name}");
-        let binary = compile_crate_in(&dir, false, &target_dir())
-            .unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
+        let lock = std::fs::read(dir.join("Cargo.lock")).unwrap();
+        let binary = compile(&dir).unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
         assert!(binary.is_file(), "{}", binary.display());
+        // The generated lock is the one cargo would write: it is left as it is.
+        assert!(
+            std::fs::read(dir.join("Cargo.lock")).unwrap() == lock,
+            "{name}: cargo changed Cargo.lock"
+        );
         assert!(binary
             .file_stem()
             .is_some_and(|s| s.to_string_lossy() == written.crate_name));
@@ -499,8 +751,7 @@ fn generated_code_agrees_with_the_interpreter() {
             probe_main(&ident, &written.type_name),
         )
         .unwrap();
-        let binary = compile_crate_in(&dir, false, &target_dir())
-            .unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
+        let binary = compile(&dir).unwrap_or_else(|e| panic!("{name}: cargo build:\n{e}"));
 
         let prepared = prepare(&mut model);
         let interp = Interpreter::new(model.clone(), &prepared);

@@ -3,6 +3,7 @@
 mod build;
 pub mod inspect;
 mod plot;
+mod progress;
 mod run;
 mod simulate;
 
@@ -53,6 +54,9 @@ pub enum Command {
         /// Compile with optimisations (cargo build --release).
         #[arg(long)]
         release: bool,
+        /// Do not show cargo's progress.
+        #[arg(short, long)]
+        quiet: bool,
     },
     /// Compute the spec's delta-PRS analyses: print summaries, write JSON and CSV results.
     Run {
@@ -70,6 +74,9 @@ pub enum Command {
         /// Pictures of the results.
         #[command(flatten)]
         plot: plot::RunPlotArgs,
+        /// Do not show cargo's progress (compiled backend).
+        #[arg(short, long)]
+        quiet: bool,
     },
     /// Monte Carlo check of the analyses: Euler-Maruyama sample paths against each delta-PRS;
     /// writes ANALYSIS.sim.json. Exit code 1 when a coverage check fails.
@@ -119,14 +126,16 @@ fn run(command: Command) -> Result<(), u8> {
             out,
             no_compile,
             release,
-        } => build::run_build(&spec, out, no_compile, release),
+            quiet,
+        } => build::run_build(&spec, out, no_compile, release, quiet),
         Command::Run {
             spec,
             analysis,
             backend,
             out,
             plot,
-        } => run::run_spec(&spec, analysis, backend, out, &plot),
+            quiet,
+        } => run::run_spec(&spec, analysis, backend, out, &plot, quiet),
         Command::Simulate {
             spec,
             sim,

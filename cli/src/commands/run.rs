@@ -7,14 +7,13 @@ use std::path::{Path, PathBuf};
 use clap::ValueEnum;
 
 use super::plot::{self, RunPlotArgs};
+use super::progress::CompileDisplay;
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
-use reachc_compiler::backend::crate_writer::{
-    compile_crate, shared_target_dir, write_crate, CrateOptions,
-};
 use reachc_compiler::backend::interp::Interpreter;
-use reachc_compiler::backend::{mangle, prepare};
+use reachc_compiler::backend::prepare;
 use reachc_compiler::diagnostics::render;
 use reachc_compiler::driver::Loaded;
+use reachc_compiler::package::{Cache, Profile};
 use reachc_runtime::app::{RunOptions, DEFAULT_OUT_DIR};
 use reachc_runtime::model::ModelInfo;
 
@@ -35,6 +34,7 @@ pub fn run_spec(
     backend: Backend,
     out: Option<PathBuf>,
     plot: &RunPlotArgs,
+    quiet: bool,
 ) -> Result<(), u8> {
     let color = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
@@ -59,7 +59,7 @@ pub fn run_spec(
             (code, Some((interp, info)))
         }
         Backend::Compiled => {
-            let binary = compiled_binary(&mut loaded, color)?;
+            let binary = compiled_binary(&mut loaded, color, quiet)?;
             let status = std::process::Command::new(&binary)
                 .args(opts.to_args())
                 .status()
@@ -110,23 +110,27 @@ pub(super) fn interpreter(mut loaded: Loaded, color: bool) -> (Interpreter, Mode
     (interp, prepared.info)
 }
 
-/// Writes the spec's crate into the shared cache and compiles it (release); the binary's path,
-/// or the exit code after reporting the failure.
-pub(super) fn compiled_binary(loaded: &mut Loaded, color: bool) -> Result<PathBuf, u8> {
-    let crates = shared_target_dir()
-        .and_then(|t| t.parent().map(|p| p.join("crates")))
-        .unwrap_or_else(|| PathBuf::from("target/reachc-crates"));
-    std::fs::create_dir_all(&crates).map_err(|e| {
-        eprintln!("error: cannot create {}: {e}", crates.display());
-        EXIT_USAGE
-    })?;
-    let dir = crates.join(mangle::crate_name(&loaded.model.name));
-    let written = write_crate(loaded, &dir, &CrateOptions::default()).map_err(|e| {
+/// The binary of the spec's crate in reachc's cache (release profile): generated, and compiled
+/// when the cached binary is not current (cargo's progress on stderr unless `quiet`; nothing
+/// when nothing is compiled). Warnings from preparing the model go to stderr. The exit code
+/// after reporting a failure: 1 for spec errors, 2 for the cache or cargo.
+pub(super) fn compiled_binary(
+    loaded: &mut Loaded,
+    color: bool,
+    quiet: bool,
+) -> Result<PathBuf, u8> {
+    let report = |e: reachc_compiler::package::BuildError| {
         eprint!("{}", e.report(color));
         e.exit_code()
-    })?;
-    compile_crate(&written.dir, true).map_err(|e| {
-        eprint!("{}", e.report(color));
-        EXIT_USAGE
-    })
+    };
+    let cache = Cache::from_env().map_err(report)?;
+    let mut display = CompileDisplay::new(quiet);
+    let binary = cache
+        .binary(loaded, Profile::Release, &mut |p| display.event(p))
+        .map_err(report)?;
+    if !binary.warnings.is_empty() {
+        let path = loaded.path.display().to_string();
+        eprint!("{}", render(&binary.warnings, &path, &loaded.source, color));
+    }
+    Ok(binary.path)
 }

@@ -43,7 +43,7 @@ pub struct SimulateArgs {
     /// Worker threads (default: all cores); the results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Do not print the summaries.
+    /// Do not print the summaries (nor cargo's progress).
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -152,7 +152,7 @@ pub fn run_simulate(
             )
         }
         Backend::Compiled => {
-            let binary = compiled_binary(&mut loaded, color)?;
+            let binary = compiled_binary(&mut loaded, color, sim.quiet)?;
             // With a bar, the binary's `reachc-progress` lines drive it.
             opts.progress = show_bar;
             run_binary(&binary, &opts.to_args(), show_bar)?

@@ -105,6 +105,8 @@ const RESERVED_CRATES: &[&str] = &[
     "lpt9",
     "reachc",
     "reachc-runtime",
+    "reachc-core",
+    "reachc-compiler",
 ];
 
 /// Splits a name into ASCII alphanumeric words: at every other character (`_`, `-`, spaces,
