@@ -20,7 +20,9 @@ fn main() {
 }
 
 fn pendulum() -> (Interpreter, reachc_runtime::system::ModelInfo) {
-    let mut model = reachc_compiler::driver::load(&spec("pendulum.sde")).unwrap().model;
+    let mut model = reachc_compiler::driver::load(&spec("pendulum.sde"))
+        .unwrap()
+        .model;
     let prepared = prepare(&mut model);
     (Interpreter::new(model, &prepared), prepared.info)
 }
@@ -84,7 +86,9 @@ fn chain_embedding_10_steps(bencher: divan::Bencher, n: usize) {
     let src = std::fs::read_to_string(spec("chain1000.sde"))
         .unwrap()
         .replace("const N = 1000", &format!("const N = {n}"));
-    let mut model = reachc_compiler::driver::check_source(&src, &spec("")).0.unwrap();
+    let mut model = reachc_compiler::driver::check_source(&src, &spec(""))
+        .0
+        .unwrap();
     let prepared = prepare(&mut model);
     let info = prepared.info.clone();
     let interp = Interpreter::new(model, &prepared);
@@ -114,7 +118,9 @@ fn drift_interpreted(bencher: divan::Bencher) {
 /// certified constants), generate and format the crate's sources.
 #[divan::bench(sample_count = 5)]
 fn build_chain1000_without_cargo() -> usize {
-    let mut model = reachc_compiler::driver::load(&spec("chain1000.sde")).unwrap().model;
+    let mut model = reachc_compiler::driver::load(&spec("chain1000.sde"))
+        .unwrap()
+        .model;
     let files = reachc_compiler::backend::crate_writer::generate_files(
         &mut model,
         &reachc_compiler::backend::crate_writer::CrateOptions::default(),

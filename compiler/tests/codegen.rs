@@ -3,7 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use reachc_compiler::backend::codegen::{generate, generate_with, main_rs, Options, LANES_MAX_STATES};
+use reachc_compiler::backend::codegen::{
+    generate, generate_with, main_rs, Options, LANES_MAX_STATES,
+};
 use reachc_compiler::backend::{mangle, prepare};
 use reachc_compiler::model::Model;
 

@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use reachc_compiler::backend::codegen;
-use reachc_compiler::backend::crate_writer::{compile_crate_in, write_crate, CrateOptions, WrittenCrate};
+use reachc_compiler::backend::crate_writer::{
+    compile_crate_in, write_crate, CrateOptions, WrittenCrate,
+};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_compiler::driver::load;

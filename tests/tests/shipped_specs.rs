@@ -173,8 +173,9 @@ fn printed_expressions_parse_back_to_the_same_function() {
         exprs.extend(d.jac_x.iter().flatten());
         exprs.extend(d.jac_u.iter().flatten());
         exprs.extend(d.jac_g.iter().map(|g| g.expr));
-        let names_of =
-            |v: &[reachc_compiler::model::Variable]| v.iter().map(|x| x.name.clone()).collect::<Vec<_>>();
+        let names_of = |v: &[reachc_compiler::model::Variable]| {
+            v.iter().map(|x| x.name.clone()).collect::<Vec<_>>()
+        };
         let (s, u, w) = (
             names_of(&model.states),
             names_of(&model.inputs),

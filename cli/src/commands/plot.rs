@@ -15,11 +15,11 @@ use reachc_runtime::simulate::{self, SimReport};
 use reachc_runtime::system::ModelInfo;
 
 use super::{load_reporting, EXIT_USAGE};
+use crate::plot::input::{ResultFile, SimFile};
+use crate::plot::{self, select, Choice, Model, Quantile};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_compiler::driver::Loaded;
-use crate::plot::input::{ResultFile, SimFile};
-use crate::plot::{self, select, Choice, Model, Quantile};
 
 /// Paths `reachc run --plot` simulates for the quantile when no report is at hand.
 pub const RUN_QUANTILE_PATHS: u64 = 2000;

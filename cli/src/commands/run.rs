@@ -8,7 +8,9 @@ use clap::ValueEnum;
 
 use super::plot::{self, RunPlotArgs};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
-use reachc_compiler::backend::crate_writer::{compile_crate, shared_target_dir, write_crate, CrateOptions};
+use reachc_compiler::backend::crate_writer::{
+    compile_crate, shared_target_dir, write_crate, CrateOptions,
+};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::{mangle, prepare};
 use reachc_compiler::diagnostics::render;

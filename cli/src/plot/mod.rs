@@ -27,10 +27,10 @@ use std::path::{Path, PathBuf};
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::system::{Analysis, ModelInfo, System};
 
-use reachc_compiler::ir::Table;
 use geometry::{Plane, Point};
 use input::ResultFile;
 use output::Draw;
+use reachc_compiler::ir::Table;
 use regions::Region;
 
 /// Sample paths drawn by default.
