@@ -1,11 +1,12 @@
-//! Turning a model name into the Rust identifiers and the Cargo package name of its generated
-//! crate.
+//! Turning spec names into Rust identifiers: the model's struct and the Cargo package name of
+//! its generated crate, and the index constants of its states, inputs and noise channels.
 //!
-//! The model's struct is the only spec name that becomes a Rust identifier; everything else
-//! (state, input, table names, doc comments) only appears inside string literals and doc
-//! comments. The results here are always valid: ASCII letters, digits, `_` / `-` only, never
-//! empty, never starting with a digit, never a Rust keyword or a name the generated code (or
-//! Cargo) relies on.
+//! These are the only spec names that become Rust identifiers; everything else (table names,
+//! doc comments) only appears inside string literals and doc comments. The results here are
+//! always valid: ASCII letters, digits, `_` / `-` only, never empty, never starting with a
+//! digit, never a Rust keyword or a name the generated code (or Cargo) relies on.
+
+use std::collections::BTreeSet;
 
 /// Rust keywords (strict, reserved and weak ones that are keywords in some position), lowercase.
 const KEYWORDS: &[&str] = &[
@@ -188,6 +189,53 @@ pub fn crate_ident(crate_name: &str) -> String {
     crate_name.replace('-', "_")
 }
 
+/// The names of constants for a list of spec names (the states, inputs or noise channels of a
+/// model), in order: each in SCREAMING_SNAKE_CASE (`theta` -> `THETA`, `x[3]` -> `X_3`,
+/// `vanDerPol` -> `VAN_DER_POL`); a name without ASCII letters or digits becomes `fallback`, one
+/// starting with a digit gets the prefix `fallback_`. Upper case, they are never keywords.
+///
+/// Names equal after this keep the plain form for their first occurrence; the others get the
+/// first suffix `_2`, `_3`, ... that no other name uses (`a_b`, `aB` -> `A_B`, `A_B_2`), so
+/// the results are distinct, and depend only on the list.
+///
+/// `fallback` must be an upper-case identifier (`STATE`).
+pub fn const_names(names: &[String], fallback: &str) -> Vec<String> {
+    let bases: Vec<String> = names
+        .iter()
+        .map(|name| {
+            let base = words(name)
+                .iter()
+                .map(|w| w.to_ascii_uppercase())
+                .collect::<Vec<_>>()
+                .join("_");
+            if base.is_empty() {
+                fallback.to_string()
+            } else if base.starts_with(|c: char| c.is_ascii_digit()) {
+                format!("{fallback}_{base}")
+            } else {
+                base
+            }
+        })
+        .collect();
+    // Every plain form is reserved, so a suffixed name never takes a later name's plain form.
+    let mut taken: BTreeSet<String> = bases.iter().cloned().collect();
+    let mut seen: BTreeSet<&str> = BTreeSet::new();
+    bases
+        .iter()
+        .map(|base| {
+            if seen.insert(base) {
+                return base.clone();
+            }
+            let name = (2..)
+                .map(|k| format!("{base}_{k}"))
+                .find(|candidate| !taken.contains(candidate))
+                .expect("some suffix is free");
+            taken.insert(name.clone());
+            name
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -230,6 +278,37 @@ mod tests {
         assert_eq!(crate_name(""), "model");
         assert_eq!(crate_name("**"), "model");
         assert_eq!(crate_ident("van-der-pol"), "van_der_pol");
+    }
+
+    fn consts(names: &[&str]) -> Vec<String> {
+        let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+        const_names(&names, "STATE")
+    }
+
+    #[test]
+    fn const_names_are_screaming_snake_case() {
+        assert_eq!(consts(&["theta", "omega"]), ["THETA", "OMEGA"]);
+        assert_eq!(
+            consts(&["x[3]", "vanDerPol", "x_10", "self", "type"]),
+            ["X_3", "VAN_DER_POL", "X_10", "SELF", "TYPE"]
+        );
+        assert_eq!(consts(&["_", "3d", "__"]), ["STATE", "STATE_3D", "STATE_2"]);
+    }
+
+    #[test]
+    fn clashing_const_names_get_distinct_suffixes() {
+        assert_eq!(consts(&["a_b", "aB", "a__b"]), ["A_B", "A_B_2", "A_B_3"]);
+        // A suffix never takes another name's plain form, wherever it comes in the list.
+        assert_eq!(
+            consts(&["x[1]", "x_1", "x_1_2", "x1_2"]),
+            ["X_1", "X_1_3", "X_1_2", "X1_2"]
+        );
+        assert_eq!(consts(&["x_1_2", "x[1]", "x_1"]), ["X_1_2", "X_1", "X_1_3"]);
+        let names: Vec<String> = (0..50).map(|i| format!("x{}", "_".repeat(i % 3))).collect();
+        let out = const_names(&names, "STATE");
+        let distinct: BTreeSet<&String> = out.iter().collect();
+        assert_eq!(distinct.len(), out.len());
+        assert!(out.iter().all(|c| is_ident(c)));
     }
 
     #[test]

@@ -74,10 +74,20 @@ impl Pool {
     /// Printing expands the DAG into a tree (shared sub-expressions repeat) and uses an
     /// explicit stack, so any depth is fine.
     pub fn to_sde(&self, e: ExprId, names: &Names<'_>) -> String {
+        self.to_sde_prefix(e, names, usize::MAX)
+    }
+
+    /// [`Pool::to_sde`] that stops once the text is longer than `max` bytes: the whole text if
+    /// it is at most `max` bytes long, else a prefix of it longer than `max`. The expanded tree
+    /// can be exponentially larger than the DAG, so this bounds the work, e.g. for docs.
+    pub fn to_sde_prefix(&self, e: ExprId, names: &Names<'_>, max: usize) -> String {
         let mut out = String::new();
         let mut stack = vec![Piece::Expr(e, 0)];
         let mut pieces = Vec::new();
         while let Some(p) = stack.pop() {
+            if out.len() > max {
+                break;
+            }
             match p {
                 Piece::Text(s) => out.push_str(&s),
                 Piece::Expr(id, min) => {
@@ -919,5 +929,33 @@ mod tests {
         assert!(s.starts_with("x + y*sin(x + y*sin("), "{}", &s[..40]);
         assert!(s.ends_with(&format!("y*sin(x){}", ")".repeat(24_999))));
         assert!(s.len() > 250_000);
+    }
+
+    #[test]
+    fn prefixes_stop_early() {
+        let f = fx();
+        let names = f.names();
+        let mut p = Pool::new();
+        let x = p.var(Var::State(0));
+        // Each level repeats the one below twice when printed: 2^k copies of `x`.
+        let doubling = |p: &mut Pool, levels: usize| {
+            (0..levels).fold(x, |e, _| {
+                let (s, c) = (p.call1(Func1::Sin, e), p.call1(Func1::Cos, e));
+                p.add(s, c)
+            })
+        };
+        let small = doubling(&mut p, 8);
+        let whole = p.to_sde(small, &names);
+        assert_eq!(p.to_sde_prefix(small, &names, whole.len()), whole);
+        let cut = p.to_sde_prefix(small, &names, 100);
+        assert!(
+            cut.len() > 100 && cut.len() < 200 && whole.starts_with(&cut),
+            "{cut}"
+        );
+        // 2^60 copies: only the prefix is printed.
+        let huge = doubling(&mut p, 60);
+        let cut = p.to_sde_prefix(huge, &names, 100);
+        assert!(cut.len() > 100 && cut.len() < 1000, "{cut}");
+        assert!(cut.starts_with("sin(sin(sin("), "{cut}");
     }
 }

@@ -223,7 +223,7 @@ fn cargo_toml(crate_name: &str, runtime: &Runtime) -> String {
             .to_string(),
     };
     format!(
-        "{MARKER} {version}; regenerate with `reachc build` instead of editing.\n\
+        "{header}\
          [package]\n\
          name = \"{crate_name}\"\n\
          version = \"0.1.0\"\n\
@@ -247,6 +247,7 @@ fn cargo_toml(crate_name: &str, runtime: &Runtime) -> String {
          \n\
          # Not a member of any enclosing workspace.\n\
          [workspace]\n",
+        header = codegen::generated_header("#"),
         path = toml_string(&runtime.path()),
     )
 }
@@ -700,6 +701,7 @@ mod tests {
     fn manifests_name_the_runtime_by_relative_path() {
         let vendored = cargo_toml("demo", &Runtime::Vendored);
         assert!(vendored.starts_with(MARKER));
+        assert!(vendored.lines().next().unwrap().contains("@generated"));
         assert!(vendored.contains("reachc-runtime = { path = \"vendor/reachc-runtime\" }"));
         assert!(vendored.contains("\n[workspace]\n"));
         let shared = cargo_toml(

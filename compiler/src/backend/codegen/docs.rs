@@ -1,0 +1,245 @@
+//! The doc comments of generated `System` methods: what each one computes, and the spec
+//! equations it implements, printed in the `.sde` grammar by [`Pool::to_sde_prefix`].
+//!
+//! Bounded, so that a 1000-state model gets a few lines per method rather than megabytes: at
+//! most [`MAX_EQUATIONS`] equations per method (then how many more), each cut at [`MAX_LINE`]
+//! characters (printing expands the expression DAG into a tree, which can be exponentially
+//! larger, so only a prefix is ever printed).
+
+use proc_macro2::TokenStream;
+
+use super::{doc_attrs, fenced, Kind};
+use crate::analysis::Derivatives;
+use crate::ir::{ExprId, Names, Pool};
+
+/// The largest number of equations quoted in one method's doc.
+const MAX_EQUATIONS: usize = 20;
+
+/// The longest equation line, in characters; longer ones are cut and end in ` ...`.
+const MAX_LINE: usize = 120;
+
+/// The doc of one method, shared by its forms (`f64`, interval, lanes): a sentence saying what
+/// it computes, and the equations.
+pub(super) struct MethodDoc {
+    what: &'static str,
+    /// A fenced `text` block, so rustdoc shows `f[x]` and `*` as written.
+    equations: String,
+}
+
+impl MethodDoc {
+    /// The `#[doc]` attributes of the method's `kind` form ([`Kind::F64`] for a method without
+    /// arithmetic).
+    pub(super) fn attrs(&self, kind: Kind) -> TokenStream {
+        let form = match kind {
+            Kind::F64 => "",
+            Kind::Interval => {
+                "Interval form: encloses it for all arguments in the given intervals \
+                 (outward-rounded arithmetic).\n\n"
+            }
+            Kind::X8 => {
+                "Lanes form: eight states at once, each lane bit for bit what `drift` gives.\n\n"
+            }
+        };
+        doc_attrs(&format!("{}.\n\n{form}{}", self.what, self.equations))
+    }
+}
+
+/// The docs of one system's methods (the model's, or a transformed frame's).
+pub(super) struct SystemDocs {
+    /// `drift`, `drift_interval`, `drift_x8`.
+    pub(super) drift: MethodDoc,
+    /// `jac_x`, `jac_x_interval`.
+    pub(super) jac_x: MethodDoc,
+    /// `jac_x_sparse_interval`.
+    pub(super) jac_x_sparse: MethodDoc,
+    /// `jac_x_pattern`.
+    pub(super) jac_x_pattern: MethodDoc,
+    /// `jac_u`, `jac_u_interval`.
+    pub(super) jac_u: MethodDoc,
+    /// `diffusion`, `diffusion_interval`.
+    pub(super) diffusion: MethodDoc,
+}
+
+impl SystemDocs {
+    /// The docs of the system with this drift, diffusion, derivatives and the non-zero pattern
+    /// of its `D_x f` (row, column, entry), its variables printed by `names`.
+    pub(super) fn new(
+        pool: &Pool,
+        names: &Names<'_>,
+        (drift, diffusion): (&[ExprId], &[Vec<ExprId>]),
+        d: &Derivatives,
+        pattern: &[(usize, usize, ExprId)],
+    ) -> SystemDocs {
+        let p = Printer { pool, names };
+        let states = names.states;
+        let d_f = |i: usize, var: &str| format!("d f[{}] / d {var}", states[i]);
+        let jac_x = p.entries(pattern, |i, j| d_f(i, &states[j]));
+        let jac_u = p.nonzero(&d.jac_u);
+        let diffusion = p.nonzero(diffusion);
+        let doc = |what, equations| MethodDoc { what, equations };
+        SystemDocs {
+            drift: doc(
+                "The drift `f(x, u, t)`: `out[i]` is the right-hand side of the equation of \
+                 state `i`",
+                block(drift.len(), |i| {
+                    p.equation(format!("{}'", states[i]), drift[i])
+                }),
+            ),
+            jac_x: doc(
+                "The Jacobian `D_x f`, row-major: `out[i * n + j] = d f[i] / d x[j]`, 0 where \
+                 `f[i]` does not depend on `x[j]`",
+                jac_x.clone(),
+            ),
+            jac_x_sparse: doc(
+                "The entries of `D_x f` at the positions of `jac_x_pattern`, in that order",
+                jac_x,
+            ),
+            jac_x_pattern: doc(
+                "The positions `(i, j)` of `D_x f` where `f[i]` depends on `x[j]`, row by row",
+                block(pattern.len(), |k| {
+                    let (i, j, _) = pattern[k];
+                    cut(format!("({i}, {j}): {}", d_f(i, &states[j])))
+                }),
+            ),
+            jac_u: doc(
+                "The Jacobian `D_u f`, row-major: `out[i * p + j] = d f[i] / d u[j]`",
+                p.entries(&jac_u, |i, j| d_f(i, &names.inputs[j])),
+            ),
+            diffusion: doc(
+                "The diffusion matrix `G(x, t)`, row-major: `out[i * m + k] = G[i, k]`, the \
+                 coefficient of noise channel `k` in the equation of state `i`",
+                p.entries(&diffusion, |i, k| {
+                    format!("G[{}, {}]", states[i], names.noises[k])
+                }),
+            ),
+        }
+    }
+}
+
+/// Prints a system's expressions.
+struct Printer<'a> {
+    pool: &'a Pool,
+    names: &'a Names<'a>,
+}
+
+impl Printer<'_> {
+    /// The entries of `matrix` that are not the constant 0: (row, column, entry).
+    fn nonzero(&self, matrix: &[Vec<ExprId>]) -> Vec<(usize, usize, ExprId)> {
+        let mut out = Vec::new();
+        for (i, row) in matrix.iter().enumerate() {
+            for (j, &e) in row.iter().enumerate() {
+                if self.pool.as_const(e) != Some(0.0) {
+                    out.push((i, j, e));
+                }
+            }
+        }
+        out
+    }
+
+    /// The [`block`] of `entry(i, j) = e` for each (row, column, entry).
+    fn entries(
+        &self,
+        entries: &[(usize, usize, ExprId)],
+        entry: impl Fn(usize, usize) -> String,
+    ) -> String {
+        block(entries.len(), |k| {
+            let (i, j, e) = entries[k];
+            self.equation(entry(i, j), e)
+        })
+    }
+
+    /// `lhs = e`, [`cut`] to [`MAX_LINE`] characters.
+    fn equation(&self, lhs: String, e: ExprId) -> String {
+        // A character takes at most 4 bytes: a prefix of this many is always long enough.
+        let rhs = self.pool.to_sde_prefix(e, self.names, 4 * MAX_LINE);
+        cut(format!("{lhs} = {rhs}"))
+    }
+}
+
+/// Lines `line(k)` for `k` below `total` in a fenced block, at most [`MAX_EQUATIONS`] of them,
+/// then how many were left out.
+fn block(total: usize, line: impl Fn(usize) -> String) -> String {
+    if total == 0 {
+        return "Every entry is 0.".to_string();
+    }
+    let mut lines: Vec<String> = (0..total.min(MAX_EQUATIONS)).map(line).collect();
+    if total > MAX_EQUATIONS {
+        lines.push(format!("... and {} more", total - MAX_EQUATIONS));
+    }
+    fenced(&lines.join("\n"))
+}
+
+/// `line` if it has at most [`MAX_LINE`] characters, else its beginning and ` ...`, cut at a
+/// space in its second half if there is one (so that no name or number is cut in two).
+fn cut(line: String) -> String {
+    if line.chars().count() <= MAX_LINE {
+        return line;
+    }
+    let keep: String = line.chars().take(MAX_LINE - 4).collect();
+    let end = keep
+        .rfind(' ')
+        .filter(|&space| space > MAX_LINE / 2)
+        .unwrap_or(keep.len());
+    format!("{} ...", &keep[..end])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ir::{Func1, Var};
+
+    #[test]
+    fn long_expressions_are_cut() {
+        let mut pool = Pool::new();
+        let x = pool.var(Var::State(0));
+        // sum of sin(k x), k = 1..100: hundreds of characters when printed.
+        let e = (1..=100).fold(x, |acc, k| {
+            let k = pool.num(f64::from(k));
+            let kx = pool.mul(k, x);
+            let s = pool.call1(Func1::Sin, kx);
+            pool.add(acc, s)
+        });
+        let states = ["x".to_string()];
+        let names = Names {
+            states: &states,
+            inputs: &[],
+            noises: &[],
+            tables: &[],
+        };
+        let p = Printer {
+            pool: &pool,
+            names: &names,
+        };
+        let line = p.equation("x'".to_string(), e);
+        assert!(
+            line.starts_with("x' = ") && line.ends_with(" ..."),
+            "{line}"
+        );
+        assert!(line.chars().count() <= MAX_LINE, "{line}");
+        assert_eq!(p.equation("x'".to_string(), x), "x' = x");
+    }
+
+    #[test]
+    fn long_lines_are_cut_at_a_space() {
+        let short = "x' = y".to_string();
+        assert_eq!(cut(short.clone()), short);
+        let words = "x' = ".to_string() + &"alpha + ".repeat(30);
+        let line = cut(words.clone());
+        assert!(line.chars().count() <= MAX_LINE, "{line}");
+        let kept = line.strip_suffix(" ...").unwrap();
+        assert!(kept.len() > MAX_LINE / 2, "{line}");
+        assert!(words.strip_prefix(kept).unwrap().starts_with(' '), "{line}");
+        // No space to cut at (and characters of several bytes): cut anywhere.
+        let line = cut("é".repeat(200));
+        assert_eq!(line, "é".repeat(MAX_LINE - 4) + " ...");
+    }
+
+    #[test]
+    fn blocks_are_bounded() {
+        assert_eq!(block(0, |_| unreachable!()), "Every entry is 0.");
+        assert_eq!(block(2, |k| format!("e{k}")), "```text\ne0\ne1\n```");
+        let text = block(1000, |k| format!("e{k}"));
+        assert_eq!(text.lines().count(), MAX_EQUATIONS + 3, "{text}");
+        assert!(text.contains("\ne19\n... and 980 more\n"), "{text}");
+    }
+}

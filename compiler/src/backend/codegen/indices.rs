@@ -1,0 +1,81 @@
+//! The index constants of a generated model, by spec name: `pub mod state { pub const THETA:
+//! usize = 0; ... }`, and `input` and `noise` likewise, so that code using the model can write
+//! `x[state::THETA]`. One module per kind, so that names of different kinds cannot clash; the
+//! names are [`mangle::const_names`], distinct within a kind.
+
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+
+use super::{doc_attrs, int};
+use crate::backend::mangle;
+use crate::ir::Names;
+
+/// One kind of variable: its module, the constant for a name that has no letters or digits,
+/// how one is called in a doc, and the module's doc.
+struct IndexKind {
+    module: &'static str,
+    fallback: &'static str,
+    label: &'static str,
+    doc: &'static str,
+}
+
+const STATE: IndexKind = IndexKind {
+    module: "state",
+    fallback: "STATE",
+    label: "State",
+    doc: "The index of each state in `x` by spec name: its equation in `f`, its row of the \
+          Jacobians and of `G`, its column of `D_x f`.",
+};
+
+const INPUT: IndexKind = IndexKind {
+    module: "input",
+    fallback: "INPUT",
+    label: "Input",
+    doc: "The index of each input in `u` by spec name: its column of `D_u f`.",
+};
+
+const NOISE: IndexKind = IndexKind {
+    module: "noise",
+    fallback: "NOISE",
+    label: "Noise channel",
+    doc: "The index of each noise channel by spec name: its column of `G`.",
+};
+
+/// The modules `state`, `input` and `noise` of the model with these names (a kind without
+/// names has none).
+pub(super) fn index_modules(names: &Names<'_>) -> TokenStream {
+    [
+        (&STATE, names.states),
+        (&INPUT, names.inputs),
+        (&NOISE, names.noises),
+    ]
+    .into_iter()
+    .filter(|(_, names)| !names.is_empty())
+    .map(|(kind, names)| index_module(kind, names))
+    .collect()
+}
+
+/// `pub mod MODULE { pub const NAME: usize = i; ... }`, each constant documented with the
+/// spec name.
+fn index_module(kind: &IndexKind, names: &[String]) -> TokenStream {
+    let consts = mangle::const_names(names, kind.fallback)
+        .into_iter()
+        .zip(names)
+        .enumerate()
+        .map(|(i, (ident, name))| {
+            let ident = format_ident!("{ident}");
+            let doc = doc_attrs(&format!("{} `{}`.", kind.label, name.replace('`', "'")));
+            let i = int(i);
+            quote! {
+                #doc
+                pub const #ident: usize = #i;
+            }
+        });
+    let (module, doc) = (format_ident!("{}", kind.module), doc_attrs(kind.doc));
+    quote! {
+        #doc
+        pub mod #module {
+            #(#consts)*
+        }
+    }
+}
