@@ -1,5 +1,5 @@
 //! The default metric optimiser against the SDP optimum (cargo feature `sdp`, needs the system
-//! OpenBLAS): `cargo test -p reachc --features sdp --test sdp`.
+//! OpenBLAS): `cargo test -p reachc-compiler --features sdp --test sdp`.
 #![cfg(feature = "sdp")]
 
 use std::path::PathBuf;

@@ -139,9 +139,9 @@ pub enum UnsafeShape {
 /// How the deterministic reachable set is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
-    /// Proposition 3: a P-ball around the nominal trajectory.
+    /// Proposition 2: a P-ball around the nominal trajectory.
     Contraction,
-    /// Proposition 4: an embedding system on boxes.
+    /// Proposition 3: an embedding system on boxes.
     Interval,
 }
 

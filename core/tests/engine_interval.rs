@@ -1,4 +1,4 @@
-//! The interval-based delta-PRS engine (Proposition 4 + Theorem 2) on hand-written systems: a
+//! The interval-based delta-PRS engine (Proposition 3 + Theorem 2) on hand-written systems: a
 //! linear system with an input (closed-form reachable set), soundness of the boxes on the
 //! paper's pendulum against sampled trajectories, safety margins, renderings.
 

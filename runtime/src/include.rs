@@ -1,6 +1,6 @@
-//! Including code that `reachc::Config` generated in a build script.
+//! Including code that `reachc_compiler::Config` generated in a build script.
 
-/// Includes the Rust code generated for a spec by `reachc::Config::compile` in `build.rs`:
+/// Includes the Rust code generated for a spec by `reachc_compiler::Config::compile` in `build.rs`:
 /// `$OUT_DIR/<name>.rs`, where `name` is the model's crate name with `-` written `_`.
 ///
 /// The file holds items only (the model's `System` type and `info()`), so it can be included in

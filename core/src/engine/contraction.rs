@@ -1,4 +1,4 @@
-//! The contraction-based deterministic part (Proposition 3): `Rbar_t = B_P(x*_t, R_t)`, a
+//! The contraction-based deterministic part (Proposition 2): `Rbar_t = B_P(x*_t, R_t)`, a
 //! P-ball around the nominal trajectory `x*_t`, with `R_t = e^(ct) r1 + rho/c (e^(ct) - 1) r2`
 //! (or the per-step recursion of an empirical rate).
 

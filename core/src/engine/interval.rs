@@ -1,4 +1,4 @@
-//! The interval-based delta-PRS (Proposition 4 with Theorem 2; method.md, section 6).
+//! The interval-based delta-PRS (Proposition 3 with Theorem 2; method.md, section 6).
 //!
 //! The deterministic reachable set `Rbar_t` is a box `[x_lo, x_hi]`, the state of the
 //! *embedding system*: with an inclusion function `F = [F_lo, F_hi]` of the drift

@@ -2,8 +2,8 @@
 //!
 //! A delta-PRS at time t is the Minkowski sum of a deterministic reachable set `Rbar_t` and the
 //! stochastic ball `B_P(r_t)`, `r_t = sqrt(Psi_t kappa(n, delta))` (Theorem 2). Two engines
-//! compute `Rbar_t`: the contraction engine (Proposition 3, `contraction.rs`), a P-ball
-//! `B_P(x*_t, R_t)` around the nominal trajectory, and the interval engine (Proposition 4,
+//! compute `Rbar_t`: the contraction engine (Proposition 2, `contraction.rs`), a P-ball
+//! `B_P(x*_t, R_t)` around the nominal trajectory, and the interval engine (Proposition 3,
 //! `interval.rs`), a box of an embedding system (or a parallelotope in coordinates `y = T x`).
 //! Everything after `Rbar_t` is shared (`assemble.rs`): the stochastic radius, the safety
 //! margins (`safety.rs`), the verdicts and the typed result [`Prs`].

@@ -1,5 +1,5 @@
 //! The rigorous scalar parts of the contraction PRS: the initial radius `r1`, the
-//! deterministic radius `R_t` (Proposition 3) and `Psi_t` (eq. Psi), all in [`Interval`]
+//! deterministic radius `R_t` (Proposition 2) and `Psi_t` (eq. Psi), all in [`Interval`]
 //! arithmetic with the upper ends kept.
 
 use super::linalg;
@@ -99,7 +99,7 @@ impl PsiStep {
     }
 }
 
-/// Upper bound of the deterministic radius of Proposition 3,
+/// Upper bound of the deterministic radius of Proposition 2,
 /// `R_t = e^(ct) r1 + rho/c (e^(ct) - 1) r2` (`r1 + rho t r2` at `c = 0`).
 pub(crate) fn det_radius(c: f64, rho: f64, r1: f64, r2: f64, t: f64) -> f64 {
     let t = Interval::point(t);

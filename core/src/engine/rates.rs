@@ -2,7 +2,7 @@
 //! analyses, and the deterministic radius `R_t` they give.
 //!
 //! `c_k` is the rate on the report step `(t_(k-1), t_k]`; `R_t` and `Psi_t` then follow the
-//! per-step recursions (Proposition 3 and eq. Psi with piecewise-constant rates).
+//! per-step recursions (Proposition 2 and eq. Psi with piecewise-constant rates).
 
 use super::radius::expm1_over;
 use super::{Run, RunError};
@@ -19,7 +19,7 @@ pub(crate) const EMPIRICAL_SEED: u64 = 0x6361_6c69_6272_6174;
 /// Lipschitz quotient
 /// `(X - x*)' P (f(X, u_c, t) - f(x*, u_c, t)) / |X - x*|_P^2` over the sampled states `X` at
 /// `t_(k-1)` and `t_k`, with `x*` the nominal and `u_c` the input box's centre: the quantity the
-/// proof of Theorem 2 bounds by `c` along the pair `(X_t, x*_t)`. An estimate, not a bound.
+/// proof of Theorem 1 bounds by `c` along the pair `(X_t, x*_t)`. An estimate, not a bound.
 pub(crate) fn empirical(
     run: &Run,
     metric: &[f64],
@@ -94,7 +94,7 @@ pub(crate) fn empirical(
 }
 
 /// `R_t` at every report time for per-step rates: `R_0 = r1`, then
-/// `R_k = R_(k-1) e^(c_k h_k) + rho r2 expm1(c_k h_k) / c_k` (Proposition 3 on each step, the
+/// `R_k = R_(k-1) e^(c_k h_k) + rho r2 expm1(c_k h_k) / c_k` (Proposition 2 on each step, the
 /// deterministic system being contracting at rate `c_k` there), upper ends kept.
 pub(crate) fn det_radii(rates: &[f64], grid: &[f64], rho: f64, r1: f64, r2: f64) -> Vec<f64> {
     let mut out = Vec::with_capacity(grid.len());

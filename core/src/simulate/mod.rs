@@ -2,7 +2,7 @@
 //! against the sets an analysis computed.
 //!
 //! For every report time `t_k` of an [`Prs`] the simulation counts the paths whose
-//! state `X_{t_k}` lies outside the PRS (decided by [`engine::contains`](crate::engine::contains))
+//! state `X_{t_k}` lies outside the PRS (decided by [`Prs::contains_at`](crate::prs::Prs::contains_at))
 //! and computes the empirical `(1 - delta)` quantile of `|X_{t_k} - x*_{t_k}|_P` (the P-norm of
 //! the analysis' metric around the result's centre `steps[k].nominal()`), to be read against the
 //! PRS radius and `r_t`. The coverage check fails when some time's violation probability is,
