@@ -2,6 +2,7 @@
 //! summary.
 
 use super::result::unsafe_kind;
+use super::summary_indices;
 use reachc_core::simulate::{InitialSampling, InputMode, NoiseKind, SimReport};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -225,11 +226,7 @@ pub fn summary(r: &SimReport) -> String {
         "  {:>9}  {:>11}  {:>11}  {:>11}  {:>7}  {:>8}  {:>10}  {:>10}",
         "t", "r_t", "PRS radius", "quantile", "q/PRS", "outside", "fraction", "CP upper"
     );
-    // About ten evenly spaced report times, the first and the last included.
-    let last = r.steps.len().saturating_sub(1);
-    let mut rows: Vec<usize> = (0..=10).map(|i| i * last / 10).collect();
-    rows.dedup();
-    for &k in rows.iter().filter(|&&k| k < r.steps.len()) {
+    for k in summary_indices(r.steps.len()) {
         let st = &r.steps[k];
         let _ = writeln!(
             s,
