@@ -62,7 +62,7 @@ fn check_args(n: usize, delta: f64) {
 
 /// `ln(1/delta)`, rounded up (an upper bound on the exact value; a larger `L` only enlarges
 /// `kappa`). `ln` is assumed accurate to 2 ulp (glibc, musl and Rust's `libm` are within 1).
-fn log_inv_delta_upper(delta: f64) -> f64 {
+pub(crate) fn log_inv_delta_upper(delta: f64) -> f64 {
     let l = -delta.ln();
     l + l.abs() * (8.0 * U) + f64::MIN_POSITIVE
 }
@@ -273,6 +273,16 @@ pub fn log_phi_lower(n: usize, z: f64) -> f64 {
 ///
 /// If `n == 0` or `delta` is not in `(0, 1)`.
 pub fn kappa_amgf(n: usize, delta: f64) -> f64 {
+    amgf_minimiser(n, delta).0
+}
+
+/// [`kappa_amgf`] and the `z = lambda sqrt(s)` attaining it: `(kappa, z)`. The time-uniform
+/// tube (`engine/uniform.rs`) tunes each epoch's `lambda` with it.
+///
+/// # Panics
+///
+/// If `n == 0` or `delta` is not in `(0, 1)`.
+pub fn amgf_minimiser(n: usize, delta: f64) -> (f64, f64) {
     check_args(n, delta);
     let l = log_inv_delta_upper(delta);
     let h = |z: f64| -> f64 {
@@ -294,8 +304,9 @@ pub fn kappa_amgf(n: usize, delta: f64) -> f64 {
         let z_next = z * STEP;
         let h_next = h(z_next);
         if h_cur.is_finite() && h_next >= h_cur {
-            let (_, v) = golden_min(h, z_prev, z_next, 1e-10, 300);
-            return v.min(h_cur) * (1.0 + KAPPA_MARGIN);
+            let (zm, v) = golden_min(h, z_prev, z_next, 1e-10, 300);
+            let (z, v) = if v <= h_cur { (zm, v) } else { (z, h_cur) };
+            return (v * (1.0 + KAPPA_MARGIN), z);
         }
         assert!(
             z_next < 1e59,

@@ -201,12 +201,17 @@ impl Inclusion {
     }
 }
 
-/// Time integrator.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How the deterministic part is integrated in time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Integrator {
-    /// Classical Runge-Kutta of order 4.
+    /// Validated steps chosen by the engine (the default): each internal step yields a
+    /// rigorous enclosure over the whole step, so the sets hold in continuous time.
+    #[default]
+    Validated,
+    /// Classical Runge-Kutta of order 4, one step per report step, taken as exact (not
+    /// validated; labelled so).
     Rk4,
-    /// Forward Euler.
+    /// Forward Euler, one step per report step, taken as exact (not validated; labelled so).
     Euler,
 }
 
@@ -214,8 +219,30 @@ impl Integrator {
     /// Its name in specs and reports.
     pub fn name(self) -> &'static str {
         match self {
+            Integrator::Validated => "validated",
             Integrator::Rk4 => "rk4",
             Integrator::Euler => "euler",
+        }
+    }
+}
+
+/// What the probability level of a PRS is about.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Guarantee {
+    /// One event of probability at least `1 - delta` on which the state stays in the tube for
+    /// all `t` in `[0, horizon]` at once (the default).
+    #[default]
+    Uniform,
+    /// For each time `t` separately, `P(X_t in PRS_t) >= 1 - delta` (the paper's semantics).
+    Pointwise,
+}
+
+impl Guarantee {
+    /// Its name in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Guarantee::Uniform => "uniform",
+            Guarantee::Pointwise => "pointwise",
         }
     }
 }
@@ -292,6 +319,8 @@ pub struct AnalysisSpec {
     pub inclusion: Inclusion,
     /// Integrator.
     pub integrator: Integrator,
+    /// What the probability level is about: all times at once, or each time separately.
+    pub guarantee: Guarantee,
     /// The coordinate transform `y = T x` of the interval method, if given. An engine that
     /// cannot honour it must refuse the analysis rather than ignore it.
     pub transform: Option<Transform>,
@@ -302,7 +331,8 @@ pub struct AnalysisSpec {
 impl Default for AnalysisSpec {
     /// The language's defaults (docs/language.md) with a horizon of 1: contraction method,
     /// `delta = 1e-3`, `step = horizon / 100`, identity metric, amgf rule, certified rate,
-    /// Jacobian inclusion, RK4, no transform, every state reported.
+    /// Jacobian inclusion, validated integration, a uniform guarantee, no transform, every
+    /// state reported.
     fn default() -> Self {
         AnalysisSpec {
             name: String::new(),
@@ -314,7 +344,8 @@ impl Default for AnalysisSpec {
             radius: RadiusRule::Amgf,
             rate: Rate::Certified,
             inclusion: Inclusion::Jacobian,
-            integrator: Integrator::Rk4,
+            integrator: Integrator::Validated,
+            guarantee: Guarantee::Uniform,
             transform: None,
             outputs: Vec::new(),
         }

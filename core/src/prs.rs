@@ -7,7 +7,8 @@
 use crate::engine::{interval, linalg};
 use crate::interval::Interval;
 use crate::model::{
-    Bounds, Inclusion, InitialSet, Integrator, Method, Provenance, RadiusRule, Rate, UnsafeShape,
+    Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, Provenance, RadiusRule, Rate,
+    UnsafeShape,
 };
 use crate::reach::InputPlan;
 
@@ -33,6 +34,11 @@ pub struct Prs {
     pub step: f64,
     /// Integrator of the nominal trajectory or of the embedding system.
     pub integrator: Integrator,
+    /// What the probability level is about: all times at once, or each time separately.
+    pub guarantee: Guarantee,
+    /// The number of internal steps of the deterministic part (the engine chooses them; the
+    /// report times are among their ends).
+    pub internal_steps: usize,
     /// All state names (the order of every vector of states).
     pub states: Vec<String>,
     /// Indices of the states reports show (all when empty).
@@ -148,8 +154,12 @@ pub struct Step {
     pub t: f64,
     /// The deterministic reachable set `Rbar_t`.
     pub det: DetSet,
-    /// Stochastic radius `r_t` (in `|.|_P`).
+    /// Stochastic radius `r_t` (in `|.|_P`) of the analysis' guarantee: the time-uniform
+    /// tube's radius at `t` (uniform), or the radius for time `t` alone (pointwise).
     pub r_t: f64,
+    /// The pointwise radius at `t` (what `r_t` would be for this time alone: the price of
+    /// uniformity is `r_t / r_pointwise`).
+    pub r_pointwise: f64,
     /// `Psi_t` (upper bound).
     pub psi: f64,
     /// Contraction rate on the step ending here.
@@ -159,9 +169,23 @@ pub struct Step {
     /// Radius of a P-ball around [`DetSet::center`] containing the PRS: the PRS itself for
     /// [`DetSet::Ball`] (`R_t + r_t`), coarser than the PRS for boxes.
     pub prs_radius: f64,
-    /// Safety margin per unsafe set (the order of [`Prs::unsafe_sets`]; `> 0` means shown
-    /// safe).
+    /// The PRS over the whole report interval ending at `t` (after the previous report time;
+    /// at `t = 0`, the PRS at 0): the sets of every time in between lie in it.
+    pub span: Span,
+    /// Safety margin per unsafe set over [`Step::span`] (the order of [`Prs::unsafe_sets`];
+    /// `> 0` means shown safe at every time of the interval).
     pub margins: Vec<f64>,
+}
+
+/// The set `{x : lo <= x <= hi} (+) B_P(radius)` holding the PRS of every time of an interval.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Span {
+    /// Lower corner of the box.
+    pub lo: Vec<f64>,
+    /// Upper corner of the box.
+    pub hi: Vec<f64>,
+    /// The radius of the P-ball added to it.
+    pub radius: f64,
 }
 
 /// A deterministic reachable set.
@@ -354,6 +378,23 @@ pub enum Proved {
         /// The bound of `T^-1`'s entries around the floating-point inverse.
         inverse_error: f64,
     },
+    /// The nominal trajectory enclosed on validated steps: a defect bound of a piecewise
+    /// cubic, propagated with the contraction rate into `R_t` (contraction method).
+    ValidatedNominal {
+        /// The number of internal steps.
+        steps: usize,
+    },
+    /// The embedding system enclosed on validated steps (the comparison principle on each
+    /// step's hull; interval method).
+    ValidatedEmbedding {
+        /// The number of internal steps.
+        steps: usize,
+    },
+    /// The time-uniform tube: Ville's inequality on `epochs` epochs at `delta / epochs` each.
+    UniformTube {
+        /// The number of epochs.
+        epochs: usize,
+    },
 }
 
 /// A part of a result that is not proved.
@@ -412,6 +453,25 @@ impl Prs {
         &self.verdict
     }
 
+    /// Whether `x` lies in [`Step::span`] of report step `k`, the PRS of every time of the
+    /// report interval ending there: `true` only if certainly (see [`Prs::contains`]).
+    pub fn span_contains(&self, k: usize, x: &[f64]) -> bool {
+        let span = &self.steps[k].span;
+        assert_eq!(
+            x.len(),
+            self.n(),
+            "span_contains: x has the wrong dimension"
+        );
+        interval::box_contains(
+            &self.constants.metric,
+            self.n(),
+            x,
+            &span.lo,
+            &span.hi,
+            span.radius,
+        )
+    }
+
     /// Whether `x` lies in the PRS at report time `t`: `Some(true)` only if certainly
     /// (decided in interval arithmetic; a point within rounding of the boundary counts as
     /// outside), `None` if `t` is not a report time. Panics if `x` has the wrong length.
@@ -452,11 +512,17 @@ impl Prs {
         }
     }
 
-    /// A rigorous bounding box of the PRS at report time `t` (`None` between report times):
-    /// the deterministic set's hull inflated by `r_t sqrt((P^-1)_ii)` (for a ball, the ball
-    /// `B_P(x*, R_t + r_t)`'s own hull), rounded outward.
+    /// A rigorous bounding box of the PRS at report time `t` (`None` between report times;
+    /// see [`Prs::hull_at`]).
     pub fn hull(&self, t: f64) -> Option<Vec<Bounds>> {
-        let k = self.step_index(t)?;
+        self.step_index(t).and_then(|k| self.hull_at(k))
+    }
+
+    /// A rigorous bounding box of the PRS at report step `k`: the deterministic set's hull
+    /// inflated by `r_t sqrt((P^-1)_ii)` (for a ball, the ball `B_P(x*, R_t + r_t)`'s own
+    /// hull), rounded outward; `None` if the metric is not certifiably positive definite.
+    /// Panics if `k` is out of range.
+    pub fn hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
         let st = &self.steps[k];
         let n = self.n();
         let w = linalg::inverse_diagonal_sqrt(&self.constants.metric, n)?;

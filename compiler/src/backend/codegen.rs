@@ -40,8 +40,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
 use reachc_core::model::{
-    Analysis, Ball, Bounds, Constants, Inclusion, InitialSet, InputGain, Integrator, MatrixBound,
-    Method, MetricChoice, ModelInfo, Provenance, RadiusRule, Rate, UnsafeSet, UnsafeShape,
+    Analysis, Ball, Bounds, Constants, Guarantee, Inclusion, InitialSet, InputGain, Integrator,
+    MatrixBound, Method, MetricChoice, ModelInfo, Provenance, RadiusRule, Rate, UnsafeSet,
+    UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -1544,8 +1545,13 @@ impl InfoWriter {
             Rate::Empirical { paths } => quote!(Rate::Empirical { paths: #paths }),
         };
         let integrator = match a_spec.integrator {
+            Integrator::Validated => quote!(Integrator::Validated),
             Integrator::Rk4 => quote!(Integrator::Rk4),
             Integrator::Euler => quote!(Integrator::Euler),
+        };
+        let guarantee = match a_spec.guarantee {
+            Guarantee::Uniform => quote!(Guarantee::Uniform),
+            Guarantee::Pointwise => quote!(Guarantee::Pointwise),
         };
         let inclusion = match a_spec.inclusion {
             Inclusion::Natural => quote!(Inclusion::Natural),
@@ -1584,6 +1590,7 @@ impl InfoWriter {
                     rate: #rate,
                     inclusion: #inclusion,
                     integrator: #integrator,
+                    guarantee: #guarantee,
                     transform: #transform,
                     outputs: #outputs,
                 },

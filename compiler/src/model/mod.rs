@@ -11,7 +11,7 @@ use crate::ir::{ExprId, Pool, Table};
 // The sets and analyses are the core's data model: the checker lowers straight into it and the
 // backends hand it on unchanged.
 pub use reachc_core::model::{
-    AnalysisSpec, Ball, Bounds, Inclusion, InitialSet, Integrator, Method, MetricChoice,
+    AnalysisSpec, Ball, Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricChoice,
     RadiusRule, Rate, Transform, UnsafeSet, UnsafeShape,
 };
 

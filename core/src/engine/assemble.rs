@@ -1,26 +1,40 @@
-//! From the deterministic sets an engine computed to the result, the same for every engine:
-//! the stochastic radius `r_t` per report time, the PRS radius, the safety margins, the
-//! verdicts.
+//! From the deterministic sets an engine computed on its internal steps to the result, the same
+//! for every engine: the stochastic radius (pointwise, and the time-uniform tube), the PRS at
+//! each report time and over each report interval, the safety margins over those intervals,
+//! the verdicts.
 
 use super::radius::Stochastic;
 use super::safety::{Check, Context};
 use super::transform::Frame;
+use super::uniform::{Scale, Tube};
 use super::Run;
 use crate::interval::Interval;
-use crate::model::{Inclusion, Method};
+use crate::model::{Guarantee, Inclusion, Method};
 use crate::prs::{
-    ConstantsUsed, DetSet, Proved, Prs, R1Bound, RateUsed, RuleUsed, Step, TransformUsed, Unproved,
-    UnsafeVerdict, Validation, Verdict,
+    ConstantsUsed, DetSet, Proved, Prs, R1Bound, RateUsed, RuleUsed, Span, Step, TransformUsed,
+    Unproved, UnsafeVerdict, Validation, Verdict,
 };
 
-/// The deterministic part of a run, per report time.
+/// One internal step `[t0, t1]` of the deterministic part.
+pub(super) struct Piece {
+    /// Its end.
+    pub(super) t1: f64,
+    /// `(c, sigma)` on the step.
+    pub(super) rates: (f64, f64),
+    /// `Rbar_(t1)`.
+    pub(super) end: DetSet,
+    /// A set holding `Rbar_s` for every `s` in `[t0, t1]` (radius: a P-ball added to the box).
+    pub(super) over: Span,
+    /// `t1` is a report time.
+    pub(super) report: bool,
+}
+
+/// The deterministic part of a run.
 pub(super) struct Deterministic {
-    /// Report times.
-    pub(super) grid: Vec<f64>,
-    /// `Rbar_t` at each report time.
-    pub(super) sets: Vec<DetSet>,
-    /// `(c, sigma)` on the step ending at each report time.
-    pub(super) rates: Vec<(f64, f64)>,
+    /// `Rbar_0`.
+    pub(super) start: DetSet,
+    /// The internal steps, in order from `t = 0`; their ends include every report time.
+    pub(super) pieces: Vec<Piece>,
     /// The transform of a parallelotope result (for exact half-space support functions).
     pub(super) frame: Option<Frame>,
 }
@@ -43,8 +57,70 @@ pub(super) struct Header {
     pub(super) not_validated: Vec<Unproved>,
 }
 
-/// The result of a run: `r_t` along the grid (exact per-step `Psi`), each step's PRS radius and
-/// margins, and the verdicts.
+/// The stochastic radius at the end of each internal step and its largest value over the
+/// step, for the run's guarantee; and the pointwise `Psi`, `r` at each end.
+struct Radii {
+    /// Per step end: `(Psi upper, pointwise r)`.
+    pointwise: Vec<(f64, f64)>,
+    /// Per step: `(radius at its end, largest radius over it)` of the guarantee.
+    guaranteed: Vec<(f64, f64)>,
+    /// The tube's epochs (uniform guarantee).
+    epochs: Option<usize>,
+}
+
+impl Radii {
+    fn new(run: &Run, det: &Deterministic, kappa: f64) -> Radii {
+        let mut stochastic = Stochastic::new(kappa);
+        let mut t0 = 0.0;
+        let pointwise: Vec<(f64, f64)> = det
+            .pieces
+            .iter()
+            .map(|p| {
+                let (c, sigma) = p.rates;
+                let r = stochastic.advance(Some(t0), p.t1, c, sigma);
+                t0 = p.t1;
+                r
+            })
+            .collect();
+        match run.spec.guarantee {
+            // Psi is increasing, so a step's largest radius is its end's.
+            Guarantee::Pointwise => Radii {
+                guaranteed: pointwise.iter().map(|&(_, r)| (r, r)).collect(),
+                pointwise,
+                epochs: None,
+            },
+            Guarantee::Uniform => {
+                let mut t0 = 0.0;
+                let scale = Scale::new(det.pieces.iter().map(|p| {
+                    let h = Interval::point(p.t1) - Interval::point(t0);
+                    t0 = p.t1;
+                    (h, p.rates.0, p.rates.1)
+                }));
+                let first = det.pieces.iter().position(|p| p.report).unwrap_or(0);
+                let s_last = scale.s.last().map_or(0.0, |s| s.hi());
+                let tube = Tube::new(run.setup.n, run.spec.delta, scale.s[first + 1].lo(), s_last);
+                let guaranteed = (0..det.pieces.len())
+                    .map(|k| {
+                        let end = tube.radius(scale.psi[k + 1], scale.s[k + 1]);
+                        let over = tube.radius(
+                            scale.psi[k].hull(scale.psi[k + 1]),
+                            scale.s[k].hull(scale.s[k + 1]),
+                        );
+                        (end, over.max(end))
+                    })
+                    .collect();
+                Radii {
+                    guaranteed,
+                    pointwise,
+                    epochs: Some(tube.epochs()),
+                }
+            }
+        }
+    }
+}
+
+/// The result of a run: the radii along the internal steps, the PRS at each report time and
+/// over each report interval, the margins over the intervals, and the verdicts.
 pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
     let setup = run.setup;
     // Upper bounds of sqrt((P^-1)_ii): B_P(r) lies in the box |d_i| <= r w_i.
@@ -53,30 +129,70 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
         w: &w,
         frame: det.frame.as_ref(),
     };
-    let mut stochastic = Stochastic::new(header.kappa);
-    let mut steps = Vec::with_capacity(det.grid.len());
-    for (k, (set, &(c, sigma))) in det.sets.into_iter().zip(&det.rates).enumerate() {
-        let t = det.grid[k];
-        let prev = k.checked_sub(1).map(|j| det.grid[j]);
-        let (psi, r_t) = stochastic.advance(prev, t, c, sigma);
-        let prs_radius = (Interval::point(set.radius()) + Interval::point(r_t)).hi();
-        let margins = setup
+    let radii = Radii::new(run, &det, header.kappa);
+    let margins = |span: &Span| -> Vec<f64> {
+        setup
             .checks
             .iter()
-            .map(|check| check.margin(&set, r_t, &context))
-            .collect();
+            .map(|check| check.margin_of_span(span, &context))
+            .collect()
+    };
+    let mut steps = Vec::new();
+    // t = 0: the initial set, no stochastic part yet.
+    let start_span = span_of(&det.start, 0.0);
+    steps.push(Step {
+        t: 0.0,
+        prs_radius: det.start.radius(),
+        margins: setup
+            .checks
+            .iter()
+            .map(|check| check.margin(&det.start, 0.0, &context))
+            .collect(),
+        det: det.start,
+        r_t: 0.0,
+        r_pointwise: 0.0,
+        psi: 0.0,
+        c: det.pieces.first().map_or(0.0, |p| p.rates.0),
+        sigma: det.pieces.first().map_or(0.0, |p| p.rates.1),
+        span: start_span,
+    });
+    // The report interval being gathered: the hull of the steps' sets and the largest radius.
+    let mut gathered: Option<Span> = None;
+    let internal_steps = det.pieces.len();
+    for (k, piece) in det.pieces.into_iter().enumerate() {
+        let (r_end, r_over) = radii.guaranteed[k];
+        let over = Span {
+            radius: (Interval::point(piece.over.radius) + Interval::point(r_over)).hi(),
+            ..piece.over
+        };
+        gathered = Some(match gathered {
+            None => over,
+            Some(g) => g.hull(&over),
+        });
+        if !piece.report {
+            continue;
+        }
+        let span = gathered.take().expect("a report interval has a step");
+        let (psi, r_pointwise) = radii.pointwise[k];
+        let (c, sigma) = piece.rates;
         steps.push(Step {
-            t,
-            det: set,
-            r_t,
+            t: piece.t1,
+            prs_radius: (Interval::point(piece.end.radius()) + Interval::point(r_end)).hi(),
+            margins: margins(&span),
+            det: piece.end,
+            r_t: r_end,
+            r_pointwise,
             psi,
             c,
             sigma,
-            prs_radius,
-            margins,
+            span,
         });
     }
     let (unsafe_sets, verdict) = verdicts(run, &setup.checks, &steps);
+    let mut rigorous = header.rigorous;
+    if let Some(epochs) = radii.epochs {
+        rigorous.push(Proved::UniformTube { epochs });
+    }
     let mut not_validated = header.not_validated;
     if run.info.has_domain {
         not_validated.push(Unproved::Domain);
@@ -90,6 +206,8 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
         horizon: run.spec.horizon,
         step: run.spec.step,
         integrator: run.spec.integrator,
+        guarantee: run.spec.guarantee,
+        internal_steps,
         states: run.info.states.clone(),
         outputs: run.spec.outputs.clone(),
         rate: header.rate,
@@ -111,10 +229,48 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
         unsafe_sets,
         verdict,
         validation: Validation {
-            rigorous: header.rigorous,
+            rigorous,
             not_validated,
             conditional_on_domain: run.info.has_domain,
         },
+    }
+}
+
+/// The span of a deterministic set widened by a P-ball of radius `r`: its box hull (the
+/// centre for a ball, whose radius joins `r`).
+pub(super) fn span_of(set: &DetSet, r: f64) -> Span {
+    match set.box_hull() {
+        Some((lo, hi)) => Span {
+            lo: lo.to_vec(),
+            hi: hi.to_vec(),
+            radius: r,
+        },
+        None => Span {
+            lo: set.center().to_vec(),
+            hi: set.center().to_vec(),
+            radius: (Interval::point(set.radius()) + Interval::point(r)).hi(),
+        },
+    }
+}
+
+impl Span {
+    /// The smallest span holding both (hull of the boxes, the larger radius).
+    pub(crate) fn hull(&self, other: &Span) -> Span {
+        Span {
+            lo: self
+                .lo
+                .iter()
+                .zip(&other.lo)
+                .map(|(a, b)| a.min(*b))
+                .collect(),
+            hi: self
+                .hi
+                .iter()
+                .zip(&other.hi)
+                .map(|(a, b)| a.max(*b))
+                .collect(),
+            radius: self.radius.max(other.radius),
+        }
     }
 }
 

@@ -1,11 +1,15 @@
-//! The contraction-based deterministic part (Proposition 2): `Rbar_t = B_P(x*_t, R_t)`, a
-//! P-ball around the nominal trajectory `x*_t`, with `R_t = e^(ct) r1 + rho/c (e^(ct) - 1) r2`
-//! (or the per-step recursion of an empirical rate).
+//! The contraction-based deterministic part (Proposition 2): `Rbar_t = B_P(p_t, R_t)`, a P-ball
+//! around a nominal curve `p_t`, with `R' = c R + rho r2 + |d|_P` (`d` the nominal's defect,
+//! zero for an exact solution): on validated steps by default (`defect.rs`), or one
+//! unvalidated RK4 or Euler step per report step when the spec asks for it.
 
-use super::assemble::{assemble, Deterministic, Header};
+use super::assemble::{assemble, Deterministic, Header, Piece};
+use super::defect::{Nominal, NominalStep};
+use super::radius::expm1_over;
 use super::{nominal, radius, rates, Run, RunError};
-use crate::model::{Method, Rate};
-use crate::prs::{ConstantsUsed, DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Unproved};
+use crate::interval::Interval;
+use crate::model::{Integrator, Method, Rate};
+use crate::prs::{ConstantsUsed, DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, Unproved};
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -30,37 +34,67 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     let rho = if run.setup.p == 0 { 0.0 } else { consts.rho };
     let (kappa, radius_rule) = radius::stochastic_factor(n, spec);
 
-    // Nominal trajectory (not validated).
-    let traj = nominal::integrate(run.sys, &x0, &inputs, &grid, spec.integrator).map_err(|k| {
-        RunError::NonFinite(format!(
-            "the nominal trajectory is not finite at t = {}",
-            grid[k]
-        ))
-    })?;
+    // The nominal on its internal steps, each with its report interval.
+    let steps = nominal_steps(run, &x0, r1, &grid, &inputs)?;
+    let validated = spec.integrator == Integrator::Validated;
 
-    // Per-step rates (None: the certified constant on every step).
+    // Per report interval rates (None: the certified constant throughout).
     let empirical = match spec.rate {
         Rate::Certified => None,
         Rate::Empirical { paths } => {
+            let mut traj = vec![x0.clone()];
+            traj.extend(
+                steps
+                    .iter()
+                    .filter(|(s, k)| s.t1 == grid[k + 1])
+                    .map(|(s, _)| s.x1.clone()),
+            );
             Some(rates::empirical(run, metric, &grid, &traj, &inputs, paths)?)
         }
     };
-    let det_radii = match &empirical {
-        Some(c) => rates::det_radii(c, &grid, rho, r1, r2),
-        None => grid
-            .iter()
-            .map(|&t| radius::det_radius(consts.c, rho, r1, r2, t))
-            .collect(),
-    };
-    let c_at = |k: usize| empirical.as_ref().map_or(consts.c, |c| c[k]);
+    // The rate on report interval k (ending at grid[k + 1]).
+    let c_on = |k: usize| empirical.as_ref().map_or(consts.c, |c| c[k + 1]);
+
+    // R along the steps: R' = c R + rho r2 + defect.
+    let gain = Interval::point(rho) * Interval::point(r2);
+    let mut r = Interval::point(r1);
+    let mut t0 = 0.0;
+    let mut pieces = Vec::with_capacity(steps.len());
+    for (step, k) in steps {
+        let c = c_on(k);
+        let h = Interval::point(step.t1) - Interval::point(t0);
+        let r_prev = r.hi();
+        r = if c.is_finite() {
+            let forcing = gain + Interval::point(step.defect);
+            Interval::point((r * (Interval::point(c) * h).exp() + forcing * expm1_over(c, h)).hi())
+        } else {
+            Interval::point(f64::INFINITY)
+        };
+        // R is monotone on the step (a linear ODE with constant forcing): its largest value
+        // is at one end.
+        pieces.push(Piece {
+            t1: step.t1,
+            rates: (c, consts.sigma),
+            report: step.t1 == grid[k + 1],
+            over: Span {
+                lo: step.lo,
+                hi: step.hi,
+                radius: r_prev.max(r.hi()),
+            },
+            end: DetSet::Ball {
+                center: step.x1,
+                radius: r.hi(),
+            },
+        });
+        t0 = step.t1;
+    }
+    let internal = pieces.len();
     let det = Deterministic {
-        rates: (0..grid.len()).map(|k| (c_at(k), consts.sigma)).collect(),
-        sets: traj
-            .into_iter()
-            .zip(det_radii)
-            .map(|(center, radius)| DetSet::Ball { center, radius })
-            .collect(),
-        grid,
+        start: DetSet::Ball {
+            center: x0.clone(),
+            radius: r1,
+        },
+        pieces,
         frame: None,
     };
 
@@ -68,13 +102,31 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         r.iter().copied().fold(f64::NEG_INFINITY, f64::max)
     });
     let certified = spec.rate == Rate::Certified;
-    let mut not_validated = vec![Unproved::Nominal {
-        integrator: spec.integrator,
-        step: spec.step,
+    let mut rigorous = vec![Proved::Constants {
+        c: certified,
+        rho: true,
+        provenance: consts.provenance.clone(),
     }];
+    let mut not_validated = Vec::new();
+    if validated {
+        rigorous.push(Proved::ValidatedNominal { steps: internal });
+    } else {
+        not_validated.push(Unproved::Nominal {
+            integrator: spec.integrator,
+            step: spec.step,
+        });
+    }
     if let Rate::Empirical { paths } = spec.rate {
         not_validated.insert(0, Unproved::EmpiricalRate { paths });
     }
+    rigorous.extend([
+        Proved::Kappa,
+        Proved::Psi,
+        Proved::Radii,
+        Proved::Margins {
+            given: Method::Contraction,
+        },
+    ]);
     let header = Header {
         method: Method::Contraction,
         inclusion: None,
@@ -97,20 +149,57 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         transform: None,
         initial_center: x0,
         input_center: inputs.first().cloned().unwrap_or_default(),
-        rigorous: vec![
-            Proved::Constants {
-                c: certified,
-                rho: true,
-                provenance: consts.provenance.clone(),
-            },
-            Proved::Kappa,
-            Proved::Psi,
-            Proved::Radii,
-            Proved::Margins {
-                given: Method::Contraction,
-            },
-        ],
+        rigorous,
         not_validated,
     };
     Ok(assemble(run, det, header))
+}
+
+/// The nominal's steps with their report interval: validated internal steps, or one step of
+/// the unvalidated integrator per report step (defect taken as 0, labelled so).
+fn nominal_steps(
+    run: &Run,
+    x0: &[f64],
+    r1: f64,
+    grid: &[f64],
+    inputs: &[Vec<f64>],
+) -> Result<Vec<(NominalStep, usize)>, RunError> {
+    let spec = run.spec;
+    if spec.integrator == Integrator::Validated {
+        let consts = run.setup.consts;
+        // The defect may add about 0.1% of the PRS's natural size over the horizon.
+        let scale = r1
+            .max(consts.sigma * spec.horizon.sqrt())
+            .max(1e-9 * x0.iter().fold(1.0f64, |m, v| m.max(v.abs())));
+        let tolerance = 1e-3 * scale / spec.horizon.max(f64::MIN_POSITIVE);
+        let domain = run.info.has_domain.then_some(&run.info.domain[..]);
+        return Nominal::new(run.sys, &consts.metric, tolerance, domain).steps(x0, grid, inputs);
+    }
+    let traj = nominal::integrate(run.sys, x0, inputs, grid, spec.integrator).map_err(|k| {
+        RunError::NonFinite(format!(
+            "the nominal trajectory is not finite at t = {} ({} integration, step {}; the \
+             default validated integrator reports where and why a step fails)",
+            grid[k],
+            spec.integrator.name(),
+            spec.step
+        ))
+    })?;
+    Ok(traj
+        .windows(2)
+        .enumerate()
+        .map(|(k, w)| {
+            let lo = w[0].iter().zip(&w[1]).map(|(a, b)| a.min(*b)).collect();
+            let hi = w[0].iter().zip(&w[1]).map(|(a, b)| a.max(*b)).collect();
+            (
+                NominalStep {
+                    t1: grid[k + 1],
+                    x1: w[1].clone(),
+                    defect: 0.0,
+                    lo,
+                    hi,
+                },
+                k,
+            )
+        })
+        .collect())
 }

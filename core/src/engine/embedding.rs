@@ -10,6 +10,8 @@
 //! evaluations of the drift and of the non-zero Jacobian entries: time proportional to the
 //! size of the expressions, not to `n^2`.
 
+use super::defect::MAX_STEPS;
+use super::RunError;
 use crate::interval::Interval;
 use crate::model::{Inclusion, Integrator};
 use crate::system::System;
@@ -38,7 +40,11 @@ struct Field<'a> {
 
 /// Buffers reused across evaluations (no allocation per step).
 struct Scratch {
+    /// The box the faces are taken of.
     bx: Vec<Interval>,
+    /// Per state, where it is pinned on its lower and upper face.
+    pin_lo: Vec<Interval>,
+    pin_hi: Vec<Interval>,
     face: Vec<Interval>,
     centre: Vec<Interval>,
     partial: Vec<Interval>,
@@ -62,6 +68,8 @@ impl<'a> Embedding<'a> {
         Embedding {
             scratch: Scratch {
                 bx: zeros(n),
+                pin_lo: zeros(n),
+                pin_hi: zeros(n),
                 face: zeros(n),
                 centre: zeros(n),
                 partial: zeros(n),
@@ -87,35 +95,47 @@ impl<'a> Embedding<'a> {
     /// Intermediate integrator stages may (numerically) invert a coordinate; the box used is
     /// then the hull of the two ends.
     fn rhs(&mut self, z: &[f64], t: f64, d: &mut [f64]) {
-        let (f, s) = (&self.field, &mut self.scratch);
-        let n = f.sys.n();
+        let s = &mut self.scratch;
+        let n = self.field.sys.n();
         let (lo, hi) = z.split_at(n);
-        for (b, (&a, &c)) in s.bx.iter_mut().zip(lo.iter().zip(hi)) {
-            *b = Interval::try_new(a.min(c), a.max(c)).unwrap_or(Interval::ENTIRE);
+        for i in 0..n {
+            s.bx[i] =
+                Interval::try_new(lo[i].min(hi[i]), lo[i].max(hi[i])).unwrap_or(Interval::ENTIRE);
+            s.pin_lo[i] = Interval::point(lo[i]);
+            s.pin_hi[i] = Interval::point(hi[i]);
         }
-        let t = Interval::point(t);
+        let (dlo, dhi) = d.split_at_mut(n);
+        self.faces(Interval::point(t), dlo, dhi);
+    }
+
+    /// Bounds of the embedding field on faces: for each state `i`, `dlo[i]` is a lower bound
+    /// of `f_i` over the box `scratch.bx` with `x_i` in `scratch.pin_lo[i]`, and `dhi[i]` an
+    /// upper bound with `x_i` in `scratch.pin_hi[i]`, for inputs in the current box and times in
+    /// `t`. A colour's states are pinned in one evaluation (none reads another).
+    fn faces(&mut self, t: Interval, dlo: &mut [f64], dhi: &mut [f64]) {
+        let (f, s) = (&self.field, &mut self.scratch);
         for colour in &f.colours {
-            for (side, offset) in [(lo, 0), (hi, n)] {
+            for low in [true, false] {
                 s.face.copy_from_slice(&s.bx);
                 for &i in colour {
-                    s.face[i] = Interval::point(side[i]);
+                    s.face[i] = if low { s.pin_lo[i] } else { s.pin_hi[i] };
                 }
                 f.eval(s, t);
                 for &i in colour {
-                    d[offset + i] = if offset == 0 {
-                        s.out[i].lo()
+                    if low {
+                        dlo[i] = s.out[i].lo();
                     } else {
-                        s.out[i].hi()
-                    };
+                        dhi[i] = s.out[i].hi();
+                    }
                 }
             }
         }
     }
 
-    /// Integrates the embedding system over the grid, with the inputs in `inputs[k]` on the
-    /// step `[t_k, t_(k+1)]`; per grid time the box `(lo, hi)`. `Err(k)` if the box is not
-    /// finite at grid index `k`.
-    #[allow(clippy::type_complexity)]
+    /// Integrates the embedding system over the grid with one step of the (unvalidated)
+    /// integrator per report step, with the inputs in `inputs[k]` on `[t_k, t_(k+1)]`; the box
+    /// at each report time after 0 (the hull of both ends stands for the step's sets, not
+    /// validated). `Err(k)` if the box is not finite at grid index `k`.
     pub(crate) fn integrate(
         &mut self,
         lo: &[f64],
@@ -123,12 +143,12 @@ impl<'a> Embedding<'a> {
         grid: &[f64],
         inputs: &[Vec<Interval>],
         integrator: Integrator,
-    ) -> Result<Vec<(Vec<f64>, Vec<f64>)>, usize> {
+    ) -> Result<Vec<BoxStep>, usize> {
         let n = lo.len();
         let m = 2 * n;
         let mut z: Vec<f64> = lo.iter().chain(hi).copied().collect();
         let mut out = Vec::with_capacity(grid.len());
-        out.push((lo.to_vec(), hi.to_vec()));
+        let (mut prev_lo, mut prev_hi) = (lo.to_vec(), hi.to_vec());
         let mut k1 = vec![0.0; m];
         let mut k2 = vec![0.0; m];
         let mut k3 = vec![0.0; m];
@@ -146,7 +166,7 @@ impl<'a> Embedding<'a> {
                         z[i] += h * k1[i];
                     }
                 }
-                Integrator::Rk4 => {
+                Integrator::Rk4 | Integrator::Validated => {
                     self.rhs(&z, t, &mut k1);
                     for i in 0..m {
                         tmp[i] = z[i] + 0.5 * h * k1[i];
@@ -171,10 +191,185 @@ impl<'a> Embedding<'a> {
             let (l, u) = z.split_at(n);
             let (l, u): (Vec<f64>, Vec<f64>) =
                 l.iter().zip(u).map(|(&a, &b)| (a.min(b), a.max(b))).unzip();
-            out.push((l, u));
+            out.push(BoxStep {
+                t1: win[1],
+                interval: idx,
+                over_lo: l.iter().zip(&prev_lo).map(|(a, b)| a.min(*b)).collect(),
+                over_hi: u.iter().zip(&prev_hi).map(|(a, b)| a.max(*b)).collect(),
+                lo: l.clone(),
+                hi: u.clone(),
+            });
+            (prev_lo, prev_hi) = (l, u);
         }
         Ok(out)
     }
+
+    /// The embedding system on validated steps (method.md section 8.4) from the box
+    /// `[lo, hi]` at `t = 0` over the report grid, inputs in `inputs[k]` on report interval
+    /// `k`: each step's end box and the hull of its boxes hold every trajectory from the box
+    /// at the end and over the whole step. The last step of each report interval ends exactly
+    /// on the report time.
+    pub(crate) fn validated(
+        &mut self,
+        lo: &[f64],
+        hi: &[f64],
+        grid: &[f64],
+        inputs: &[Vec<Interval>],
+    ) -> Result<Vec<BoxStep>, RunError> {
+        let mut out = Vec::new();
+        let (mut lo, mut hi) = (lo.to_vec(), hi.to_vec());
+        let mut t = 0.0;
+        let mut h = grid.get(1).copied().unwrap_or(0.0);
+        for (k, w) in grid.windows(2).enumerate() {
+            if self.field.ubox != inputs[k] {
+                self.field.set_inputs(&inputs[k]);
+            }
+            let end = w[1];
+            while t < end {
+                if out.len() >= MAX_STEPS {
+                    return Err(RunError::NonFinite(format!(
+                        "the embedding system needs more than {MAX_STEPS} validated steps before \
+                         t = {t} (a coordinate transform or a shorter horizon may help)"
+                    )));
+                }
+                let (step, used) = self.validated_step(&lo, &hi, t, h.min(w[1] - w[0]), end, k)?;
+                h = (2.0 * used).min(w[1] - w[0]);
+                (lo, hi) = (step.lo.clone(), step.hi.clone());
+                t = step.t1;
+                out.push(step);
+            }
+        }
+        Ok(out)
+    }
+
+    /// One validated step from the box `[lo, hi]` at `t`, of length at most `h` (halved until
+    /// it validates); returns it with the length used.
+    fn validated_step(
+        &mut self,
+        lo: &[f64],
+        hi: &[f64],
+        t: f64,
+        mut h: f64,
+        end: f64,
+        interval: usize,
+    ) -> Result<(BoxStep, f64), RunError> {
+        let min_h = 1e-12 * end.abs().max(1.0);
+        loop {
+            let t1 = if t + h >= end * (1.0 - 1e-15) || end - (t + h) < min_h {
+                end
+            } else {
+                t + h
+            };
+            if let Some((nlo, nhi)) = self.try_validated(lo, hi, t, t1) {
+                let over_lo = lo.iter().zip(&nlo).map(|(a, b)| a.min(*b)).collect();
+                let over_hi = hi.iter().zip(&nhi).map(|(a, b)| a.max(*b)).collect();
+                let step = BoxStep {
+                    t1,
+                    interval,
+                    lo: nlo,
+                    hi: nhi,
+                    over_lo,
+                    over_hi,
+                };
+                return Ok((step, t1 - t));
+            }
+            h = 0.5 * (t1 - t);
+            if h < min_h {
+                return Err(RunError::NonFinite(format!(
+                    "the embedding system cannot be validated at t = {t}: the step shrank below \
+                     {min_h:e} (the box grows without bound: try the other inclusion, a \
+                     coordinate transform or a domain)"
+                )));
+            }
+        }
+    }
+
+    /// The comparison principle on `[t, t1]`: with `lo(s)`, `hi(s)` linear from `[lo, hi]` and
+    /// every face bound taken over a box `B` holding both ends and with the pinned coordinate
+    /// over the interval its end sweeps, `lo_i' <= inf f_i` on the lower faces (and `hi`
+    /// likewise) for all `s` at once, so no trajectory leaves `[lo(s), hi(s)]`. Guess, check,
+    /// widen; `None` when the guesses do not close (a shorter step may).
+    fn try_validated(
+        &mut self,
+        lo: &[f64],
+        hi: &[f64],
+        t: f64,
+        t1: f64,
+    ) -> Option<(Vec<f64>, Vec<f64>)> {
+        let n = lo.len();
+        let h = Interval::point(t1) - Interval::point(t);
+        let times = Interval::point(t).hull(Interval::point(t1));
+        let (mut dlo, mut dhi) = (vec![0.0; n], vec![0.0; n]);
+        // First guess: the slopes on the box itself.
+        for i in 0..n {
+            self.scratch.bx[i] = Interval::try_new(lo[i], hi[i])?;
+            self.scratch.pin_lo[i] = Interval::point(lo[i]);
+            self.scratch.pin_hi[i] = Interval::point(hi[i]);
+        }
+        self.faces(times, &mut dlo, &mut dhi);
+        let (mut nlo, mut nhi) = (vec![0.0; n], vec![0.0; n]);
+        for _ in 0..6 {
+            // Widen the pins to the swept intervals of the current guess (with some slack), the
+            // box to hold them.
+            for i in 0..n {
+                let end_lo = (Interval::point(lo[i]) + h * Interval::point(dlo[i])).lo();
+                let end_hi = (Interval::point(hi[i]) + h * Interval::point(dhi[i])).hi();
+                if !(end_lo.is_finite() && end_hi.is_finite()) {
+                    return None;
+                }
+                let slack = |a: f64, b: f64| 0.25 * (a - b).abs() + 1e-15 * (1.0 + a.abs());
+                let pin_lo = Interval::try_new(
+                    lo[i].min(end_lo) - slack(lo[i], end_lo),
+                    lo[i].max(end_lo) + slack(lo[i], end_lo),
+                )?;
+                let pin_hi = Interval::try_new(
+                    hi[i].min(end_hi) - slack(hi[i], end_hi),
+                    hi[i].max(end_hi) + slack(hi[i], end_hi),
+                )?;
+                let s = &mut self.scratch;
+                s.pin_lo[i] = s.pin_lo[i].hull(pin_lo);
+                s.pin_hi[i] = s.pin_hi[i].hull(pin_hi);
+                s.bx[i] = s.bx[i].hull(s.pin_lo[i]).hull(s.pin_hi[i]);
+            }
+            self.faces(times, &mut dlo, &mut dhi);
+            // The new ends, and the check: each end inside its pin, both boxes inside bx.
+            let mut closed = true;
+            for i in 0..n {
+                nlo[i] = (Interval::point(lo[i]) + h * Interval::point(dlo[i])).lo();
+                nhi[i] = (Interval::point(hi[i]) + h * Interval::point(dhi[i])).hi();
+                let s = &self.scratch;
+                closed &= s.pin_lo[i].contains(nlo[i])
+                    && s.pin_hi[i].contains(nhi[i])
+                    && s.bx[i].contains(nlo[i].min(lo[i]))
+                    && s.bx[i].contains(nhi[i].max(hi[i]));
+            }
+            if closed {
+                // A sound embedding keeps lo <= hi; rounding aside, order the ends.
+                let (l, u) = nlo
+                    .iter()
+                    .zip(&nhi)
+                    .map(|(&a, &b)| (a.min(b), a.max(b)))
+                    .unzip();
+                return Some((l, u));
+            }
+        }
+        None
+    }
+}
+
+/// One step of the embedding system (in `y = T x` with a transform).
+#[derive(Clone, Debug)]
+pub(crate) struct BoxStep {
+    /// Its end.
+    pub(crate) t1: f64,
+    /// The report interval it belongs to (`[t_k, t_(k+1)]`).
+    pub(crate) interval: usize,
+    /// The box at `t1`.
+    pub(crate) lo: Vec<f64>,
+    pub(crate) hi: Vec<f64>,
+    /// A box holding the boxes of every time of the step.
+    pub(crate) over_lo: Vec<f64>,
+    pub(crate) over_hi: Vec<f64>,
 }
 
 impl Field<'_> {

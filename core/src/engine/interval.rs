@@ -26,14 +26,14 @@
 //! integrated numerically (RK4 or Euler, no remainder bound), so the box is an enclosure only
 //! up to the time-discretisation error. The result says so.
 
-use super::assemble::{assemble, Deterministic, Header};
-use super::embedding::Embedding;
+use super::assemble::{assemble, Deterministic, Header, Piece};
+use super::embedding::{BoxStep, Embedding};
 use super::transform::{self, Frame};
 use super::{nominal, radius, validate, Run, RunError};
 use crate::interval::Interval;
-use crate::model::{AnalysisSpec, Inclusion, InitialSet, Method, ModelInfo, Rate};
+use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
 use crate::prs::{
-    ConstantsUsed, DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, TransformUsed, Unproved,
+    ConstantsUsed, DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, TransformUsed, Unproved,
 };
 use crate::system::System;
 
@@ -45,7 +45,8 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
     let (inputs, _) = run.nominal_inputs(&grid);
     let Boxes {
         frame,
-        boxes,
+        start,
+        steps,
         x0,
         half0,
     } = boxes(
@@ -60,43 +61,61 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
     let r1 = radius::r1_bound(metric, &half0);
     let (kappa, radius_rule) = radius::stochastic_factor(n, spec);
     let box_radius = radius::BoxRadius::new(metric, n);
-    let sets = boxes
+    // The set in x of a box of the embedding: the box itself, or the parallelotope T^-1 box
+    // with its hull.
+    let x_box = |lo: &[f64], hi: &[f64]| match &frame {
+        Some(f) => f.x_hull(lo, hi),
+        None => (lo.to_vec(), hi.to_vec()),
+    };
+    let det_set = |(blo, bhi): (Vec<f64>, Vec<f64>)| {
+        let (xlo, xhi) = x_box(&blo, &bhi);
+        let ivs: Vec<Interval> = xlo
+            .iter()
+            .zip(&xhi)
+            .map(|(&a, &b)| Interval::new(a, b))
+            .collect();
+        let center: Vec<f64> = ivs.iter().map(|iv| iv.mid()).collect();
+        let half: Vec<f64> = ivs.iter().map(|iv| iv.rad()).collect();
+        // The box lies in B_P(center, radius): an enclosing P-ball, so the step's PRS radius is
+        // that of a P-ball containing the PRS (coarser than the PRS itself).
+        let radius = box_radius.bound(&half);
+        match frame {
+            Some(_) => DetSet::Parallelotope {
+                lo: blo,
+                hi: bhi,
+                hull_lo: xlo,
+                hull_hi: xhi,
+                center,
+                radius,
+            },
+            None => DetSet::Box {
+                lo: xlo,
+                hi: xhi,
+                center,
+                radius,
+            },
+        }
+    };
+    let internal = steps.len();
+    let pieces = steps
         .into_iter()
-        .map(|(blo, bhi)| {
-            // The set in x: the box itself, or the parallelotope T^-1 box with its hull.
-            let (xlo, xhi) = match &frame {
-                Some(f) => f.x_hull(&blo, &bhi),
-                None => (blo.clone(), bhi.clone()),
-            };
-            let ivs: Vec<Interval> = xlo
-                .iter()
-                .zip(&xhi)
-                .map(|(&a, &b)| Interval::new(a, b))
-                .collect();
-            let center: Vec<f64> = ivs.iter().map(|iv| iv.mid()).collect();
-            let half: Vec<f64> = ivs.iter().map(|iv| iv.rad()).collect();
-            // The box lies in B_P(center, radius): an enclosing P-ball, so the step's PRS
-            // radius is that of a P-ball containing the PRS (coarser than the PRS itself).
-            let radius = box_radius.bound(&half);
-            match frame {
-                Some(_) => DetSet::Parallelotope {
-                    lo: blo,
-                    hi: bhi,
-                    hull_lo: xlo,
-                    hull_hi: xhi,
-                    center,
-                    radius,
+        .map(|step| {
+            let (lo, hi) = x_box(&step.over_lo, &step.over_hi);
+            Piece {
+                t1: step.t1,
+                rates: (consts.c, consts.sigma),
+                report: step.t1 == grid[step.interval + 1],
+                over: Span {
+                    lo,
+                    hi,
+                    radius: 0.0,
                 },
-                None => DetSet::Box {
-                    lo: xlo,
-                    hi: xhi,
-                    center,
-                    radius,
-                },
+                end: det_set((step.lo, step.hi)),
             }
         })
         .collect();
     let transform = frame.as_ref().map(Frame::used);
+    let validated = spec.integrator == Integrator::Validated;
     let mut rigorous = vec![
         Proved::Constants {
             c: true,
@@ -104,17 +123,24 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
             provenance: consts.provenance.clone(),
         },
         Proved::Inclusion(inclusion),
+    ];
+    let mut not_validated = Vec::new();
+    if validated {
+        rigorous.push(Proved::ValidatedEmbedding { steps: internal });
+    } else {
+        not_validated.push(Unproved::Embedding {
+            integrator: spec.integrator,
+            step: spec.step,
+        });
+    }
+    rigorous.extend([
         Proved::Kappa,
         Proved::Psi,
         Proved::StochasticRadius,
         Proved::Margins {
             given: Method::Interval,
         },
-    ];
-    let mut not_validated = vec![Unproved::Embedding {
-        integrator: spec.integrator,
-        step: spec.step,
-    }];
+    ]);
     if let Some(tr) = &transform {
         rigorous.push(Proved::TransformMaps {
             inverse_error: tr.inverse_error,
@@ -122,9 +148,8 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         not_validated.push(Unproved::TransformedDrift);
     }
     let det = Deterministic {
-        rates: vec![(consts.c, consts.sigma); grid.len()],
-        grid,
-        sets,
+        start: det_set(start),
+        pieces,
         frame,
     };
     let header = Header {
@@ -177,21 +202,23 @@ fn run_inputs(run: &Run, nominal: &[Vec<f64>]) -> Vec<Vec<Interval>> {
     }
 }
 
-/// The boxes of the embedding system at the report times (in `y = T x` with a transform).
+/// The embedding system's boxes on its steps (in `y = T x` with a transform).
 struct Boxes {
     /// The transform, if any.
     frame: Option<Frame>,
-    /// Per report time, the box `(lo, hi)`.
-    boxes: Vec<(Vec<f64>, Vec<f64>)>,
+    /// The initial box `(lo, hi)`.
+    start: (Vec<f64>, Vec<f64>),
+    /// The steps.
+    steps: Vec<BoxStep>,
     /// Centre and half-widths of the initial box in `x`.
     x0: Vec<f64>,
     half0: Vec<f64>,
 }
 
 /// The boxes of the embedding system with the given inclusion function, inputs in `inputs[k]`
-/// on report step `k`: from the initial box (balls replaced by their bounding boxes), or with a
-/// transform from the interval hull of `T X0`, integrated over the report grid (not validated
-/// in time).
+/// on report interval `k`: from the initial box (balls replaced by their bounding boxes), or
+/// with a transform from the interval hull of `T X0`; on validated steps, or one step of the
+/// (unvalidated) integrator per report step when the spec asks for it.
 fn boxes(
     sys: &dyn System,
     info: &ModelInfo,
@@ -241,19 +268,28 @@ fn boxes(
     if let Some(f) = &frame {
         (lo, hi) = f.to_y(&lo, &hi);
     }
-    let boxes = Embedding::new(emb_sys, inclusion)
-        .integrate(&lo, &hi, grid, inputs, spec.integrator)
-        .map_err(|k| {
-            RunError::NonFinite(format!(
-                "the embedding system's box is not finite at t = {} (the {} inclusion diverged; \
-                 try the other inclusion, a smaller step or a coordinate transform)",
-                grid[k],
-                inclusion.name()
-            ))
-        })?;
+    let mut embedding = Embedding::new(emb_sys, inclusion);
+    let steps = if spec.integrator == Integrator::Validated {
+        embedding.validated(&lo, &hi, grid, inputs)?
+    } else {
+        embedding
+            .integrate(&lo, &hi, grid, inputs, spec.integrator)
+            .map_err(|k| {
+                RunError::NonFinite(format!(
+                    "the embedding system's box is not finite at t = {} (the {} inclusion \
+                     diverged with {} integration, step {}; try the validated integrator, the \
+                     other inclusion or a coordinate transform)",
+                    grid[k],
+                    inclusion.name(),
+                    spec.integrator.name(),
+                    spec.step
+                ))
+            })?
+    };
     Ok(Boxes {
         frame,
-        boxes,
+        start: (lo, hi),
+        steps,
         x0,
         half0,
     })
@@ -262,7 +298,8 @@ fn boxes(
 /// The deterministic reachable boxes of an interval analysis without the stochastic part (no
 /// constants needed): per report time `(t, lo, hi)`, in the coordinates `y = T x` when the
 /// analysis has a transform. The boxes enclose every deterministic trajectory from the model's
-/// initial set with inputs in the input box, up to the (not validated) time discretisation.
+/// initial set with inputs in the input box (on validated steps; with `integrator = rk4` or
+/// `euler`, up to the time discretisation).
 #[allow(clippy::type_complexity)]
 pub fn interval_boxes(
     sys: &dyn System,
@@ -285,11 +322,14 @@ pub fn interval_boxes(
         &inputs,
         spec.inclusion,
     )?;
-    Ok(grid
-        .into_iter()
-        .zip(d.boxes)
-        .map(|(t, (lo, hi))| (t, lo, hi))
-        .collect())
+    let mut out = vec![(0.0, d.start.0, d.start.1)];
+    out.extend(
+        d.steps
+            .into_iter()
+            .filter(|s| s.t1 == grid[s.interval + 1])
+            .map(|s| (s.t1, s.lo, s.hi)),
+    );
+    Ok(out)
 }
 
 /// Whether `x` lies in `[lo, hi] (+) B_P(r)` (`p` the `n x n` metric, row-major): `true` only

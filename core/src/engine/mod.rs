@@ -19,6 +19,7 @@
 
 mod assemble;
 mod contraction;
+mod defect;
 mod embedding;
 pub(crate) mod interval;
 pub(crate) mod linalg;
@@ -27,6 +28,7 @@ mod radius;
 mod rates;
 mod safety;
 pub(crate) mod transform;
+mod uniform;
 
 pub use interval::interval_boxes;
 pub use radius::MAX_VERTEX_COORDS;

@@ -1,5 +1,6 @@
-//! The nominal trajectory `x*_t` of the deterministic system `x' = f(x, u_c, t)` (centre input),
-//! integrated numerically. Not validated: the report says so.
+//! The report grid, and the nominal trajectory `x*_t` of `x' = f(x, u_c, t)` (centre input)
+//! integrated with one step of an unvalidated integrator per report step (`integrator = rk4` or
+//! `euler`, labelled not validated; the default is `defect.rs`).
 
 use crate::model::Integrator;
 use crate::system::System;
@@ -17,9 +18,32 @@ pub(crate) fn time_grid(horizon: f64, step: f64) -> Vec<f64> {
     ts
 }
 
-/// Integrates `x' = f(x, u_k, t)` over the grid with the integrator, `u_k = inputs[k]` on the
-/// step `[t_k, t_(k+1)]`; `Err(k)` with the index of the first grid time where a state is not
-/// finite.
+/// One classical Runge-Kutta step of length `h` from `x` at `t` with the input `u` held.
+pub(crate) fn rk4(sys: &dyn System, x: &[f64], u: &[f64], t: f64, h: f64) -> Vec<f64> {
+    let n = x.len();
+    let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut tmp = vec![0.0; n];
+    sys.drift(x, u, t, &mut k1);
+    for i in 0..n {
+        tmp[i] = x[i] + 0.5 * h * k1[i];
+    }
+    sys.drift(&tmp, u, t + 0.5 * h, &mut k2);
+    for i in 0..n {
+        tmp[i] = x[i] + 0.5 * h * k2[i];
+    }
+    sys.drift(&tmp, u, t + 0.5 * h, &mut k3);
+    for i in 0..n {
+        tmp[i] = x[i] + h * k3[i];
+    }
+    sys.drift(&tmp, u, t + h, &mut k4);
+    (0..n)
+        .map(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+        .collect()
+}
+
+/// Integrates `x' = f(x, u_k, t)` over the grid with one step of the (unvalidated) integrator
+/// per report step, `u_k = inputs[k]` on `[t_k, t_(k+1)]`; `Err(k)` with the index of the first
+/// grid time where a state is not finite.
 pub(crate) fn integrate(
     sys: &dyn System,
     x0: &[f64],
@@ -31,40 +55,17 @@ pub(crate) fn integrate(
     let mut out = Vec::with_capacity(grid.len());
     out.push(x0.to_vec());
     let mut x = x0.to_vec();
-    let mut k1 = vec![0.0; n];
-    let mut k2 = vec![0.0; n];
-    let mut k3 = vec![0.0; n];
-    let mut k4 = vec![0.0; n];
-    let mut tmp = vec![0.0; n];
+    let mut f = vec![0.0; n];
     for (idx, w) in grid.windows(2).enumerate() {
         let (t, h) = (w[0], w[1] - w[0]);
         let u = &inputs[idx];
-        match integrator {
+        x = match integrator {
             Integrator::Euler => {
-                sys.drift(&x, u, t, &mut k1);
-                for i in 0..n {
-                    x[i] += h * k1[i];
-                }
+                sys.drift(&x, u, t, &mut f);
+                x.iter().zip(&f).map(|(xi, fi)| xi + h * fi).collect()
             }
-            Integrator::Rk4 => {
-                sys.drift(&x, u, t, &mut k1);
-                for i in 0..n {
-                    tmp[i] = x[i] + 0.5 * h * k1[i];
-                }
-                sys.drift(&tmp, u, t + 0.5 * h, &mut k2);
-                for i in 0..n {
-                    tmp[i] = x[i] + 0.5 * h * k2[i];
-                }
-                sys.drift(&tmp, u, t + 0.5 * h, &mut k3);
-                for i in 0..n {
-                    tmp[i] = x[i] + h * k3[i];
-                }
-                sys.drift(&tmp, u, t + h, &mut k4);
-                for i in 0..n {
-                    x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                }
-            }
-        }
+            _ => rk4(sys, &x, u, t, h),
+        };
         if x.iter().any(|v| !v.is_finite()) {
             return Err(idx + 1);
         }

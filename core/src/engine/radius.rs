@@ -99,19 +99,6 @@ impl PsiStep {
     }
 }
 
-/// Upper bound of the deterministic radius of Proposition 2,
-/// `R_t = e^(ct) r1 + rho/c (e^(ct) - 1) r2` (`r1 + rho t r2` at `c = 0`).
-pub(crate) fn det_radius(c: f64, rho: f64, r1: f64, r2: f64, t: f64) -> f64 {
-    let t = Interval::point(t);
-    let growth = (Interval::point(c) * t).exp() * Interval::point(r1);
-    let input = if rho == 0.0 || r2 == 0.0 {
-        Interval::ZERO
-    } else {
-        Interval::point(rho) * expm1_over(c, t) * Interval::point(r2)
-    };
-    (growth + input).hi()
-}
-
 /// The centre of the initial set (box midpoints, ball centres) and, per state, a half-width
 /// `h_i` with `|x_i - centre_i| <= h_i` for every `x` in the set (rounded up).
 ///

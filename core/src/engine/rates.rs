@@ -1,12 +1,9 @@
 //! Per-step contraction rates `c_k` of [`Rate::Empirical`](crate::model::Rate::Empirical)
-//! analyses, and the deterministic radius `R_t` they give.
-//!
-//! `c_k` is the rate on the report step `(t_(k-1), t_k]`; `R_t` and `Psi_t` then follow the
-//! per-step recursions (Proposition 2 and eq. Psi with piecewise-constant rates).
+//! analyses: `c_k` is the rate on the report step `(t_(k-1), t_k]`, and `R_t` and `Psi_t`
+//! follow their per-step recursions with it (Proposition 2 and eq. Psi with piecewise-constant
+//! rates).
 
-use super::radius::expm1_over;
 use super::{Run, RunError};
-use crate::interval::Interval;
 use crate::model::ModelInfo;
 use crate::simulate::{self, InputMode};
 
@@ -91,53 +88,4 @@ pub(crate) fn empirical(
         )));
     }
     Ok(rates)
-}
-
-/// `R_t` at every report time for per-step rates: `R_0 = r1`, then
-/// `R_k = R_(k-1) e^(c_k h_k) + rho r2 expm1(c_k h_k) / c_k` (Proposition 2 on each step, the
-/// deterministic system being contracting at rate `c_k` there), upper ends kept.
-pub(crate) fn det_radii(rates: &[f64], grid: &[f64], rho: f64, r1: f64, r2: f64) -> Vec<f64> {
-    let mut out = Vec::with_capacity(grid.len());
-    let mut r = Interval::point(r1);
-    out.push(r1);
-    let gain = Interval::point(rho) * Interval::point(r2);
-    for k in 1..grid.len() {
-        let h = Interval::point(grid[k]) - Interval::point(grid[k - 1]);
-        let c = rates[k];
-        r = if c.is_finite() {
-            let growth = (Interval::point(c) * h).exp();
-            let input = if rho == 0.0 || r2 == 0.0 {
-                Interval::ZERO
-            } else {
-                gain * expm1_over(c, h)
-            };
-            Interval::point((r * growth + input).hi())
-        } else {
-            Interval::point(f64::INFINITY)
-        };
-        out.push(r.hi());
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn det_radii_match_the_closed_form_for_a_constant_rate() {
-        let grid: Vec<f64> = (0..=100).map(|k| k as f64 * 0.01).collect();
-        let (c, rho, r1, r2) = (-0.8, 0.3, 0.05, 1.0);
-        let radii = det_radii(&vec![c; grid.len()], &grid, rho, r1, r2);
-        for (k, &t) in grid.iter().enumerate() {
-            let exact = (c * t).exp() * r1 + rho / c * ((c * t).exp() - 1.0) * r2;
-            assert!(
-                radii[k] >= exact && radii[k] <= exact * (1.0 + 1e-12),
-                "{k}"
-            );
-        }
-        let inf = det_radii(&[0.0, f64::INFINITY, -1.0], &[0.0, 0.1, 0.2], rho, r1, r2);
-        assert_eq!(inf[1], f64::INFINITY);
-        assert_eq!(inf[2], f64::INFINITY);
-    }
 }

@@ -11,7 +11,7 @@ use super::linalg;
 use super::transform::Frame;
 use crate::interval::Interval;
 use crate::model::{UnsafeSet, UnsafeShape};
-use crate::prs::{DetSet, UnsafeKind};
+use crate::prs::{DetSet, Span, UnsafeKind};
 
 /// What the margins of box-shaped sets need besides the set.
 pub(crate) struct Context<'a> {
@@ -86,6 +86,12 @@ impl Check {
                 box_margin(self, hull_lo, hull_hi, r_t, context.w, support)
             }
         }
+    }
+
+    /// A lower bound of the safety margin of the span `{lo <= x <= hi} (+) B_P(radius)` (see
+    /// [`Check::margin`]).
+    pub(crate) fn margin_of_span(&self, span: &Span, context: &Context) -> f64 {
+        box_margin(self, &span.lo, &span.hi, span.radius, context.w, None)
     }
 
     /// Precomputes the checks of every unsafe set (see [`Check::new`]).

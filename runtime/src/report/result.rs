@@ -1,7 +1,7 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
 use super::{csv_field, num, summary_indices};
-use reachc_core::model::{Method, Rate};
+use reachc_core::model::{Guarantee, Method, Rate};
 use reachc_core::prs::{
     DetSet, Proved, Prs, R1Method, Step, Unproved, UnsafeKind, UnsafeVerdict, Verdict,
 };
@@ -27,6 +27,8 @@ struct Json<'a> {
     horizon: f64,
     step: f64,
     integrator: &'static str,
+    guarantee: &'static str,
+    internal_steps: usize,
     states: &'a [String],
     outputs: &'a [usize],
     rate: RateJson,
@@ -83,11 +85,22 @@ struct StepJson<'a> {
     nominal: &'a [f64],
     det_set: DetSetJson<'a>,
     r_t: f64,
+    r_pointwise: f64,
     psi: f64,
     c: f64,
     sigma: f64,
     prs_radius: f64,
+    prs_hull_lo: Vec<f64>,
+    prs_hull_hi: Vec<f64>,
+    span: SpanJson<'a>,
     margins: &'a [f64],
+}
+
+#[derive(Serialize)]
+struct SpanJson<'a> {
+    lo: &'a [f64],
+    hi: &'a [f64],
+    radius: f64,
 }
 
 #[derive(Serialize)]
@@ -145,6 +158,8 @@ impl<'a> Json<'a> {
             horizon: prs.horizon,
             step: prs.step,
             integrator: prs.integrator.name(),
+            guarantee: prs.guarantee.name(),
+            internal_steps: prs.internal_steps,
             states: &prs.states,
             outputs: &prs.outputs,
             rate: RateJson {
@@ -178,7 +193,7 @@ impl<'a> Json<'a> {
             }),
             initial_center: &prs.initial_center,
             input_center: &prs.input_center,
-            steps: prs.steps.iter().map(StepJson::of).collect(),
+            steps: (0..prs.steps.len()).map(|k| StepJson::of(prs, k)).collect(),
             unsafe_sets: prs.unsafe_sets.iter().map(UnsafeJson::of).collect(),
             verdict: match prs.verdict {
                 Verdict::Safe => VerdictJson::Safe,
@@ -199,7 +214,14 @@ impl<'a> Json<'a> {
 }
 
 impl<'a> StepJson<'a> {
-    fn of(st: &'a Step) -> StepJson<'a> {
+    fn of(prs: &'a Prs, k: usize) -> StepJson<'a> {
+        let st = &prs.steps[k];
+        let (prs_lo, prs_hi) = prs
+            .hull_at(k)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|b| (b.lo, b.hi))
+            .unzip();
         let (shape, lo, hi, hull_lo, hull_hi) = match &st.det {
             DetSet::Ball { .. } => ("p_ball", None, None, None, None),
             DetSet::Box { lo, hi, .. } => ("box", Some(&lo[..]), Some(&hi[..]), None, None),
@@ -231,10 +253,18 @@ impl<'a> StepJson<'a> {
                 hull_hi,
             },
             r_t: st.r_t,
+            r_pointwise: st.r_pointwise,
             psi: st.psi,
             c: st.c,
             sigma: st.sigma,
             prs_radius: st.prs_radius,
+            prs_hull_lo: prs_lo,
+            prs_hull_hi: prs_hi,
+            span: SpanJson {
+                lo: &st.span.lo,
+                hi: &st.span.hi,
+                radius: st.span.radius,
+            },
             margins: &st.margins,
         }
     }
@@ -350,6 +380,21 @@ fn proved(p: &Proved) -> String {
         Proved::TransformMaps { inverse_error } => format!(
             "the initial box in y = T x (interval hull of T X0) and the map back to x (T^-1 \
              enclosed entry-wise within {inverse_error:.1e} of the floating-point inverse)"
+        ),
+        Proved::ValidatedNominal { steps } => format!(
+            "nominal trajectory on {steps} validated steps (a cubic through RK4 nodes, its \
+             defect bounded in interval arithmetic on each step and added to R_t through the \
+             contraction rate): the sets hold over whole steps, not only at report times"
+        ),
+        Proved::ValidatedEmbedding { steps } => format!(
+            "embedding system on {steps} validated steps (the comparison principle on each \
+             step's hull, time as an interval): the boxes hold over whole steps, not only at \
+             report times"
+        ),
+        Proved::UniformTube { epochs } => format!(
+            "time-uniform tube: Ville's inequality on the averaged-MGF supermartingale over \
+             {epochs} epochs at delta / {epochs} each: one event, of probability at least \
+             1 - delta, for all t in [0, horizon]"
         ),
     }
 }
@@ -480,12 +525,14 @@ pub fn summary(prs: &Prs) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "analysis `{}` of model `{}` ({} method, delta = {})",
+        "analysis `{}` of model `{}` ({} method, delta = {}, {} guarantee)",
         prs.analysis,
         prs.model,
         prs.method.name(),
-        prs.delta
+        prs.delta,
+        prs.guarantee.name()
     );
+    let _ = writeln!(s, "  {}", guarantee_sentence(prs));
     let k = &prs.constants;
     let c = match prs.rate.rate {
         Rate::Certified => format!("{:.6}", k.c),
@@ -530,18 +577,19 @@ pub fn summary(prs: &Prs) -> String {
         let _ = writeln!(s, "  r1 = {:.6} ({}), r2 = {}", prs.r1, r1_how(prs), prs.r2);
         let _ = writeln!(
             s,
-            "  {:>10}  {:>12}  {:>12}  {:>12}",
-            "t", "R_t", "r_t", "PRS radius"
+            "  {:>10}  {:>12}  {:>12}  {:>12}  {:>12}",
+            "t", "R_t", "r_t", "PRS radius", "pointwise r"
         );
         for i in summary_indices(prs.steps.len()) {
             let st = &prs.steps[i];
             let _ = writeln!(
                 s,
-                "  {:>10.4}  {:>12}  {:>12}  {:>12}",
+                "  {:>10.4}  {:>12}  {:>12}  {:>12}  {:>12}",
                 st.t,
                 num(st.det.radius()),
                 num(st.r_t),
-                num(st.prs_radius)
+                num(st.prs_radius),
+                num(st.r_pointwise)
             );
         }
     }
@@ -574,10 +622,24 @@ pub fn summary(prs: &Prs) -> String {
              guarantee)"
                 .to_string()
         }
-        Verdict::Safe => "safe (every PRS misses every unsafe set)".to_string(),
+        Verdict::Safe => match prs.guarantee {
+            Guarantee::Uniform => format!(
+                "safe: with probability at least {} the state avoids every unsafe set for all t \
+                 in [0, {}] (every PRS over every interval misses every unsafe set)",
+                1.0 - prs.delta,
+                prs.horizon
+            ),
+            Guarantee::Pointwise => format!(
+                "safe at each time separately: for every t in [0, {}], the state is in no \
+                 unsafe set with probability at least {} (every PRS misses every unsafe set)",
+                prs.horizon,
+                1.0 - prs.delta
+            ),
+        },
         Verdict::NoUnsafeSets => "no unsafe sets to check".to_string(),
         Verdict::NotShownSafe { t, set, .. } => format!(
-            "not shown safe: the PRS at t = {t:.4} meets `{}` (this does not prove a violation)",
+            "not shown safe: the PRS over the interval ending at t = {t:.4} meets `{}` (this \
+             does not prove a violation)",
             prs.unsafe_sets[*set].name
         ),
     };
@@ -585,6 +647,23 @@ pub fn summary(prs: &Prs) -> String {
     let not_validated: Vec<String> = prs.validation.not_validated.iter().map(unproved).collect();
     let _ = writeln!(s, "  not validated: {}", not_validated.join("; "));
     s
+}
+
+/// What the probability level is about, in words.
+fn guarantee_sentence(prs: &Prs) -> String {
+    match prs.guarantee {
+        Guarantee::Uniform => format!(
+            "guarantee: one event of probability at least {}: X_t lies in the tube for all t in \
+             [0, {}] at once",
+            1.0 - prs.delta,
+            prs.horizon
+        ),
+        Guarantee::Pointwise => format!(
+            "guarantee: for each t separately, X_t lies in its PRS with probability at least {} \
+             (not uniformly in time)",
+            1.0 - prs.delta
+        ),
+    }
 }
 
 /// The table of the summary for box sets: per column of [`box_columns`] the range `[lo, hi]`,

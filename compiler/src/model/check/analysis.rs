@@ -6,8 +6,8 @@ use super::sets::Fields;
 use super::Checker;
 use crate::diagnostics::{Diagnostic, Span};
 use crate::model::{
-    Analysis, AnalysisSpec, Inclusion, Integrator, Method, MetricChoice as Metric, RadiusRule,
-    Rate, Transform,
+    Analysis, AnalysisSpec, Guarantee, Inclusion, Integrator, Method, MetricChoice as Metric,
+    RadiusRule, Rate, Transform,
 };
 use crate::syntax::ast::{Block, Expr, ExprKind, Ident};
 
@@ -24,6 +24,7 @@ const KEYS: &[&str] = &[
     "rate",
     "inclusion",
     "integrator",
+    "guarantee",
     "transform",
     "outputs",
 ];
@@ -58,8 +59,21 @@ impl Checker<'_> {
         let integrator = self.choice(
             &f,
             "integrator",
-            &[("rk4", Integrator::Rk4), ("euler", Integrator::Euler)],
-            Integrator::Rk4,
+            &[
+                ("validated", Integrator::Validated),
+                ("rk4", Integrator::Rk4),
+                ("euler", Integrator::Euler),
+            ],
+            Integrator::Validated,
+        );
+        let guarantee = self.choice(
+            &f,
+            "guarantee",
+            &[
+                ("uniform", Guarantee::Uniform),
+                ("pointwise", Guarantee::Pointwise),
+            ],
+            Guarantee::Uniform,
         );
         let delta = self.number(&f, "delta", 1e-3, |d| {
             (d > 0.0 && d < 1.0)
@@ -127,10 +141,13 @@ impl Checker<'_> {
             Some(method),
             Some(inclusion),
             Some(integrator),
+            Some(guarantee),
             Some(delta),
             Some(horizon),
             Some(step),
-        ) = (method, inclusion, integrator, delta, horizon, step)
+        ) = (
+            method, inclusion, integrator, guarantee, delta, horizon, step,
+        )
         else {
             return;
         };
@@ -166,6 +183,23 @@ impl Checker<'_> {
                 return;
             }
         }
+        // The time-uniform tube is built on the averaged-MGF bound (method.md section 8.2).
+        if let (Guarantee::Uniform, RadiusRule::Paper(_) | RadiusRule::PaperOptimal, Some((e, _))) =
+            (guarantee, radius, f.get("radius"))
+        {
+            self.fail::<()>(
+                Diagnostic::error(
+                    "the paper's radius rule holds at each time separately",
+                    e.span.clone(),
+                    "a pointwise rule",
+                )
+                .with_help(
+                    "add `guarantee = pointwise` (the paper's semantics), or use `radius = amgf` \
+                     for a tube that holds at all times at once",
+                ),
+            );
+            return;
+        }
         if let (Some(_), Some((e, _))) = (&transform, f.get("transform")) {
             if method != Method::Interval {
                 self.fail::<()>(
@@ -194,6 +228,7 @@ impl Checker<'_> {
                 rate,
                 inclusion,
                 integrator,
+                guarantee,
                 transform,
                 outputs,
             },

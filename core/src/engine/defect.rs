@@ -1,0 +1,258 @@
+//! A validated nominal trajectory for the contraction method (method.md section 8.4): the
+//! engine chooses internal steps, joins RK4 nodes by cubic Hermite pieces `p`, and bounds the
+//! defect `d(s) = p'(s) - f(p(s), u, s)` rigorously over every step. With the contraction rate
+//! `c` (for all states and inputs of the domain), every trajectory `x` from the initial set
+//! satisfies `D+ |x - p|_P <= c |x - p|_P + rho r2 + |d|_P`, so `R_t` of Proposition 2 grows by
+//! the defect's integral: `p` need not be exact, only its defect bounded.
+//!
+//! The defect on a piece `[a, b]` of a step, centre `m`, by the mean value theorem:
+//! `p(s) - p(m) in p'([a, b]) (s - m)` and `p'(s) - p'(m) in p''([a, b]) (s - m)`, and
+//! `f(p(s)) - f(p(m)) in J (p(s) - p(m))` with `J` the interval Jacobian over the hull of
+//! `p([a, b])`, so `d(s) in p'(m) - f(p(m), u, [a, b]) + (p''([a, b]) - J p'([a, b])) [a - m, b - m]`:
+//! a small first term (the Hermite error), and a second that shrinks with the piece.
+
+use super::radius::BoxRadius;
+use super::RunError;
+use crate::interval::Interval;
+use crate::system::System;
+
+/// Pieces per step for the defect bound.
+const PIECES: usize = 8;
+/// The most internal steps of one analysis.
+pub(crate) const MAX_STEPS: usize = 2_000_000;
+
+/// One validated step `[t0, t1]` of the nominal.
+pub(super) struct NominalStep {
+    /// Its end.
+    pub(super) t1: f64,
+    /// The nominal at `t1` (the RK4 node).
+    pub(super) x1: Vec<f64>,
+    /// An upper bound of `|d(s)|_P` over the step.
+    pub(super) defect: f64,
+    /// The interval hull of `p([t0, t1])`.
+    pub(super) lo: Vec<f64>,
+    pub(super) hi: Vec<f64>,
+}
+
+/// The validated nominal over the report grid: internal steps chosen so that the defect stays
+/// below `tolerance` (in the P-norm, per unit time), landing on every report time.
+pub(super) struct Nominal<'a> {
+    sys: &'a dyn System,
+    /// `(row, column)` of the Jacobian entries the drift depends on.
+    pattern: Vec<(usize, usize)>,
+    metric: BoxRadius<'a>,
+    tolerance: f64,
+    /// The box where the constants hold (the nominal must stay in it).
+    domain: Option<&'a [crate::model::Bounds]>,
+}
+
+/// Cubic Hermite basis over `tau` in `[0, 1]` (interval), with its first and second
+/// derivatives (in `tau`).
+fn hermite(tau: Interval) -> ([Interval; 4], [Interval; 4], [Interval; 4]) {
+    let (one, two, three) = (Interval::ONE, Interval::point(2.0), Interval::point(3.0));
+    let t2 = tau.sqr();
+    let t3 = t2 * tau;
+    let basis = [
+        two * t3 - three * t2 + one,
+        t3 - two * t2 + tau,
+        three * t2 - two * t3,
+        t3 - t2,
+    ];
+    let (four, six) = (Interval::point(4.0), Interval::point(6.0));
+    let first = [
+        six * t2 - six * tau,
+        three * t2 - four * tau + one,
+        six * tau - six * t2,
+        three * t2 - two * tau,
+    ];
+    let twelve = Interval::point(12.0);
+    let second = [
+        twelve * tau - six,
+        six * tau - four,
+        six - twelve * tau,
+        six * tau - two,
+    ];
+    (basis, first, second)
+}
+
+impl<'a> Nominal<'a> {
+    /// The nominal of `sys` in the metric `p` (`n x n`), with defects up to `tolerance` per unit
+    /// time, kept inside `domain` when given.
+    pub(super) fn new(
+        sys: &'a dyn System,
+        p: &'a [f64],
+        tolerance: f64,
+        domain: Option<&'a [crate::model::Bounds]>,
+    ) -> Self {
+        Nominal {
+            sys,
+            pattern: sys.jac_x_pattern(),
+            metric: BoxRadius::new(p, sys.n()),
+            tolerance,
+            domain,
+        }
+    }
+
+    /// The validated steps from `x0` at `t = 0` over `grid` (report times), the input
+    /// `inputs[k]` held on `[t_k, t_(k+1)]`. The last step of each report interval ends
+    /// exactly on the report time. Errors name the time and what to change.
+    pub(super) fn steps(
+        &self,
+        x0: &[f64],
+        grid: &[f64],
+        inputs: &[Vec<f64>],
+    ) -> Result<Vec<(NominalStep, usize)>, RunError> {
+        let mut out = Vec::new();
+        let mut x = x0.to_vec();
+        let mut t = 0.0;
+        let mut h = grid.get(1).copied().unwrap_or(0.0);
+        for (k, w) in grid.windows(2).enumerate() {
+            let end = w[1];
+            while t < end {
+                if out.len() >= MAX_STEPS {
+                    return Err(RunError::NonFinite(format!(
+                        "the nominal trajectory needs more than {MAX_STEPS} validated steps \
+                         before t = {t}: the system is too stiff or fast for this horizon \
+                         (shorten the horizon)"
+                    )));
+                }
+                let (step, used) = self.step(&x, &inputs[k], t, h.min(end - t), end)?;
+                // Land exactly on the report time when the step reaches it.
+                h = (2.0 * used).min(w[1] - w[0]);
+                x = step.x1.clone();
+                t = step.t1;
+                out.push((step, k));
+            }
+        }
+        Ok(out)
+    }
+
+    /// One accepted step from `(x, t)`: tries `h`, halving it until the defect is below the
+    /// tolerance; returns the step and the length used.
+    fn step(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        t: f64,
+        mut h: f64,
+        end: f64,
+    ) -> Result<(NominalStep, f64), RunError> {
+        let min_h = 1e-12 * end.abs().max(1.0);
+        loop {
+            // The last step of an interval ends exactly on its report time.
+            let t1 = if t + h >= end * (1.0 - 1e-15) || end - (t + h) < min_h {
+                end
+            } else {
+                t + h
+            };
+            let h_used = t1 - t;
+            if let Some(step) = self.try_step(x, u, t, t1)? {
+                if step.defect <= self.tolerance {
+                    return Ok((step, h_used));
+                }
+            }
+            h = 0.5 * h_used;
+            if h < min_h {
+                return Err(RunError::NonFinite(format!(
+                    "the nominal trajectory cannot be validated at t = {t}: the step shrank \
+                     below {min_h:e} without bounding the defect (the drift is too large or \
+                     not smooth here; a domain or a shorter horizon may help)"
+                )));
+            }
+        }
+    }
+
+    /// An RK4 step `[t, t1]` and its defect bound; `None` if a value is not finite (a smaller
+    /// step may help); an error if the nominal leaves the domain.
+    fn try_step(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        t: f64,
+        t1: f64,
+    ) -> Result<Option<NominalStep>, RunError> {
+        let sys = self.sys;
+        let n = x.len();
+        let h = t1 - t;
+        let mut f0 = vec![0.0; n];
+        sys.drift(x, u, t, &mut f0);
+        let x1 = super::nominal::rk4(sys, x, u, t, h);
+        let mut f1 = vec![0.0; n];
+        sys.drift(&x1, u, t1, &mut f1);
+        if x1.iter().chain(&f0).chain(&f1).any(|v| !v.is_finite()) {
+            return Ok(None);
+        }
+        let pt = |v: &[f64]| -> Vec<Interval> { v.iter().map(|&a| Interval::point(a)).collect() };
+        let (x0i, x1i, f0i, f1i) = (pt(x), pt(&x1), pt(&f0), pt(&f1));
+        let hi_ = Interval::point(t1) - Interval::point(t);
+        let ui = pt(u);
+        // p(tau), p'(s) = dp/dtau / h, p''(s) = d2p/dtau2 / h^2 on tau in an interval.
+        let eval = |tau: Interval| -> (Vec<Interval>, Vec<Interval>, Vec<Interval>) {
+            let (b, d1, d2) = hermite(tau);
+            let comb = |c: &[Interval; 4], scale_x: Interval, scale_f: Interval| -> Vec<Interval> {
+                (0..n)
+                    .map(|i| {
+                        (c[0] * x0i[i] + c[2] * x1i[i]) * scale_x
+                            + (c[1] * f0i[i] + c[3] * f1i[i]) * scale_f
+                    })
+                    .collect()
+            };
+            (
+                comb(&b, Interval::ONE, hi_),
+                comb(&d1, Interval::ONE / hi_, Interval::ONE),
+                comb(&d2, Interval::ONE / hi_.sqr(), Interval::ONE / hi_),
+            )
+        };
+        let (mut lo, mut hi) = (x.to_vec(), x.to_vec());
+        let mut defect_half = vec![0.0f64; n];
+        let mut jac = vec![Interval::ZERO; self.pattern.len()];
+        let mut f_mid = vec![Interval::ZERO; n];
+        let mut slope = vec![Interval::ZERO; n];
+        for piece in 0..PIECES {
+            let (a, b) = (
+                piece as f64 / PIECES as f64,
+                (piece + 1) as f64 / PIECES as f64,
+            );
+            let tau = Interval::new(a, b);
+            let mid = Interval::point(0.5 * (a + b));
+            let (p_piece, dp_piece, d2p_piece) = eval(tau);
+            let (p_mid, dp_mid, _) = eval(mid);
+            let t_piece = Interval::point(t) + tau * hi_;
+            for i in 0..n {
+                lo[i] = lo[i].min(p_piece[i].lo());
+                hi[i] = hi[i].max(p_piece[i].hi());
+            }
+            sys.drift_interval(&p_mid, &ui, t_piece, &mut f_mid);
+            sys.jac_x_sparse_interval(&p_piece, &ui, t_piece, &mut jac);
+            // p'' - J p' over the piece, J on the drift's dependency pattern.
+            slope.copy_from_slice(&d2p_piece);
+            for (&(i, j), &jij) in self.pattern.iter().zip(&jac) {
+                slope[i] -= jij * dp_piece[j];
+            }
+            // s - m over the piece.
+            let offset = (tau - mid) * hi_;
+            for i in 0..n {
+                let d = dp_mid[i] - f_mid[i] + slope[i] * offset;
+                if !(d.lo().is_finite() && d.hi().is_finite()) {
+                    return Ok(None);
+                }
+                defect_half[i] = defect_half[i].max(d.mag());
+            }
+        }
+        if let Some(domain) = self.domain {
+            if let Some(i) = (0..n).find(|&i| lo[i] < domain[i].lo || hi[i] > domain[i].hi) {
+                return Err(RunError::Invalid(format!(
+                    "the nominal trajectory leaves the domain in state {i} near t = {t}: the \
+                     constants hold only in the domain (enlarge it, or shorten the horizon)"
+                )));
+            }
+        }
+        Ok(Some(NominalStep {
+            t1,
+            defect: self.metric.bound(&defect_half),
+            x1,
+            lo,
+            hi,
+        }))
+    }
+}

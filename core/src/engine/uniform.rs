@@ -1,0 +1,224 @@
+//! The time-uniform stochastic tube (method.md section 8.2): one event of probability at least
+//! `1 - delta` on which `|X_t - x_t|_P < rho_t` for all `t` in `[0, T]` at once.
+//!
+//! In the scaled coordinates of the proof of Theorem 1, `psi_t = int_0^t c_s ds` and
+//! `S_t = int_0^t sigma_s^2 e^(-2 psi_s) ds` (so `Psi_t = e^(2 psi_t) S_t`), and for every fixed
+//! `lambda > 0`, `M_t = e^(-lambda^2 S_t / 2) Phi_n(lambda |v~_t|)` is a non-negative
+//! supermartingale with `M_0 = 1`. Ville's inequality: `P(sup_t M_t >= 1/delta) <= delta`, and
+//! off that event `|X_t - x_t|_P < e^(psi_t) z(S_t) / lambda`, `z(S)` the root of
+//! `ln Phi_n(z) = lambda^2 S / 2 + ln(1/delta)`.
+//!
+//! One `lambda` is tight at one value of `S` only, so the horizon is cut into epochs by `S`
+//! (deterministic): thresholds `S^(k) = S_T 2^(k + 1 - K)`, epoch `k` the times with
+//! `S_t in (S^(k-1), S^(k)]`, each with its own `lambda_k` (optimal at `S^(k)`) and
+//! `delta_k = delta / K`; the union bound gives probability `delta`. At an epoch's end the radius
+//! is the pointwise one at `delta_k`, in particular at the horizon.
+//!
+//! Rigour: `psi_t`, `S_t` are enclosed in interval arithmetic; `z` is the upper end of a bisection
+//! on a certified lower bound of `ln Phi_n` ([`log_phi_lower`]), so it is never below the exact
+//! root; a time whose epoch is uncertain (its `S_t` enclosure meets a threshold) gets the larger
+//! of the candidate epochs' radii.
+
+use super::radius::expm1_over;
+use crate::interval::Interval;
+use crate::kappa::{amgf_minimiser, log_inv_delta_upper, log_phi_lower};
+
+/// The most epochs (the union bound's price grows with their number).
+const MAX_EPOCHS: usize = 64;
+
+/// Enclosures of `psi_t` and `S_t` at the ends of the internal steps (index 0: `t = 0`).
+#[derive(Clone, Debug)]
+pub(super) struct Scale {
+    pub(super) psi: Vec<Interval>,
+    pub(super) s: Vec<Interval>,
+}
+
+impl Scale {
+    /// Along steps of lengths `h` (enclosures) with constant rates `(c, sigma)` on each:
+    /// `psi_(k+1) = psi_k + c h`, `S_(k+1) = S_k + sigma^2 e^(-2 psi_k) int_0^h e^(-2 c s) ds`.
+    pub(super) fn new(steps: impl Iterator<Item = (Interval, f64, f64)>) -> Scale {
+        let (mut psi, mut s) = (vec![Interval::ZERO], vec![Interval::ZERO]);
+        for (h, c, sigma) in steps {
+            let (p, v) = (psi[psi.len() - 1], s[s.len() - 1]);
+            let sigma2 = Interval::point(sigma).sqr();
+            let gain = sigma2 * (Interval::point(-2.0) * p).exp() * expm1_over(-2.0 * c, h);
+            psi.push(p + Interval::point(c) * h);
+            // S is non-decreasing: its lower end never falls below the previous one.
+            let next = v + gain;
+            s.push(Interval::new(next.lo().max(v.lo()), next.hi()));
+        }
+        Scale { psi, s }
+    }
+}
+
+/// One epoch of the tube.
+#[derive(Clone, Copy, Debug)]
+struct Epoch {
+    /// Its threshold `S^(k)` (the epoch holds the times with `S_t <= S^(k)` after the previous
+    /// epoch).
+    s_end: f64,
+    /// Its `lambda`.
+    lambda: f64,
+    /// An upper bound of `ln(1 / delta_k)`.
+    log_inv_delta: f64,
+}
+
+/// The epochs of a run, fixed before the fact from its deterministic `S_t`.
+#[derive(Clone, Debug)]
+pub(super) struct Tube {
+    n: usize,
+    epochs: Vec<Epoch>,
+}
+
+impl Tube {
+    /// The tube for dimension `n`, probability `delta`, from the scale of the first report time
+    /// after 0 (`s_first`, the first epoch's threshold at most) to the horizon's (`s_last`).
+    pub(super) fn new(n: usize, delta: f64, s_first: f64, s_last: f64) -> Tube {
+        if s_last <= 0.0 {
+            return Tube {
+                n,
+                epochs: Vec::new(),
+            };
+        }
+        let ratio = (s_last / s_first.max(f64::MIN_POSITIVE)).max(1.0);
+        let k = (ratio.log2().ceil() as usize + 1).clamp(1, MAX_EPOCHS);
+        // A little below delta / K, so that the K shares sum to at most delta.
+        let delta_k = (delta / k as f64).next_down();
+        let (kappa, z) = amgf_minimiser(n, delta_k);
+        let log_inv_delta = log_inv_delta_upper(delta_k);
+        let epochs = (0..k)
+            .map(|e| {
+                let s_end = s_last * 2f64.powi(e as i32 + 1 - k as i32);
+                Epoch {
+                    s_end,
+                    // Optimal at the threshold: there the radius is the pointwise one at
+                    // delta_k (any lambda > 0 is valid).
+                    lambda: z / (s_end * kappa).sqrt(),
+                    log_inv_delta,
+                }
+            })
+            .collect();
+        Tube { n, epochs }
+    }
+
+    /// The number of epochs (the union bound's `K`).
+    pub(super) fn epochs(&self) -> usize {
+        self.epochs.len()
+    }
+
+    /// An upper bound of the tube's radius over the times whose `psi` lies in `psi` and whose
+    /// `S` lies in `s` (a time, or a step: the enclosures of both ends' hulls).
+    pub(super) fn radius(&self, psi: Interval, s: Interval) -> f64 {
+        if s.hi() <= 0.0 || self.epochs.is_empty() {
+            return 0.0;
+        }
+        let grow = Interval::point(psi.hi()).exp();
+        let mut radius = 0.0f64;
+        let mut s_prev = f64::NEG_INFINITY;
+        for e in &self.epochs {
+            // The times of this epoch within the range: S in (s_prev, s_end] and in s.
+            if s.hi() > s_prev && s.lo() <= e.s_end {
+                let s_top = s.hi().min(e.s_end);
+                let z = self.root(e, s_top);
+                let r = grow * Interval::point(z) / Interval::point(e.lambda);
+                radius = radius.max(r.hi());
+            }
+            s_prev = e.s_end;
+        }
+        // Beyond the last threshold (rounding of S at the horizon): the last epoch's formula.
+        if let Some(last) = self.epochs.last().filter(|e| s.hi() > e.s_end) {
+            let z = self.root(last, s.hi());
+            radius = radius.max((grow * Interval::point(z) / Interval::point(last.lambda)).hi());
+        }
+        radius
+    }
+
+    /// An upper bound of the root `z` of `ln Phi_n(z) = lambda^2 S / 2 + ln(1/delta_k)`
+    /// (increasing in `S`): bisection keeping an upper end where the certified lower bound of
+    /// `ln Phi_n` already reaches the target.
+    fn root(&self, e: &Epoch, s: f64) -> f64 {
+        let lambda = Interval::point(e.lambda);
+        let target = (lambda.sqr() * Interval::point(s) * Interval::point(0.5)
+            + Interval::point(e.log_inv_delta))
+        .hi();
+        let reaches = |z: f64| log_phi_lower(self.n, z) >= target;
+        // ln Phi_n(z) <= z: the root is at least the target.
+        let (mut lo, mut hi) = (0.0, target.max(1.0));
+        while !reaches(hi) {
+            lo = hi;
+            hi *= 2.0;
+        }
+        while hi - lo > 1e-12 * hi {
+            let mid = 0.5 * (lo + hi);
+            if reaches(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        hi
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kappa::kappa_amgf;
+
+    /// At each epoch's threshold the tube's radius is the pointwise one at delta / K; between
+    /// thresholds it is larger than the pointwise one at delta, by a bounded factor.
+    #[test]
+    fn the_tube_meets_the_pointwise_radius_at_the_thresholds() {
+        let (n, delta) = (2, 1e-3);
+        let tube = Tube::new(n, delta, 1e-4, 1.0);
+        let k = tube.epochs();
+        assert_eq!(k, 15);
+        let kappa_k = kappa_amgf(n, (delta / k as f64).next_down());
+        for e in &tube.epochs {
+            let r = tube.radius(Interval::ZERO, Interval::point(e.s_end));
+            let pointwise = (e.s_end * kappa_k).sqrt();
+            assert!(r >= pointwise * (1.0 - 1e-9), "{r} vs {pointwise}");
+            assert!(r <= pointwise * (1.0 + 1e-6), "{r} vs {pointwise}");
+        }
+        // The price of uniformity at the horizon: sqrt(kappa(delta / K) / kappa(delta)).
+        let at_end = tube.radius(Interval::ZERO, Interval::point(1.0));
+        let price = at_end / kappa_amgf(n, delta).sqrt();
+        assert!(price > 1.0 && price < 1.2, "{price}");
+        // Inside an epoch, at most a bounded factor above the pointwise radius at delta.
+        for i in 0..200 {
+            let s = 1e-4 * 10f64.powf(4.0 * f64::from(i) / 200.0);
+            let r = tube.radius(Interval::ZERO, Interval::point(s));
+            let pointwise = (s * kappa_amgf(n, delta)).sqrt();
+            assert!(
+                r >= pointwise && r < 1.6 * pointwise,
+                "S = {s}: {r} vs {pointwise}"
+            );
+        }
+        // The radius scales with e^psi.
+        let r0 = tube.radius(Interval::ZERO, Interval::point(0.5));
+        let r1 = tube.radius(Interval::point(-1.0), Interval::point(0.5));
+        assert!((r1 / r0 - (-1.0f64).exp()).abs() < 1e-12);
+    }
+
+    /// `Scale` against the closed forms for constant rates: `psi = c t`,
+    /// `S = sigma^2 (1 - e^(-2 c t)) / (2 c)`, and `Psi = e^(2 psi) S`.
+    #[test]
+    fn scale_matches_closed_forms() {
+        let (c, sigma, h) = (-0.5, 0.3, 0.01);
+        let scale = Scale::new((0..400).map(|_| (Interval::point(h), c, sigma)));
+        for k in [1usize, 100, 400] {
+            let t = k as f64 * h;
+            let s = sigma * sigma * (-(-2.0 * c * t).exp_m1()) / (2.0 * c);
+            assert!(scale.s[k].contains(s), "{:?} vs {s}", scale.s[k]);
+            assert!(scale.s[k].width() <= 1e-12 * s);
+            assert!(scale.psi[k].contains(c * t));
+        }
+    }
+
+    /// No noise: no radius.
+    #[test]
+    fn no_noise_no_tube() {
+        let tube = Tube::new(3, 0.01, 0.0, 0.0);
+        assert_eq!(tube.radius(Interval::point(2.0), Interval::ZERO), 0.0);
+    }
+}
