@@ -77,7 +77,13 @@ fn run_plot_writes_both_figures_for_each_analysis() {
         "1,4",
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let expected: Vec<String> = ["contraction", "interval"]
+    let analyses = [
+        "contraction",
+        "interval",
+        "paper_contraction",
+        "paper_interval",
+    ];
+    let expected: Vec<String> = analyses
         .iter()
         .flat_map(|a| {
             ["radius.png", "radius.svg", "sets.png", "sets.svg"].map(|f| format!("{a}_{f}"))
@@ -85,7 +91,7 @@ fn run_plot_writes_both_figures_for_each_analysis() {
         .collect();
     // Exactly the pictures: no temporary files left behind.
     assert_eq!(files(&plots), expected);
-    for a in ["contraction", "interval"] {
+    for a in analyses {
         let sets = svg(&plots.join(format!("{a}_sets.svg")));
         assert!(sets.contains(&format!("pendulum / {a}")), "{a}");
         assert!(

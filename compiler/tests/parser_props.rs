@@ -38,7 +38,7 @@ initial ball { over = [z, q] center = [0, 0] radius = .5 metric = [[1, 0], [0, 2
 unsafe wall halfspace { theta + 2 * c >= 3 }
 unsafe b box { theta in [1, 2] c in [3, 4] }
 unsafe s ball { over = [theta, c] center = [2, 3] radius = 1e-1 }
-analysis main { delta = 1e-3 horizon = 4 step = 0.01 metric = auto radius = paper(eps = 1/16) }
+analysis main { delta = 1e-3 horizon = 4 step = 0.01 metric = auto radius = paper(eps = 1/16) guarantee = pointwise }
 ";
 
 /// Words, numbers and punctuation of the language (plus a few stray characters).

@@ -4,7 +4,7 @@
 //! A delta-PRS at time `t` is `Rbar_t (+) B_P(r_t)`: a deterministic reachable set ([`DetSet`])
 //! plus the stochastic ball of radius `r_t` in the metric `P` of the analysis' constants.
 
-use crate::engine::{interval, linalg};
+use crate::engine::interval;
 use crate::interval::Interval;
 use crate::model::{
     Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, Provenance, RadiusRule, Rate,
@@ -101,6 +101,9 @@ pub struct ConstantsUsed {
     pub provenance: Provenance,
     /// The metric `P`, `n x n` row-major.
     pub metric: Vec<f64>,
+    /// Upper bounds of `sqrt((P^-1)_ii)`: the P-ball of radius `r` around `c` lies in the box
+    /// `|x_i - c_i| <= r spread_i`.
+    pub spread: Vec<f64>,
 }
 
 /// The stochastic radius rule used.
@@ -520,12 +523,15 @@ impl Prs {
 
     /// A rigorous bounding box of the PRS at report step `k`: the deterministic set's hull
     /// inflated by `r_t sqrt((P^-1)_ii)` (for a ball, the ball `B_P(x*, R_t + r_t)`'s own
-    /// hull), rounded outward; `None` if the metric is not certifiably positive definite.
-    /// Panics if `k` is out of range.
+    /// hull), rounded outward; `None` if [`ConstantsUsed::spread`] is missing (a result built
+    /// by hand). Panics if `k` is out of range.
     pub fn hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
         let st = &self.steps[k];
         let n = self.n();
-        let w = linalg::inverse_diagonal_sqrt(&self.constants.metric, n)?;
+        let w = &self.constants.spread;
+        if w.len() != n {
+            return None;
+        }
         let spread = |r: f64, i: usize| Interval::point(r) * Interval::point(w[i]);
         Some(match st.det.box_hull() {
             None => {

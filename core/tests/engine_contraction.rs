@@ -5,8 +5,8 @@ use reachc_core::engine::{self, RunError};
 use reachc_core::interval::Interval;
 use reachc_core::kappa::kappa;
 use reachc_core::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Integrator, Method, ModelInfo,
-    RadiusRule, Rate, Transform, UnsafeSet, UnsafeShape,
+    Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
+    ModelInfo, RadiusRule, Rate, Transform, UnsafeSet, UnsafeShape,
 };
 use reachc_core::prs::{Prs, Unproved, UnsafeKind, Verdict};
 use reachc_core::{InputPlan, Reach, System};
@@ -179,6 +179,9 @@ fn identity(n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// An analysis with the paper's semantics, whose closed forms these tests check: the radius
+/// for each time separately, one RK4 step per report step (`validated.rs` tests the defaults:
+/// validated steps and the time-uniform tube).
 fn analysis(delta: f64, horizon: f64, step: f64, constants: Constants) -> Analysis {
     Analysis {
         spec: AnalysisSpec {
@@ -186,6 +189,8 @@ fn analysis(delta: f64, horizon: f64, step: f64, constants: Constants) -> Analys
             delta,
             horizon,
             step,
+            guarantee: Guarantee::Pointwise,
+            integrator: Integrator::Rk4,
             ..AnalysisSpec::default()
         },
         constants: Ok(constants),
@@ -528,11 +533,18 @@ fn safety_against_boxes_and_balls() {
         },
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();
-    for st in &res.steps {
-        let (x, r) = (st.nominal()[0], st.prs_radius);
-        let box_gap = 5.0 - (x + r);
+    for (k, st) in res.steps.iter().enumerate() {
+        // The margins are over the report interval ending at t: its span holds the PRS at
+        // both ends, [x - r, x + r] now and at the previous report time.
+        let span = &st.span;
+        for prev in &res.steps[k.saturating_sub(1)..=k] {
+            let (x, r) = (prev.nominal()[0], prev.prs_radius);
+            assert!(span.lo[0] - span.radius <= x - r && x + r <= span.hi[0] + span.radius);
+        }
+        let (lo, hi) = (span.lo[0] - span.radius, span.hi[0] + span.radius);
+        let box_gap = 5.0 - hi;
         assert!(st.margins[0] <= box_gap && box_gap - st.margins[0] < 1e-12);
-        let ball_gap = (x + 4.0) - r - 1.0;
+        let ball_gap = (lo + 4.0) - 1.0;
         assert!(st.margins[1] <= ball_gap && ball_gap - st.margins[1] < 1e-12);
     }
     assert!(res.unsafe_sets[0].safe && res.unsafe_sets[1].safe);
@@ -576,27 +588,34 @@ fn pendulum_half_space_uses_inverse_metric() {
     let (tr, dt) = (pinv[0] + pinv[3], pinv[0] * pinv[3] - pinv[1] * pinv[2]);
     let lmax = tr / 2.0 + (tr * tr / 4.0 - dt).sqrt();
     for st in &res.steps {
-        let (x, r) = (&st.nominal(), st.prs_radius);
-        let e0 = 1.0 - x[0] - r * pinv[0].sqrt();
+        // Margins over the report interval: of its span, the box [lo, hi] plus the P-ball of
+        // radius r (the PRS at t lies in it: checked below against its boundary).
+        let (lo, hi, r) = (&st.span.lo, &st.span.hi, st.span.radius);
+        assert!(r >= st.prs_radius);
+        let e0 = 1.0 - hi[0] - r * pinv[0].sqrt();
         assert!(
             st.margins[0] <= e0 && e0 - st.margins[0] < 1e-12,
             "{} {e0}",
             st.margins[0]
         );
-        let e1 = 3.0 - (x[1] + r * pinv[3].sqrt());
+        let e1 = 3.0 - (hi[1] + r * pinv[3].sqrt());
         assert!(st.margins[1] <= e1 && e1 - st.margins[1] < 1e-12);
         // A ball: the larger of two lower bounds of the gap, through the ellipse's spread
         // and through its bounding box.
-        let by_spread = (x[0] * x[0] + (x[1] - 5.0).powi(2)).sqrt() - r * lmax.sqrt() - 0.5;
-        let gap = |c: f64, w: f64| (c.abs() - w).max(0.0);
-        let (w0, w1) = (r * pinv[0].sqrt(), r * pinv[3].sqrt());
-        let by_box = (gap(x[0], w0).powi(2) + gap(x[1] - 5.0, w1).powi(2)).sqrt() - 0.5;
+        let gap = |c: f64, a: f64, b: f64| (a - c).max(c - b).max(0.0);
+        let dist = |w0: f64, w1: f64| {
+            (gap(0.0, lo[0] - w0, hi[0] + w0).powi(2) + gap(5.0, lo[1] - w1, hi[1] + w1).powi(2))
+                .sqrt()
+        };
+        let by_spread = dist(0.0, 0.0) - r * lmax.sqrt() - 0.5;
+        let by_box = dist(r * pinv[0].sqrt(), r * pinv[3].sqrt()) - 0.5;
         let want = by_spread.max(by_box);
         assert!(
             st.margins[2] <= want && want - st.margins[2] < 1e-9,
             "{} {want}",
             st.margins[2]
         );
+        let (x, r) = (&st.nominal(), st.prs_radius);
         // Sound: no point of the PRS (its boundary, sampled) is closer to the unsafe ball.
         let closest = (0..720)
             .map(|k| {

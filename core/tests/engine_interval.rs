@@ -364,12 +364,16 @@ fn linear_safety_and_membership() {
             set: 3
         }
     );
-    // Margins by hand at the last step: PRS = [lo - r, hi + r] (P = 1).
+    // Margins by hand at the last step, over its report interval: the span holds the PRS at
+    // t, [lo - r, hi + r] (P = 1), and at the times before it; margins are the span's.
     let st = res.steps.last().unwrap();
     let (lo, hi, r) = (corners(&st.det).0[0], corners(&st.det).1[0], st.r_t);
-    let m_half = 3.0 - (hi + r);
-    let m_box = (lo - r) - (-3.0);
-    let m_ball = (4.0 - (hi + r)) - 1.0;
+    let span = &st.span;
+    assert!(span.lo[0] <= lo && hi <= span.hi[0] && r <= span.radius);
+    let (slo, shi) = (span.lo[0] - span.radius, span.hi[0] + span.radius);
+    let m_half = 3.0 - shi;
+    let m_box = slo - (-3.0);
+    let m_ball = (4.0 - shi) - 1.0;
     for (m, want) in st.margins.iter().zip([m_half, m_box, m_ball]) {
         assert!(*m <= want && *m >= want - 1e-12, "{m} vs {want}");
     }

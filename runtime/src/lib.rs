@@ -57,9 +57,9 @@
 //!     let hull = prs.hull(1.0).unwrap();
 //!     assert!(hull[0].lo < at_1.nominal()[0] && at_1.nominal()[0] < hull[0].hi);
 //! }
-//! // Boxes of the same width: the same radius wherever they start (a linear drift), up to
-//! // the rounding of the boxes' ends.
-//! assert!(radii.windows(2).all(|w| (w[0] - w[1]).abs() < 1e-12));
+//! // Boxes of the same width: about the same radius wherever they start (a linear drift), up
+//! // to the bound on the validated nominal's defect, which the engine keeps near 1% of the PRS.
+//! assert!(radii.windows(2).all(|w| (w[0] - w[1]).abs() < 0.02 * w[0]));
 //! # Ok(())
 //! # }
 //! ```

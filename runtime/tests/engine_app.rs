@@ -195,6 +195,25 @@ fn results_render() {
     assert_eq!(v["steps"][0]["det_set"]["shape"], "box");
     assert_eq!(v["steps"][0]["det_set"]["lo"][0], 0.9);
     assert_eq!(v["steps"][0]["det_set"]["hi"][0], 1.1);
+    // Validated steps and a time-uniform tube by default: nothing unproved.
+    assert_eq!(v["guarantee"], "uniform");
+    assert_eq!(v["validated"]["not_validated"], serde_json::json!([]));
+    let proved: Vec<&str> = v["validated"]["rigorous"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap())
+        .collect();
+    assert!(
+        proved.iter().any(|p| p.starts_with("embedding system on"))
+            && proved.iter().any(|p| p.starts_with("time-uniform tube")),
+        "{proved:?}"
+    );
+    // An integrator the user asked for is labelled.
+    let mut euler = info.clone();
+    euler.analyses[1].spec.integrator = reachc_runtime::model::Integrator::Euler;
+    let unvalidated = Reach::new(&Decay, &euler, "boxes").unwrap().run().unwrap();
+    let v: serde_json::Value = serde_json::from_str(&report::to_json(&unvalidated)).unwrap();
     assert!(v["validated"]["not_validated"][0]
         .as_str()
         .unwrap()

@@ -21,12 +21,10 @@ pub(super) struct Piece {
     pub(super) t1: f64,
     /// `(c, sigma)` on the step.
     pub(super) rates: (f64, f64),
-    /// `Rbar_(t1)`.
-    pub(super) end: DetSet,
+    /// `Rbar_(t1)` when `t1` is a report time (only those sets are reported).
+    pub(super) end: Option<DetSet>,
     /// A set holding `Rbar_s` for every `s` in `[t0, t1]` (radius: a P-ball added to the box).
     pub(super) over: Span,
-    /// `t1` is a report time.
-    pub(super) report: bool,
 }
 
 /// The deterministic part of a run.
@@ -57,12 +55,13 @@ pub(super) struct Header {
     pub(super) not_validated: Vec<Unproved>,
 }
 
-/// The stochastic radius at the end of each internal step and its largest value over the
-/// step, for the run's guarantee; and the pointwise `Psi`, `r` at each end.
+/// The stochastic radius at each report time and its largest value over the report interval
+/// ending there, for the run's guarantee; and the pointwise `Psi`, `r` at each report time.
 struct Radii {
-    /// Per step end: `(Psi upper, pointwise r)`.
+    /// Per report time after 0: `(Psi upper, pointwise r)`.
     pointwise: Vec<(f64, f64)>,
-    /// Per step: `(radius at its end, largest radius over it)` of the guarantee.
+    /// Per report time after 0: `(radius at it, largest radius over its report interval)` of
+    /// the guarantee.
     guaranteed: Vec<(f64, f64)>,
     /// The tube's epochs (uniform guarantee).
     epochs: Option<usize>,
@@ -72,18 +71,17 @@ impl Radii {
     fn new(run: &Run, det: &Deterministic, kappa: f64) -> Radii {
         let mut stochastic = Stochastic::new(kappa);
         let mut t0 = 0.0;
-        let pointwise: Vec<(f64, f64)> = det
-            .pieces
-            .iter()
-            .map(|p| {
-                let (c, sigma) = p.rates;
-                let r = stochastic.advance(Some(t0), p.t1, c, sigma);
-                t0 = p.t1;
-                r
-            })
-            .collect();
+        let mut pointwise = Vec::new();
+        for p in &det.pieces {
+            let (c, sigma) = p.rates;
+            let r = stochastic.advance(Some(t0), p.t1, c, sigma);
+            t0 = p.t1;
+            if p.end.is_some() {
+                pointwise.push(r);
+            }
+        }
         match run.spec.guarantee {
-            // Psi is increasing, so a step's largest radius is its end's.
+            // Psi is increasing, so an interval's largest radius is its end's.
             Guarantee::Pointwise => Radii {
                 guaranteed: pointwise.iter().map(|&(_, r)| (r, r)).collect(),
                 pointwise,
@@ -96,19 +94,22 @@ impl Radii {
                     t0 = p.t1;
                     (h, p.rates.0, p.rates.1)
                 }));
-                let first = det.pieces.iter().position(|p| p.report).unwrap_or(0);
+                let first = det.pieces.iter().position(|p| p.end.is_some()).unwrap_or(0);
                 let s_last = scale.s.last().map_or(0.0, |s| s.hi());
                 let tube = Tube::new(run.setup.n, run.spec.delta, scale.s[first + 1].lo(), s_last);
-                let guaranteed = (0..det.pieces.len())
-                    .map(|k| {
+                // Per report interval: the radius over the hull of psi and S along it (the
+                // tube's bound holds for every time whose psi and S lie in the hulls).
+                let mut guaranteed = Vec::with_capacity(pointwise.len());
+                let (mut psi, mut s) = (scale.psi[0], scale.s[0]);
+                for (k, p) in det.pieces.iter().enumerate() {
+                    psi = psi.hull(scale.psi[k + 1]);
+                    s = s.hull(scale.s[k + 1]);
+                    if p.end.is_some() {
                         let end = tube.radius(scale.psi[k + 1], scale.s[k + 1]);
-                        let over = tube.radius(
-                            scale.psi[k].hull(scale.psi[k + 1]),
-                            scale.s[k].hull(scale.s[k + 1]),
-                        );
-                        (end, over.max(end))
-                    })
-                    .collect();
+                        guaranteed.push((end, tube.radius(psi, s).max(end)));
+                        (psi, s) = (scale.psi[k + 1], scale.s[k + 1]);
+                    }
+                }
                 Radii {
                     guaranteed,
                     pointwise,
@@ -123,8 +124,7 @@ impl Radii {
 /// over each report interval, the margins over the intervals, and the verdicts.
 pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
     let setup = run.setup;
-    // Upper bounds of sqrt((P^-1)_ii): B_P(r) lies in the box |d_i| <= r w_i.
-    let w: Vec<f64> = setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect();
+    let w = spread(run);
     let context = Context {
         w: &w,
         frame: det.frame.as_ref(),
@@ -156,30 +156,29 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
         sigma: det.pieces.first().map_or(0.0, |p| p.rates.1),
         span: start_span,
     });
-    // The report interval being gathered: the hull of the steps' sets and the largest radius.
+    // The report interval being gathered: the hull of the steps' deterministic sets.
     let mut gathered: Option<Span> = None;
     let internal_steps = det.pieces.len();
-    for (k, piece) in det.pieces.into_iter().enumerate() {
-        let (r_end, r_over) = radii.guaranteed[k];
-        let over = Span {
-            radius: (Interval::point(piece.over.radius) + Interval::point(r_over)).hi(),
-            ..piece.over
-        };
+    let mut report = 0;
+    for piece in det.pieces {
         gathered = Some(match gathered {
-            None => over,
-            Some(g) => g.hull(&over),
+            None => piece.over,
+            Some(g) => g.hull(&piece.over),
         });
-        if !piece.report {
+        let Some(end) = piece.end else {
             continue;
-        }
-        let span = gathered.take().expect("a report interval has a step");
-        let (psi, r_pointwise) = radii.pointwise[k];
+        };
+        let (r_end, r_over) = radii.guaranteed[report];
+        let (psi, r_pointwise) = radii.pointwise[report];
+        report += 1;
+        let mut span = gathered.take().expect("a report interval has a step");
+        span.radius = (Interval::point(span.radius) + Interval::point(r_over)).hi();
         let (c, sigma) = piece.rates;
         steps.push(Step {
             t: piece.t1,
-            prs_radius: (Interval::point(piece.end.radius()) + Interval::point(r_end)).hi(),
+            prs_radius: (Interval::point(end.radius()) + Interval::point(r_end)).hi(),
             margins: margins(&span),
-            det: piece.end,
+            det: end,
             r_t: r_end,
             r_pointwise,
             psi,
@@ -234,6 +233,24 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
             conditional_on_domain: run.info.has_domain,
         },
     }
+}
+
+/// The constants of a run as the result reports them, with input gain `rho`.
+pub(super) fn constants_used(run: &Run, rho: f64) -> ConstantsUsed {
+    let consts = run.setup.consts;
+    ConstantsUsed {
+        c: consts.c,
+        sigma: consts.sigma,
+        rho,
+        provenance: consts.provenance.clone(),
+        metric: consts.metric.clone(),
+        spread: spread(run),
+    }
+}
+
+/// Upper bounds of `sqrt((P^-1)_ii)`: `B_P(r)` lies in the box `|d_i| <= r w_i`.
+fn spread(run: &Run) -> Vec<f64> {
+    run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect()
 }
 
 /// The span of a deterministic set widened by a P-ball of radius `r`: its box hull (the

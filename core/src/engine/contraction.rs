@@ -3,13 +3,13 @@
 //! zero for an exact solution): on validated steps by default (`defect.rs`), or one
 //! unvalidated RK4 or Euler step per report step when the spec asks for it.
 
-use super::assemble::{assemble, Deterministic, Header, Piece};
+use super::assemble::{assemble, constants_used, Deterministic, Header, Piece};
 use super::defect::{Nominal, NominalStep};
 use super::radius::expm1_over;
 use super::{nominal, radius, rates, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
-use crate::prs::{ConstantsUsed, DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, Unproved};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, Unproved};
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -75,16 +75,15 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         pieces.push(Piece {
             t1: step.t1,
             rates: (c, consts.sigma),
-            report: step.t1 == grid[k + 1],
             over: Span {
                 lo: step.lo,
                 hi: step.hi,
                 radius: r_prev.max(r.hi()),
             },
-            end: DetSet::Ball {
+            end: (step.t1 == grid[k + 1]).then(|| DetSet::Ball {
                 center: step.x1,
                 radius: r.hi(),
-            },
+            }),
         });
         t0 = step.t1;
     }
@@ -134,13 +133,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
             rate: spec.rate,
             max_c,
         },
-        constants: ConstantsUsed {
-            c: consts.c,
-            sigma: consts.sigma,
-            rho,
-            provenance: consts.provenance.clone(),
-            metric: metric.clone(),
-        },
+        constants: constants_used(run, rho),
         radius_rule,
         kappa,
         r1,
@@ -167,11 +160,13 @@ fn nominal_steps(
     let spec = run.spec;
     if spec.integrator == Integrator::Validated {
         let consts = run.setup.consts;
-        // The defect may add about 0.1% of the PRS's natural size over the horizon.
+        // The defect may add about 1% of the PRS's natural size (the initial radius, or the
+        // stochastic radius sqrt(sigma^2 T kappa)) over the horizon.
+        let (kappa, _) = radius::stochastic_factor(run.setup.n, spec);
         let scale = r1
-            .max(consts.sigma * spec.horizon.sqrt())
+            .max(consts.sigma * (spec.horizon * kappa).sqrt())
             .max(1e-9 * x0.iter().fold(1.0f64, |m, v| m.max(v.abs())));
-        let tolerance = 1e-3 * scale / spec.horizon.max(f64::MIN_POSITIVE);
+        let tolerance = 1e-2 * scale / spec.horizon.max(f64::MIN_POSITIVE);
         let domain = run.info.has_domain.then_some(&run.info.domain[..]);
         return Nominal::new(run.sys, &consts.metric, tolerance, domain).steps(x0, grid, inputs);
     }

@@ -11,15 +11,71 @@
 //! `p([a, b])`, so `d(s) in p'(m) - f(p(m), u, [a, b]) + (p''([a, b]) - J p'([a, b])) [a - m, b - m]`:
 //! a small first term (the Hermite error), and a second that shrinks with the piece.
 
+use super::hermite::Cubic;
 use super::radius::BoxRadius;
 use super::RunError;
 use crate::interval::Interval;
 use crate::system::System;
 
-/// Pieces per step for the defect bound.
-const PIECES: usize = 8;
 /// The most internal steps of one analysis.
 pub(crate) const MAX_STEPS: usize = 2_000_000;
+
+/// The most internal steps in one report interval.
+pub(crate) const MAX_STEPS_PER_REPORT: usize = 10_000;
+
+/// Counts a run's internal steps against [`MAX_STEPS`] and [`MAX_STEPS_PER_REPORT`], so that an
+/// enclosure creeping towards a blow-up stops early with a diagnostic.
+pub(crate) struct StepBudget {
+    /// What is integrated ("the nominal trajectory", "the embedding system").
+    what: &'static str,
+    /// What to try instead, for the diagnostic.
+    hint: &'static str,
+    total: usize,
+    in_interval: usize,
+}
+
+impl StepBudget {
+    pub(crate) fn new(what: &'static str, hint: &'static str) -> Self {
+        StepBudget {
+            what,
+            hint,
+            total: 0,
+            in_interval: 0,
+        }
+    }
+
+    /// Starts a report interval.
+    pub(crate) fn next_interval(&mut self) {
+        self.in_interval = 0;
+    }
+
+    /// Takes one step at `t` in the report interval `window`, or says why not.
+    pub(crate) fn take(&mut self, t: f64, window: &[f64]) -> Result<(), RunError> {
+        let (what, hint) = (self.what, self.hint);
+        if self.total >= MAX_STEPS {
+            return Err(RunError::NonFinite(format!(
+                "{what} needs more than {MAX_STEPS} validated steps before t = {t} ({hint})"
+            )));
+        }
+        if self.in_interval >= MAX_STEPS_PER_REPORT {
+            return Err(RunError::NonFinite(format!(
+                "{what} needs more than {MAX_STEPS_PER_REPORT} validated steps in the report \
+                 interval [{}, {}] (at t = {t}): it grows without bound there, or is too stiff \
+                 for this report step ({hint})",
+                window[0], window[1]
+            )));
+        }
+        self.total += 1;
+        self.in_interval += 1;
+        Ok(())
+    }
+}
+
+/// The shortest internal step, as a fraction of the report step: a step that must be shorter
+/// to validate means the enclosure is blowing up (a finite escape time of the embedding
+/// system, a nominal leaving every bound), and the run stops there with a diagnostic instead
+/// of creeping towards it.
+pub(crate) const MIN_STEP: f64 = 1e-6;
 
 /// One validated step `[t0, t1]` of the nominal.
 pub(super) struct NominalStep {
@@ -44,35 +100,6 @@ pub(super) struct Nominal<'a> {
     tolerance: f64,
     /// The box where the constants hold (the nominal must stay in it).
     domain: Option<&'a [crate::model::Bounds]>,
-}
-
-/// Cubic Hermite basis over `tau` in `[0, 1]` (interval), with its first and second
-/// derivatives (in `tau`).
-fn hermite(tau: Interval) -> ([Interval; 4], [Interval; 4], [Interval; 4]) {
-    let (one, two, three) = (Interval::ONE, Interval::point(2.0), Interval::point(3.0));
-    let t2 = tau.sqr();
-    let t3 = t2 * tau;
-    let basis = [
-        two * t3 - three * t2 + one,
-        t3 - two * t2 + tau,
-        three * t2 - two * t3,
-        t3 - t2,
-    ];
-    let (four, six) = (Interval::point(4.0), Interval::point(6.0));
-    let first = [
-        six * t2 - six * tau,
-        three * t2 - four * tau + one,
-        six * tau - six * t2,
-        three * t2 - two * tau,
-    ];
-    let twelve = Interval::point(12.0);
-    let second = [
-        twelve * tau - six,
-        six * tau - four,
-        six - twelve * tau,
-        six * tau - two,
-    ];
-    (basis, first, second)
 }
 
 impl<'a> Nominal<'a> {
@@ -106,17 +133,16 @@ impl<'a> Nominal<'a> {
         let mut x = x0.to_vec();
         let mut t = 0.0;
         let mut h = grid.get(1).copied().unwrap_or(0.0);
+        let mut budget = StepBudget::new(
+            "the nominal trajectory",
+            "a smaller report step or a shorter horizon may help",
+        );
         for (k, w) in grid.windows(2).enumerate() {
             let end = w[1];
+            budget.next_interval();
             while t < end {
-                if out.len() >= MAX_STEPS {
-                    return Err(RunError::NonFinite(format!(
-                        "the nominal trajectory needs more than {MAX_STEPS} validated steps \
-                         before t = {t}: the system is too stiff or fast for this horizon \
-                         (shorten the horizon)"
-                    )));
-                }
-                let (step, used) = self.step(&x, &inputs[k], t, h.min(end - t), end)?;
+                budget.take(t, w)?;
+                let (step, used) = self.step(&x, &inputs[k], t, h.min(end - t), w)?;
                 // Land exactly on the report time when the step reaches it.
                 h = (2.0 * used).min(w[1] - w[0]);
                 x = step.x1.clone();
@@ -127,17 +153,18 @@ impl<'a> Nominal<'a> {
         Ok(out)
     }
 
-    /// One accepted step from `(x, t)`: tries `h`, halving it until the defect is below the
-    /// tolerance; returns the step and the length used.
+    /// One accepted step from `(x, t)` in the report interval `window`: tries `h`, halving it
+    /// until the defect is below the tolerance; returns the step and the length used.
     fn step(
         &self,
         x: &[f64],
         u: &[f64],
         t: f64,
         mut h: f64,
-        end: f64,
+        window: &[f64],
     ) -> Result<(NominalStep, f64), RunError> {
-        let min_h = 1e-12 * end.abs().max(1.0);
+        let end = window[1];
+        let min_h = MIN_STEP * (end - window[0]);
         loop {
             // The last step of an interval ends exactly on its report time.
             let t1 = if t + h >= end * (1.0 - 1e-15) || end - (t + h) < min_h {
@@ -156,7 +183,7 @@ impl<'a> Nominal<'a> {
                 return Err(RunError::NonFinite(format!(
                     "the nominal trajectory cannot be validated at t = {t}: the step shrank \
                      below {min_h:e} without bounding the defect (the drift is too large or \
-                     not smooth here; a domain or a shorter horizon may help)"
+                     not smooth here: a shorter horizon or a smaller report step may help)"
                 )));
             }
         }
@@ -182,57 +209,27 @@ impl<'a> Nominal<'a> {
         if x1.iter().chain(&f0).chain(&f1).any(|v| !v.is_finite()) {
             return Ok(None);
         }
-        let pt = |v: &[f64]| -> Vec<Interval> { v.iter().map(|&a| Interval::point(a)).collect() };
-        let (x0i, x1i, f0i, f1i) = (pt(x), pt(&x1), pt(&f0), pt(&f1));
-        let hi_ = Interval::point(t1) - Interval::point(t);
-        let ui = pt(u);
-        // p(tau), p'(s) = dp/dtau / h, p''(s) = d2p/dtau2 / h^2 on tau in an interval.
-        let eval = |tau: Interval| -> (Vec<Interval>, Vec<Interval>, Vec<Interval>) {
-            let (b, d1, d2) = hermite(tau);
-            let comb = |c: &[Interval; 4], scale_x: Interval, scale_f: Interval| -> Vec<Interval> {
-                (0..n)
-                    .map(|i| {
-                        (c[0] * x0i[i] + c[2] * x1i[i]) * scale_x
-                            + (c[1] * f0i[i] + c[3] * f1i[i]) * scale_f
-                    })
-                    .collect()
-            };
-            (
-                comb(&b, Interval::ONE, hi_),
-                comb(&d1, Interval::ONE / hi_, Interval::ONE),
-                comb(&d2, Interval::ONE / hi_.sqr(), Interval::ONE / hi_),
-            )
-        };
+        let ui: Vec<Interval> = u.iter().map(|&a| Interval::point(a)).collect();
+        let cubic = Cubic::new(t, t1, x, &x1, &f0, &f1);
         let (mut lo, mut hi) = (x.to_vec(), x.to_vec());
         let mut defect_half = vec![0.0f64; n];
         let mut jac = vec![Interval::ZERO; self.pattern.len()];
         let mut f_mid = vec![Interval::ZERO; n];
         let mut slope = vec![Interval::ZERO; n];
-        for piece in 0..PIECES {
-            let (a, b) = (
-                piece as f64 / PIECES as f64,
-                (piece + 1) as f64 / PIECES as f64,
-            );
-            let tau = Interval::new(a, b);
-            let mid = Interval::point(0.5 * (a + b));
-            let (p_piece, dp_piece, d2p_piece) = eval(tau);
-            let (p_mid, dp_mid, _) = eval(mid);
-            let t_piece = Interval::point(t) + tau * hi_;
+        for piece in cubic.pieces() {
             for i in 0..n {
-                lo[i] = lo[i].min(p_piece[i].lo());
-                hi[i] = hi[i].max(p_piece[i].hi());
+                lo[i] = lo[i].min(piece.over.p[i].lo());
+                hi[i] = hi[i].max(piece.over.p[i].hi());
             }
-            sys.drift_interval(&p_mid, &ui, t_piece, &mut f_mid);
-            sys.jac_x_sparse_interval(&p_piece, &ui, t_piece, &mut jac);
+            sys.drift_interval(&piece.mid.p, &ui, piece.times, &mut f_mid);
+            sys.jac_x_sparse_interval(&piece.over.p, &ui, piece.times, &mut jac);
             // p'' - J p' over the piece, J on the drift's dependency pattern.
-            slope.copy_from_slice(&d2p_piece);
+            slope.copy_from_slice(&piece.over.d2p);
             for (&(i, j), &jij) in self.pattern.iter().zip(&jac) {
-                slope[i] -= jij * dp_piece[j];
+                slope[i] -= jij * piece.over.dp[j];
             }
-            // s - m over the piece.
-            let offset = (tau - mid) * hi_;
             for i in 0..n {
-                let d = dp_mid[i] - f_mid[i] + slope[i] * offset;
+                let d = piece.mid.dp[i] - f_mid[i] + slope[i] * piece.offset;
                 if !(d.lo().is_finite() && d.hi().is_finite()) {
                     return Ok(None);
                 }

@@ -10,7 +10,9 @@
 //! evaluations of the drift and of the non-zero Jacobian entries: time proportional to the
 //! size of the expressions, not to `n^2`.
 
-use super::defect::MAX_STEPS;
+use super::defect::{StepBudget, MIN_STEP};
+use super::hermite::Cubic;
+use super::nominal::rk4_step;
 use super::RunError;
 use crate::interval::Interval;
 use crate::model::{Inclusion, Integrator};
@@ -145,15 +147,10 @@ impl<'a> Embedding<'a> {
         integrator: Integrator,
     ) -> Result<Vec<BoxStep>, usize> {
         let n = lo.len();
-        let m = 2 * n;
         let mut z: Vec<f64> = lo.iter().chain(hi).copied().collect();
         let mut out = Vec::with_capacity(grid.len());
         let (mut prev_lo, mut prev_hi) = (lo.to_vec(), hi.to_vec());
-        let mut k1 = vec![0.0; m];
-        let mut k2 = vec![0.0; m];
-        let mut k3 = vec![0.0; m];
-        let mut k4 = vec![0.0; m];
-        let mut tmp = vec![0.0; m];
+        let mut slope = vec![0.0; 2 * n];
         for (idx, win) in grid.windows(2).enumerate() {
             let (t, h) = (win[0], win[1] - win[0]);
             if self.field.ubox != inputs[idx] {
@@ -161,28 +158,13 @@ impl<'a> Embedding<'a> {
             }
             match integrator {
                 Integrator::Euler => {
-                    self.rhs(&z, t, &mut k1);
-                    for i in 0..m {
-                        z[i] += h * k1[i];
+                    self.rhs(&z, t, &mut slope);
+                    for (zi, di) in z.iter_mut().zip(&slope) {
+                        *zi += h * di;
                     }
                 }
                 Integrator::Rk4 | Integrator::Validated => {
-                    self.rhs(&z, t, &mut k1);
-                    for i in 0..m {
-                        tmp[i] = z[i] + 0.5 * h * k1[i];
-                    }
-                    self.rhs(&tmp, t + 0.5 * h, &mut k2);
-                    for i in 0..m {
-                        tmp[i] = z[i] + 0.5 * h * k2[i];
-                    }
-                    self.rhs(&tmp, t + 0.5 * h, &mut k3);
-                    for i in 0..m {
-                        tmp[i] = z[i] + h * k3[i];
-                    }
-                    self.rhs(&tmp, t + h, &mut k4);
-                    for i in 0..m {
-                        z[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                    }
+                    z = rk4_step(&mut |z, t, d| self.rhs(z, t, d), &z, t, h).0;
                 }
             }
             if z.iter().any(|v| !v.is_finite()) {
@@ -206,34 +188,39 @@ impl<'a> Embedding<'a> {
 
     /// The embedding system on validated steps (method.md section 8.4) from the box
     /// `[lo, hi]` at `t = 0` over the report grid, inputs in `inputs[k]` on report interval
-    /// `k`: each step's end box and the hull of its boxes hold every trajectory from the box
-    /// at the end and over the whole step. The last step of each report interval ends exactly
-    /// on the report time.
+    /// `k`: each step's end box and its hull over the step hold every trajectory from the box,
+    /// at the end and over the whole step. Steps are chosen so that what validation adds to a
+    /// box stays near `accuracy` times its width per unit time. The last step of each report
+    /// interval ends exactly on the report time.
     pub(crate) fn validated(
         &mut self,
         lo: &[f64],
         hi: &[f64],
         grid: &[f64],
         inputs: &[Vec<Interval>],
+        accuracy: f64,
     ) -> Result<Vec<BoxStep>, RunError> {
         let mut out = Vec::new();
         let (mut lo, mut hi) = (lo.to_vec(), hi.to_vec());
         let mut t = 0.0;
         let mut h = grid.get(1).copied().unwrap_or(0.0);
+        let mut budget = StepBudget::new(
+            "the embedding system",
+            "the other inclusion, a coordinate transform, the contraction method, a smaller \
+             report step or a shorter horizon may help",
+        );
         for (k, w) in grid.windows(2).enumerate() {
             if self.field.ubox != inputs[k] {
                 self.field.set_inputs(&inputs[k]);
             }
             let end = w[1];
+            budget.next_interval();
             while t < end {
-                if out.len() >= MAX_STEPS {
-                    return Err(RunError::NonFinite(format!(
-                        "the embedding system needs more than {MAX_STEPS} validated steps before \
-                         t = {t} (a coordinate transform or a shorter horizon may help)"
-                    )));
-                }
-                let (step, used) = self.validated_step(&lo, &hi, t, h.min(w[1] - w[0]), end, k)?;
-                h = (2.0 * used).min(w[1] - w[0]);
+                budget.take(t, w)?;
+                let report = w[1] - w[0];
+                let (step, next) =
+                    self.validated_step(&lo, &hi, t, h.min(report), w, k, accuracy)?;
+                h = next.min(report);
                 (lo, hi) = (step.lo.clone(), step.hi.clone());
                 t = step.t1;
                 out.push(step);
@@ -242,118 +229,254 @@ impl<'a> Embedding<'a> {
         Ok(out)
     }
 
-    /// One validated step from the box `[lo, hi]` at `t`, of length at most `h` (halved until
-    /// it validates); returns it with the length used.
+    /// One validated step from the box `[lo, hi]` at `t` in report interval `interval`
+    /// (`window`), of length at most `h`: shortened until it validates and what it adds to the
+    /// box is within `accuracy` (the latter only down to `2^-12` of the report step: a step
+    /// that validates is sound, only looser; the former down to [`MIN_STEP`] of it). Returns
+    /// the step and the length to try next.
+    #[allow(clippy::too_many_arguments)]
     fn validated_step(
         &mut self,
         lo: &[f64],
         hi: &[f64],
         t: f64,
         mut h: f64,
-        end: f64,
+        window: &[f64],
         interval: usize,
+        accuracy: f64,
     ) -> Result<(BoxStep, f64), RunError> {
-        let min_h = 1e-12 * end.abs().max(1.0);
+        let end = window[1];
+        let min_h = MIN_STEP * (end - window[0]);
+        let floor = (end - window[0]) * 2f64.powi(-12);
+        h = h.max(min_h);
+        let wmax = lo.iter().zip(hi).fold(0.0f64, |m, (a, b)| m.max(b - a));
+        // Per coordinate, what a step may add per unit time (a floor for boxes of no width).
+        let allowed: Vec<f64> = lo
+            .iter()
+            .zip(hi)
+            .map(|(a, b)| {
+                let scale = (b - a)
+                    .max(1e-3 * wmax)
+                    .max(1e-12 * (1.0 + a.abs().max(b.abs())));
+                accuracy * scale
+            })
+            .collect();
         loop {
             let t1 = if t + h >= end * (1.0 - 1e-15) || end - (t + h) < min_h {
                 end
             } else {
                 t + h
             };
-            if let Some((nlo, nhi)) = self.try_validated(lo, hi, t, t1) {
-                let over_lo = lo.iter().zip(&nlo).map(|(a, b)| a.min(*b)).collect();
-                let over_hi = hi.iter().zip(&nhi).map(|(a, b)| a.max(*b)).collect();
-                let step = BoxStep {
-                    t1,
-                    interval,
-                    lo: nlo,
-                    hi: nhi,
-                    over_lo,
-                    over_hi,
-                };
-                return Ok((step, t1 - t));
+            let used = t1 - t;
+            let mut shrink = 0.5;
+            if let Some(step) = self.try_validated(lo, hi, t, t1) {
+                // What validation added, relative to what is allowed (<= 1 to accept).
+                let ratio = (0..lo.len())
+                    .map(|i| {
+                        let added = (step.end_lo[i] - step.lo[i]).max(step.hi[i] - step.end_hi[i]);
+                        added / (allowed[i] * used)
+                    })
+                    .fold(0.0f64, f64::max);
+                // It grows about like the square of the step: aim at 0.8 of the allowance.
+                let next = 0.9 / ratio.sqrt();
+                if ratio <= 1.0 || used <= floor {
+                    return Ok((step.into_box(t1, interval), used * next.min(2.0)));
+                }
+                shrink = next.clamp(0.1, 0.5);
             }
-            h = 0.5 * (t1 - t);
+            h = shrink * used;
             if h < min_h {
                 return Err(RunError::NonFinite(format!(
-                    "the embedding system cannot be validated at t = {t}: the step shrank below \
-                     {min_h:e} (the box grows without bound: try the other inclusion, a \
-                     coordinate transform or a domain)"
+                    "the embedding system cannot be validated at t = {t}: the step would have \
+                     to be shorter than {min_h:e} (a millionth of the report step), with the \
+                     box {wmax:e} wide and growing without bound there (try the other \
+                     inclusion, a coordinate transform, the contraction method or a shorter \
+                     horizon)"
                 )));
             }
         }
     }
 
-    /// The comparison principle on `[t, t1]`: with `lo(s)`, `hi(s)` linear from `[lo, hi]` and
-    /// every face bound taken over a box `B` holding both ends and with the pinned coordinate
-    /// over the interval its end sweeps, `lo_i' <= inf f_i` on the lower faces (and `hi`
-    /// likewise) for all `s` at once, so no trajectory leaves `[lo(s), hi(s)]`. Guess, check,
-    /// widen; `None` when the guesses do not close (a shorter step may).
-    fn try_validated(
-        &mut self,
-        lo: &[f64],
-        hi: &[f64],
-        t: f64,
-        t1: f64,
-    ) -> Option<(Vec<f64>, Vec<f64>)> {
+    /// A validated step on `[t, t1]`. The embedding's RK4 step, joined by the cubic
+    /// `q = (q_lo, q_hi)` ([`Cubic`]), is a box moving with time; no trajectory leaves a moving
+    /// box whose lower faces move no faster than `inf f_i` over them and upper faces no
+    /// slower than `sup f_i` (differential inequalities on the faces). `q` satisfies this up to
+    /// a deficit, bounded on each piece of the step by the mean value theorem around the
+    /// piece's midpoint `m`: for `x` on the lower face `i` at `s`,
+    /// `f_i(x, s) - q_lo_i'(s) >= inf f_i(face(m), [piece]) - q_lo_i'(m)
+    ///     + (J_i([hull]) x'([piece]) - q_lo_i''([piece])) (s - m)`,
+    /// with `x'` the rates of the face's coordinates (the hull of `q_lo_j'` and `q_hi_j'`,
+    /// `q_lo_i'` for the pinned one). Widening the faces by `e(s)`, linear from 0 with
+    /// `e' >= deficit + M e` (`M` the Metzler bound of the Jacobian: how much widening the box
+    /// lowers the faces' bounds), absorbs the deficit. `None` if a value is not finite or the
+    /// step is too long for the widening.
+    fn try_validated(&mut self, lo: &[f64], hi: &[f64], t: f64, t1: f64) -> Option<Validated> {
         let n = lo.len();
-        let h = Interval::point(t1) - Interval::point(t);
-        let times = Interval::point(t).hull(Interval::point(t1));
-        let (mut dlo, mut dhi) = (vec![0.0; n], vec![0.0; n]);
-        // First guess: the slopes on the box itself.
-        for i in 0..n {
-            self.scratch.bx[i] = Interval::try_new(lo[i], hi[i])?;
-            self.scratch.pin_lo[i] = Interval::point(lo[i]);
-            self.scratch.pin_hi[i] = Interval::point(hi[i]);
+        let z0: Vec<f64> = lo.iter().chain(hi).copied().collect();
+        let (z1, f0) = rk4_step(&mut |z, s, d| self.rhs(z, s, d), &z0, t, t1 - t);
+        let mut f1 = vec![0.0; 2 * n];
+        self.rhs(&z1, t1, &mut f1);
+        if z1.iter().chain(&f0).chain(&f1).any(|v| !v.is_finite()) {
+            return None;
         }
-        self.faces(times, &mut dlo, &mut dhi);
-        let (mut nlo, mut nhi) = (vec![0.0; n], vec![0.0; n]);
-        for _ in 0..6 {
-            // Widen the pins to the swept intervals of the current guess (with some slack), the
-            // box to hold them.
+        let cubic = Cubic::new(t, t1, &z0, &z1, &f0, &f1);
+        let (mut dlo, mut dhi) = (vec![0.0; n], vec![0.0; n]);
+        // Per coordinate: the deficits of the lower (i) and upper (n + i) faces.
+        let mut deficit = vec![0.0f64; 2 * n];
+        let (mut over_lo, mut over_hi) = (lo.to_vec(), hi.to_vec());
+        let mut hull = vec![Interval::ZERO; n];
+        let mut rate = vec![Interval::ZERO; n];
+        let mut slope = vec![Interval::ZERO; 2 * n];
+        for piece in cubic.pieces() {
+            let (mid, over) = (&piece.mid, &piece.over);
+            let s = &mut self.scratch;
+            for j in 0..n {
+                s.pin_lo[j] = mid.p[j];
+                s.pin_hi[j] = mid.p[n + j];
+                s.bx[j] = mid.p[j].hull(mid.p[n + j]);
+                hull[j] = over.p[j].hull(over.p[n + j]);
+                rate[j] = over.dp[j].hull(over.dp[n + j]);
+                over_lo[j] = over_lo[j].min(hull[j].lo());
+                over_hi[j] = over_hi[j].max(hull[j].hi());
+            }
+            self.faces(piece.times, &mut dlo, &mut dhi);
+            let f = &self.field;
+            let jac = &mut self.scratch.jac;
+            f.sys
+                .jac_x_sparse_interval(&hull, &f.ubox, piece.times, jac);
             for i in 0..n {
-                let end_lo = (Interval::point(lo[i]) + h * Interval::point(dlo[i])).lo();
-                let end_hi = (Interval::point(hi[i]) + h * Interval::point(dhi[i])).hi();
-                if !(end_lo.is_finite() && end_hi.is_finite()) {
+                slope[i] = -over.d2p[i];
+                slope[n + i] = -over.d2p[n + i];
+            }
+            for (&(i, j), &jij) in f.pattern.iter().zip(jac.iter()) {
+                if i == j {
+                    slope[i] += jij * over.dp[i];
+                    slope[n + i] += jij * over.dp[n + i];
+                } else {
+                    let v = jij * rate[j];
+                    slope[i] += v;
+                    slope[n + i] += v;
+                }
+            }
+            for i in 0..n {
+                // f_i - q_lo_i' on the lower face, q_hi_i' - f_i on the upper: >= 0 wanted.
+                let low = Interval::point(dlo[i]) - mid.dp[i] + slope[i] * piece.offset;
+                let up = mid.dp[n + i] - Interval::point(dhi[i]) - slope[n + i] * piece.offset;
+                if !(low.lo().is_finite() && up.lo().is_finite()) {
                     return None;
                 }
-                let slack = |a: f64, b: f64| 0.25 * (a - b).abs() + 1e-15 * (1.0 + a.abs());
-                let pin_lo = Interval::try_new(
-                    lo[i].min(end_lo) - slack(lo[i], end_lo),
-                    lo[i].max(end_lo) + slack(lo[i], end_lo),
-                )?;
-                let pin_hi = Interval::try_new(
-                    hi[i].min(end_hi) - slack(hi[i], end_hi),
-                    hi[i].max(end_hi) + slack(hi[i], end_hi),
-                )?;
-                let s = &mut self.scratch;
-                s.pin_lo[i] = s.pin_lo[i].hull(pin_lo);
-                s.pin_hi[i] = s.pin_hi[i].hull(pin_hi);
-                s.bx[i] = s.bx[i].hull(s.pin_lo[i]).hull(s.pin_hi[i]);
-            }
-            self.faces(times, &mut dlo, &mut dhi);
-            // The new ends, and the check: each end inside its pin, both boxes inside bx.
-            let mut closed = true;
-            for i in 0..n {
-                nlo[i] = (Interval::point(lo[i]) + h * Interval::point(dlo[i])).lo();
-                nhi[i] = (Interval::point(hi[i]) + h * Interval::point(dhi[i])).hi();
-                let s = &self.scratch;
-                closed &= s.pin_lo[i].contains(nlo[i])
-                    && s.pin_hi[i].contains(nhi[i])
-                    && s.bx[i].contains(nlo[i].min(lo[i]))
-                    && s.bx[i].contains(nhi[i].max(hi[i]));
-            }
-            if closed {
-                // A sound embedding keeps lo <= hi; rounding aside, order the ends.
-                let (l, u) = nlo
-                    .iter()
-                    .zip(&nhi)
-                    .map(|(&a, &b)| (a.min(b), a.max(b)))
-                    .unzip();
-                return Some((l, u));
+                deficit[i] = deficit[i].max(-low.lo());
+                deficit[n + i] = deficit[n + i].max(-up.lo());
             }
         }
+        let widen = self.widening(&deficit, &over_lo, &over_hi, t, t1)?;
+        let end = cubic.end();
+        let out = |a: Interval, e: f64, up: bool| {
+            let e = Interval::point(e);
+            if up {
+                (a + e).hi()
+            } else {
+                (a - e).lo()
+            }
+        };
+        Some(Validated {
+            lo: (0..n).map(|i| out(end[i], widen[i], false)).collect(),
+            hi: (0..n)
+                .map(|i| out(end[n + i], widen[n + i], true))
+                .collect(),
+            end_lo: (0..n).map(|i| end[i].lo()).collect(),
+            end_hi: (0..n).map(|i| end[n + i].hi()).collect(),
+            over_lo: (0..n)
+                .map(|i| out(Interval::point(over_lo[i]), widen[i], false))
+                .collect(),
+            over_hi: (0..n)
+                .map(|i| out(Interval::point(over_hi[i]), widen[n + i], true))
+                .collect(),
+        })
+    }
+
+    /// The widening `e(t1)` of each face (lower `i`, upper `n + i`) that absorbs the deficits
+    /// on `[t, t1]`: with `e_i(s) = (deficit_i + nu E) (s - t)` and `E >= max e(t1)`,
+    /// `e_i' >= deficit_i + sum_j M_ij e_j`, where `nu` bounds the rows of the Metzler matrix
+    /// `M` (`max(J_ii, 0)`, `|J_ij|` off the diagonal) over the widened hull of the step. `None`
+    /// when the step is too long for that (`nu (t1 - t) > 1/2`).
+    fn widening(
+        &mut self,
+        deficit: &[f64],
+        over_lo: &[f64],
+        over_hi: &[f64],
+        t: f64,
+        t1: f64,
+    ) -> Option<Vec<f64>> {
+        let n = over_lo.len();
+        let dmax = deficit.iter().fold(0.0f64, |m, &d| m.max(d));
+        if dmax == 0.0 {
+            return Some(vec![0.0; 2 * n]);
+        }
+        let h = Interval::point(t1) - Interval::point(t);
+        let times = Interval::point(t).hull(Interval::point(t1));
+        let mut guess = (Interval::point(4.0 * dmax) * h).hi();
+        for _ in 0..4 {
+            let (f, s) = (&self.field, &mut self.scratch);
+            let g = Interval::new(-guess, guess);
+            for j in 0..n {
+                s.bx[j] = Interval::new(over_lo[j], over_hi[j]) + g;
+            }
+            f.sys
+                .jac_x_sparse_interval(&s.bx, &f.ubox, times, &mut s.jac);
+            let mut rows = vec![Interval::ZERO; n];
+            for (&(i, j), &jij) in f.pattern.iter().zip(&s.jac) {
+                rows[i] += if i == j {
+                    Interval::point(jij.hi().max(0.0))
+                } else {
+                    Interval::point(jij.mag())
+                };
+            }
+            let nu = rows.iter().fold(Interval::ZERO, |m, r| m.max(*r));
+            let nu_h = nu * h;
+            if !(nu_h.hi() <= 0.5) {
+                return None;
+            }
+            // E = dmax h / (1 - nu h) solves E = (dmax + nu E) h.
+            let e_max = (Interval::point(dmax) * h / (Interval::ONE - nu_h)).hi();
+            if e_max <= guess {
+                let grow = Interval::point(nu.hi()) * Interval::point(e_max);
+                return Some(
+                    deficit
+                        .iter()
+                        .map(|&d| ((Interval::point(d) + grow) * h).hi())
+                        .collect(),
+                );
+            }
+            guess = 2.0 * e_max;
+        }
         None
+    }
+}
+
+/// A validated step before it is placed on the grid.
+struct Validated {
+    /// The box at the end.
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    /// The RK4 step's end (what the box would be without validation).
+    end_lo: Vec<f64>,
+    end_hi: Vec<f64>,
+    /// A box holding the boxes of the whole step.
+    over_lo: Vec<f64>,
+    over_hi: Vec<f64>,
+}
+
+impl Validated {
+    fn into_box(self, t1: f64, interval: usize) -> BoxStep {
+        BoxStep {
+            t1,
+            interval,
+            lo: self.lo,
+            hi: self.hi,
+            over_lo: self.over_lo,
+            over_hi: self.over_hi,
+        }
     }
 }
 

@@ -26,15 +26,13 @@
 //! integrated numerically (RK4 or Euler, no remainder bound), so the box is an enclosure only
 //! up to the time-discretisation error. The result says so.
 
-use super::assemble::{assemble, Deterministic, Header, Piece};
+use super::assemble::{assemble, constants_used, Deterministic, Header, Piece};
 use super::embedding::{BoxStep, Embedding};
 use super::transform::{self, Frame};
 use super::{nominal, radius, validate, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
-use crate::prs::{
-    ConstantsUsed, DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, TransformUsed, Unproved,
-};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, TransformUsed, Unproved};
 use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
@@ -104,13 +102,12 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
             Piece {
                 t1: step.t1,
                 rates: (consts.c, consts.sigma),
-                report: step.t1 == grid[step.interval + 1],
                 over: Span {
                     lo,
                     hi,
                     radius: 0.0,
                 },
-                end: det_set((step.lo, step.hi)),
+                end: (step.t1 == grid[step.interval + 1]).then(|| det_set((step.lo, step.hi))),
             }
         })
         .collect();
@@ -159,13 +156,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
             rate: Rate::Certified,
             max_c: consts.c,
         },
-        constants: ConstantsUsed {
-            c: consts.c,
-            sigma: consts.sigma,
-            rho: consts.rho,
-            provenance: consts.provenance.clone(),
-            metric: metric.clone(),
-        },
+        constants: constants_used(run, consts.rho),
         radius_rule,
         kappa,
         r1,
@@ -270,7 +261,14 @@ fn boxes(
     }
     let mut embedding = Embedding::new(emb_sys, inclusion);
     let steps = if spec.integrator == Integrator::Validated {
-        embedding.validated(&lo, &hi, grid, inputs)?
+        // Validation may add about 1% to each box over the horizon.
+        embedding.validated(
+            &lo,
+            &hi,
+            grid,
+            inputs,
+            1e-2 / spec.horizon.max(f64::MIN_POSITIVE),
+        )?
     } else {
         embedding
             .integrate(&lo, &hi, grid, inputs, spec.integrator)

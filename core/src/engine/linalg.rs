@@ -139,18 +139,6 @@ pub(crate) fn inverse_diagonal(l: &[Interval], n: usize) -> Vec<Interval> {
         .collect()
 }
 
-/// Upper bounds of `sqrt((P^-1)_ii)` for a metric `P` (`n x n` row-major): `B_P(r)` lies in the
-/// box `|d_i| <= r w_i`. `None` if `P` is not certifiably positive definite.
-pub(crate) fn inverse_diagonal_sqrt(p: &[f64], n: usize) -> Option<Vec<f64>> {
-    let l = cholesky(&to_intervals(p), n)?;
-    Some(
-        inverse_diagonal(&l, n)
-            .iter()
-            .map(|d| d.sqrt().hi())
-            .collect(),
-    )
-}
-
 /// Eigenvalues of a symmetric `f64` matrix by the cyclic Jacobi method (an estimate only; the
 /// callers verify what they use).
 pub(crate) fn jacobi_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {

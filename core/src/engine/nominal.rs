@@ -20,25 +20,37 @@ pub(crate) fn time_grid(horizon: f64, step: f64) -> Vec<f64> {
 
 /// One classical Runge-Kutta step of length `h` from `x` at `t` with the input `u` held.
 pub(crate) fn rk4(sys: &dyn System, x: &[f64], u: &[f64], t: f64, h: f64) -> Vec<f64> {
+    rk4_step(&mut |x, t, out| sys.drift(x, u, t, out), x, t, h).0
+}
+
+/// One classical Runge-Kutta step of length `h` of `x' = rhs(x, t)` from `x` at `t`: the end
+/// and the slope at the start.
+pub(crate) fn rk4_step(
+    rhs: &mut dyn FnMut(&[f64], f64, &mut [f64]),
+    x: &[f64],
+    t: f64,
+    h: f64,
+) -> (Vec<f64>, Vec<f64>) {
     let n = x.len();
     let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut tmp = vec![0.0; n];
-    sys.drift(x, u, t, &mut k1);
+    rhs(x, t, &mut k1);
     for i in 0..n {
         tmp[i] = x[i] + 0.5 * h * k1[i];
     }
-    sys.drift(&tmp, u, t + 0.5 * h, &mut k2);
+    rhs(&tmp, t + 0.5 * h, &mut k2);
     for i in 0..n {
         tmp[i] = x[i] + 0.5 * h * k2[i];
     }
-    sys.drift(&tmp, u, t + 0.5 * h, &mut k3);
+    rhs(&tmp, t + 0.5 * h, &mut k3);
     for i in 0..n {
         tmp[i] = x[i] + h * k3[i];
     }
-    sys.drift(&tmp, u, t + h, &mut k4);
-    (0..n)
+    rhs(&tmp, t + h, &mut k4);
+    let x1 = (0..n)
         .map(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
-        .collect()
+        .collect();
+    (x1, k1)
 }
 
 /// Integrates `x' = f(x, u_k, t)` over the grid with one step of the (unvalidated) integrator

@@ -166,8 +166,8 @@ pub(crate) fn initial_center_and_halfwidths(
 /// Upper bound of `max |d|_P` over the box `|d_i| <= h_i` (P row-major `n x n`).
 ///
 /// `d' P d` is convex in `d`, so its maximum over the box is attained at a vertex. With at most
-/// [`MAX_VERTEX_COORDS`] coordinates of non-zero width every vertex is evaluated (in interval
-/// arithmetic); otherwise `d' P d <= sum_ij |P_ij| h_i h_j` is used. The square root is
+/// [`MAX_VERTEX_COORDS`] coordinates of non-zero width every vertex is evaluated (in f64 with a
+/// rigorous bound of the rounding error); otherwise `d' P d <= sum_ij |P_ij| h_i h_j` is used. The square root is
 /// rounded up.
 pub(crate) fn r1_bound(p: &[f64], half: &[f64]) -> f64 {
     BoxRadius::new(p, half.len()).bound(half)
@@ -211,35 +211,48 @@ impl<'a> BoxRadius<'a> {
                 });
             return Interval::point(sum.hi().max(0.0)).sqrt().hi();
         }
-        // q_ab = P_ij h_i h_j over the active coordinates.
-        let mut q = vec![Interval::ZERO; k * k];
+        // q_ab = P_ij h_i h_j over the active coordinates in f64 (relative error <= 2u each),
+        // an upper bound of sum |q_ab|, and whether q is diagonal.
+        let mut q = vec![0.0; k * k];
+        let mut abs_sum = Interval::ZERO;
+        let mut diagonal = true;
         for (a, &i) in active.iter().enumerate() {
             for (b, &j) in active.iter().enumerate() {
-                q[a * k + b] = Interval::point(p[i * n + j])
+                let v = p[i * n + j] * half[i] * half[j];
+                q[a * k + b] = v;
+                abs_sum += Interval::point(v.abs());
+                diagonal &= a == b || v == 0.0;
+            }
+        }
+        let max_sq = if diagonal {
+            // Every vertex gives sum_a q_aa.
+            active.iter().fold(Interval::ZERO, |acc, &i| {
+                acc + Interval::point(p[i * n + i])
                     * Interval::point(half[i])
-                    * Interval::point(half[j]);
-            }
-        }
-        // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the same value,
-        // so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
-        let mut max_sq = f64::NEG_INFINITY;
-        for bits in 0u32..(1u32 << (k - 1)) {
-            let sign = |a: usize| a == 0 || (bits >> (a - 1)) & 1 == 0;
-            let mut s = Interval::ZERO;
-            for a in 0..k {
-                s += q[a * k + a];
-                for b in a + 1..k {
-                    let term = q[a * k + b] + q[b * k + a];
-                    if sign(a) == sign(b) {
-                        s += term;
+                    * Interval::point(half[i])
+            })
+        } else {
+            // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the
+            // same value, so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
+            let mut max_sq = f64::NEG_INFINITY;
+            for bits in 0u32..(1u32 << (k - 1)) {
+                let sign = |a: usize| {
+                    if a == 0 || (bits >> (a - 1)) & 1 == 0 {
+                        1.0
                     } else {
-                        s -= term;
+                        -1.0
                     }
-                }
+                };
+                let s: f64 = (0..k)
+                    .map(|a| sign(a) * (0..k).map(|b| sign(b) * q[a * k + b]).sum::<f64>())
+                    .sum();
+                max_sq = max_sq.max(s);
             }
-            max_sq = max_sq.max(s.hi());
-        }
-        Interval::point(max_sq.max(0.0)).sqrt().hi()
+            // Each vertex value is a sum of k^2 terms +-q_ab: its error (the products' and
+            // the sums') is below (k^2 + 2) u sum |q_ab|, within the margin with a factor 2.
+            Interval::point(max_sq) + abs_sum * Interval::point((k * k + 2) as f64 * f64::EPSILON)
+        };
+        Interval::point(max_sq.hi().max(0.0)).sqrt().hi()
     }
 }
 

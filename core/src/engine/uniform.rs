@@ -134,26 +134,48 @@ impl Tube {
     }
 
     /// An upper bound of the root `z` of `ln Phi_n(z) = lambda^2 S / 2 + ln(1/delta_k)`
-    /// (increasing in `S`): bisection keeping an upper end where the certified lower bound of
-    /// `ln Phi_n` already reaches the target.
+    /// (increasing in `S`): a bracket `[lo, hi]` whose upper end the certified lower bound of
+    /// `ln Phi_n` already lifts above the target, narrowed by regula falsi (Illinois) to a
+    /// relative width of `1e-12`.
     fn root(&self, e: &Epoch, s: f64) -> f64 {
         let lambda = Interval::point(e.lambda);
         let target = (lambda.sqr() * Interval::point(s) * Interval::point(0.5)
             + Interval::point(e.log_inv_delta))
         .hi();
-        let reaches = |z: f64| log_phi_lower(self.n, z) >= target;
-        // ln Phi_n(z) <= z: the root is at least the target.
-        let (mut lo, mut hi) = (0.0, target.max(1.0));
-        while !reaches(hi) {
-            lo = hi;
+        // Increasing in z; >= 0 at an upper bound of the root.
+        let gap = |z: f64| log_phi_lower(self.n, z) - target;
+        // ln Phi_n(0) = 0 < target, and ln Phi_n(z) <= z: the root is at least the target.
+        let (mut lo, mut g_lo) = (0.0, -target);
+        let mut hi = target.max(1.0);
+        let mut g_hi = gap(hi);
+        while g_hi < 0.0 {
+            (lo, g_lo) = (hi, g_hi);
             hi *= 2.0;
+            g_hi = gap(hi);
         }
-        while hi - lo > 1e-12 * hi {
-            let mid = 0.5 * (lo + hi);
-            if reaches(mid) {
-                hi = mid;
+        let mut last = 0i8;
+        for _ in 0..200 {
+            if hi - lo <= 1e-12 * hi {
+                break;
+            }
+            let mut z = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+            if !(z > lo && z < hi) {
+                z = 0.5 * (lo + hi);
+            }
+            let g = gap(z);
+            if g >= 0.0 {
+                (hi, g_hi) = (z, g);
+                // The same end twice: halve the other's weight (Illinois).
+                if last == 1 {
+                    g_lo *= 0.5;
+                }
+                last = 1;
             } else {
-                lo = mid;
+                (lo, g_lo) = (z, g);
+                if last == -1 {
+                    g_hi *= 0.5;
+                }
+                last = -1;
             }
         }
         hi

@@ -34,10 +34,18 @@ fn sizes_and_diffusion_follow_the_spec() {
 }
 
 #[test]
-fn info_lists_the_two_analyses() {
+fn info_lists_the_analyses() {
     let info = info();
     assert_eq!(info.name, "pendulum");
     assert_eq!(info.states, ["theta", "omega"]);
     let names: Vec<&str> = info.analyses.iter().map(|a| a.spec.name.as_str()).collect();
-    assert_eq!(names, ["contraction", "interval"]);
+    assert_eq!(
+        names,
+        [
+            "contraction",
+            "interval",
+            "paper_contraction",
+            "paper_interval"
+        ]
+    );
 }

@@ -42,11 +42,14 @@ fn a_sweep_of_equal_boxes_has_equal_initial_radii() {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs();
     assert!(prs.windows(2).all(|w| close(w[0].r1, w[1].r1)));
     assert!(prs[0].r1 > 0.0);
-    // Nominals differ, radii agree (a global rate: R_t depends on r1 only).
+    // Nominals differ, stochastic radii agree (a global rate: r_t depends on the constants
+    // only); so do the PRS radii up to the validated nominal's defect bound, which the engine
+    // keeps near 1% of the PRS.
     let at5: Vec<_> = prs.iter().map(|p| p.at(5.0).unwrap()).collect();
+    assert!(at5.windows(2).all(|w| close(w[0].r_t, w[1].r_t)));
     assert!(at5
         .windows(2)
-        .all(|w| close(w[0].prs_radius, w[1].prs_radius)));
+        .all(|w| (w[0].prs_radius - w[1].prs_radius).abs() <= 0.02 * w[0].prs_radius));
     assert!(at5[0].nominal()[0] < 0.0 && at5[2].nominal()[0] > 0.0);
 }
 
