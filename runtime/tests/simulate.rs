@@ -139,6 +139,9 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
             delta,
             horizon: 1.5,
             step: 0.01,
+            // These tests are about the paths: an RK4 nominal (the engine's validated nominal
+            // refuses a non-zero initial box of these systems at t = 0 for now).
+            integrator: Integrator::Rk4,
             ..AnalysisSpec::default()
         },
         constants: Ok(constants),
@@ -306,19 +309,26 @@ fn simulated_paths_are_the_recorded_sample_paths() {
     }
 }
 
-/// A PRS computed with half the true noise level is too small: the coverage check fails, and
-/// a PRS shrunk after the fact as well. The correct one passes.
+/// A pointwise PRS computed with half the true noise level is too small: the coverage check
+/// fails, and a PRS shrunk after the fact as well. The correct one passes. The same for a
+/// time-uniform tube, decided by the paths leaving it.
 #[test]
 fn a_too_small_prs_fails_the_coverage_check() {
     let opts = Options {
         paths: 5_000,
         ..Options::default()
     };
-    let good = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 1.0);
+    // The pointwise semantics (the tube's radii are larger: see below).
+    let pointwise = |mut info: ModelInfo| {
+        info.analyses[0].spec.guarantee = Guarantee::Pointwise;
+        info
+    };
+    let good = pointwise(info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 1.0));
     let r = run(&LINEAR, &good);
-    assert!(simulate(&LINEAR, &good, &r, &opts).passed());
+    let rep = simulate(&LINEAR, &good, &r, &opts);
+    assert!(rep.passed() && rep.tube.is_none());
 
-    let wrong = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 0.5);
+    let wrong = pointwise(info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 0.5));
     let rep = simulate(&LINEAR, &wrong, &run(&LINEAR, &wrong), &opts);
     assert!(!rep.passed());
     // Half the radius: with r_t about q_0.99 / 0.86 (the amgf rule's slack at n = 2),
@@ -341,6 +351,134 @@ fn a_too_small_prs_fails_the_coverage_check() {
     let rep = simulate(&LINEAR, &good, &shrunk, &opts);
     assert!(!rep.passed());
     assert!(rep.verdict.worst_cp_lower > 0.01, "{:?}", rep.verdict);
+
+    // Time-uniform (the default): the correct tube holds, few paths leave it.
+    let good = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 1.0);
+    let rep = simulate(&LINEAR, &good, &run(&LINEAR, &good), &opts);
+    let tube = rep.tube.clone().unwrap();
+    assert!(rep.passed() && tube.fraction < 0.002, "{}", summary(&rep));
+    // Half the noise: a quarter of the variance, so the tube's radius is too small by a factor
+    // 2 at every time, and most paths leave it; the verdict is the tube's.
+    let wrong = info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 0.5);
+    let rep = simulate(&LINEAR, &wrong, &run(&LINEAR, &wrong), &opts);
+    let tube = rep.tube.clone().unwrap();
+    assert!(!rep.passed() && tube.cp_lower > 0.5, "{}", summary(&rep));
+    assert_eq!(rep.verdict.decided_by, Guarantee::Uniform);
+}
+
+/// The JSON and the summary say what was checked: for a uniform result the tube (all times
+/// at once, every Euler-Maruyama step) decides, its count is the per-interval first exits'
+/// sum, and the pointwise sentence is absent; a pointwise result keeps every field it had
+/// (plus `guarantee`, `outside_tube: null` and the verdict's `decided_by` and
+/// `pointwise_status`) and its sentence.
+#[test]
+fn reports_say_what_was_checked() {
+    let sys = DRIVEN;
+    let uniform = info(&sys, 0.5, 0.2, 0.3, 0.05, 1.0);
+    let mut pointwise = uniform.clone();
+    pointwise.analyses[0].spec.guarantee = Guarantee::Pointwise;
+    let opts = Options {
+        paths: 2_000,
+        seed: 3,
+        dt: Some(0.0025),
+        ..Options::default()
+    };
+    // The tube narrowed between report times: paths leave it.
+    let mut narrow = run(&sys, &uniform);
+    for st in &mut narrow.steps[1..] {
+        st.span.radius *= 0.5;
+    }
+    let rep = simulate(&sys, &uniform, &narrow, &opts);
+    let v: serde_json::Value = serde_json::from_str(&to_json(&rep)).unwrap();
+    assert_eq!(v["guarantee"], "uniform");
+    let tube = &v["outside_tube"];
+    let count = tube["count"].as_u64().unwrap();
+    assert!(count > 100 && count < 2_000, "{tube}");
+    assert_eq!(tube["fraction"], count as f64 / 2_000.0);
+    let (lower, upper) = (
+        tube["cp_lower"].as_f64().unwrap(),
+        tube["cp_upper"].as_f64().unwrap(),
+    );
+    assert!(lower < count as f64 / 2_000.0 && count as f64 / 2_000.0 < upper);
+    assert_eq!(tube["checks_per_path"], 601);
+    assert!(tube["checked"]
+        .as_str()
+        .unwrap()
+        .contains("every Euler-Maruyama step"));
+    let steps = v["steps"].as_array().unwrap();
+    let left: u64 = steps.iter().map(|s| s["left_tube"].as_u64().unwrap()).sum();
+    assert_eq!(left, count);
+    assert_eq!(v["verdict"]["status"], "fail");
+    assert_eq!(v["verdict"]["decided_by"], "uniform");
+    assert_eq!(v["verdict"]["pointwise_status"], "pass");
+    let text = summary(&rep);
+    assert!(text.contains("uniform guarantee"), "{text}");
+    assert!(
+        text.contains(&format!("tube, all times at once: {count} paths"))
+            && text.contains("checked at every Euler-Maruyama step (601 states per path)"),
+        "{text}"
+    );
+    assert!(text.contains("coverage: FAIL (uniform: "), "{text}");
+    assert!(!text.contains("each time separately"), "{text}");
+
+    let r = run(&sys, &pointwise);
+    let rep = simulate(&sys, &pointwise, &r, &opts);
+    let v: serde_json::Value = serde_json::from_str(&to_json(&rep)).unwrap();
+    let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    for key in [
+        "model",
+        "analysis",
+        "method",
+        "delta",
+        "paths",
+        "seed",
+        "dt",
+        "steps_per_path",
+        "initial_states",
+        "inputs",
+        "noise",
+        "compared",
+        "quantile_rank",
+        "confidence",
+        "steps",
+        "horizon",
+        "unsafe_sets",
+        "left_domain",
+        "diverged",
+        "verdict",
+    ] {
+        assert!(keys.contains(&key), "{key}");
+    }
+    assert_eq!(v["guarantee"], "pointwise");
+    assert!(v["outside_tube"].is_null());
+    let step_keys: Vec<&str> = v["steps"][1]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    // (Sorted: serde_json's map.)
+    assert_eq!(
+        step_keys,
+        [
+            "cp_upper",
+            "fraction",
+            "max",
+            "outside",
+            "prs_radius",
+            "quantile",
+            "r_t",
+            "t"
+        ]
+    );
+    assert_eq!(v["verdict"]["status"], "pass");
+    assert_eq!(v["verdict"]["decided_by"], "pointwise");
+    let text = summary(&rep);
+    assert!(
+        text.contains("the PRS bounds each time separately"),
+        "{text}"
+    );
+    assert!(!text.contains("tube"), "{text}");
 }
 
 fn cli(info: &ModelInfo, args: &[&str]) -> (u8, String, String) {

@@ -198,6 +198,35 @@ impl Group8 {
         let loud = _mm512_cmp_pd_mask::<_CMP_NLT_UQ>(q, _mm512_set1_pd(bound));
         (to_x8(q), loud)
     }
+
+    /// The mask of the lanes where `q < bound` is false (NaN included), `q = sum_i w_i (x_i -
+    /// y_i)^2` with `y_i` the state clamped into `[lo_i, hi_i]`: per lane, what
+    /// [`diag_quad_to_box`](super::prs::diag_quad_to_box) computes, to the bit.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    pub(crate) fn outside_box(
+        &self,
+        n: usize,
+        w: &[f64],
+        lo: &[f64],
+        hi: &[f64],
+        bound: f64,
+    ) -> u8 {
+        let mut q = _mm512_setzero_pd();
+        for i in 0..n {
+            let x = self.x[i];
+            let (l, u) = (_mm512_set1_pd(lo[i]), _mm512_set1_pd(hi[i]));
+            // `clamp`: above `hi` takes `hi`, then below `lo` takes `lo` (so `lo` wins, as in
+            // the scalar `if`s); NaN compares false and stays.
+            let above = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(x, u);
+            let below = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(x, l);
+            let y = _mm512_mask_blend_pd(below, _mm512_mask_blend_pd(above, x, u), l);
+            let d = _mm512_sub_pd(x, y);
+            let t = _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(w[i]), d), d);
+            q = if i == 0 { t } else { _mm512_add_pd(q, t) };
+        }
+        _mm512_cmp_pd_mask::<_CMP_NLT_UQ>(q, _mm512_set1_pd(bound))
+    }
 }
 
 #[inline]
@@ -254,5 +283,51 @@ mod tests {
         // SAFETY: eight u64 are the vector's 64 bytes.
         let states: [u64; 8] = unsafe { std::mem::transmute(lanes.0) };
         assert_eq!(states, scalar.map(PathRng::state));
+    }
+
+    /// The lanes' distance to a box is the scalar `diag_quad_to_box`, and so is the decision
+    /// against the bound: random states inside, outside and on the faces of a box, with
+    /// states far away, infinite and NaN, and the bound at the lanes' own values.
+    #[test]
+    fn lanes_measure_the_distance_to_a_box_as_the_scalar_loop() {
+        use super::super::prs::diag_quad_to_box;
+        if !available() {
+            eprintln!("no AVX-512: nothing to compare");
+            return;
+        }
+        let mut rng = PathRng::new(4, 0);
+        let (w, lo, hi) = ([2.0, 0.5, 1.0], [-1.0, 0.0, 0.25], [1.0, 0.0, 0.75]);
+        let special = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -0.0, 0.0, 1e300];
+        let mut loud = 0;
+        for round in 0..2000 {
+            let n = 1 + round % 3;
+            let x: Vec<f64> = (0..8 * n)
+                .map(|v| match (round + v) % 11 {
+                    0 => special[(round / 11 + v) % special.len()],
+                    1 => [lo[v % n], hi[v % n]][round % 2],
+                    _ => 4.0 * rng.uniform() - 2.0,
+                })
+                .collect();
+            let paths = [PathRng::new(0, 0); 8];
+            // SAFETY: `available()`.
+            let group = unsafe { Group8::new(n, &x, paths) };
+            let q: Vec<f64> = (0..8)
+                .map(|l| diag_quad_to_box(&w[..n], &x[l * n..][..n], &lo, &hi))
+                .collect();
+            for bound in [q[round % 8], 0.5, f64::INFINITY] {
+                // SAFETY: `available()`.
+                let mask = unsafe { group.outside_box(n, &w, &lo, &hi, bound) };
+                for (l, q) in q.iter().enumerate() {
+                    let scalar = q.partial_cmp(&bound) != Some(std::cmp::Ordering::Less);
+                    assert_eq!(
+                        mask >> l & 1 == 1,
+                        scalar,
+                        "round {round}, lane {l}, q = {q}"
+                    );
+                    loud += u32::from(scalar);
+                }
+            }
+        }
+        assert!(loud > 1000, "{loud}");
     }
 }

@@ -5,10 +5,21 @@
 //! state `X_{t_k}` lies outside the PRS (decided by [`Prs::contains_at`](crate::prs::Prs::contains_at))
 //! and computes the empirical `(1 - delta)` quantile of `|X_{t_k} - x*_{t_k}|_P` (the P-norm of
 //! the analysis' metric around the result's centre `steps[k].nominal()`), to be read against the
-//! PRS radius and `r_t`. The coverage check fails when some time's violation probability is,
-//! with confidence, above `delta` (Clopper-Pearson lower bound, Bonferroni over the report
-//! times). A PRS holds `X_t` with probability `1 - delta` at each time `t`; it says nothing
-//! about whole paths, so the horizon-wide count is reported but not checked.
+//! PRS radius and `r_t`.
+//!
+//! What the coverage check tests follows the result's [`Guarantee`]:
+//!
+//! * uniform (one event of probability `>= 1 - delta` on which the path stays in the tube at
+//!   all times): every path's state after every Euler-Maruyama step of report interval
+//!   `(t_{k-1}, t_k]` is checked against the tube over that interval (the span `k`, decided by
+//!   [`Prs::span_contains`](crate::prs::Prs::span_contains) with shortcuts), the initial state
+//!   against span 0, and the states at report times against their PRS too. The check fails when
+//!   the one-sided Clopper-Pearson lower bound of the fraction of paths that left the tube
+//!   exceeds `delta` (one event: no correction for multiplicity);
+//! * pointwise (each `X_t` with probability `1 - delta` separately): it fails when some report
+//!   time's violation probability is, with confidence, above `delta` (Clopper-Pearson lower
+//!   bound, Bonferroni over the report times). Such a PRS says nothing about whole paths, so
+//!   the horizon-wide count is reported but not checked.
 //!
 //! Paths: initial states uniform in the initial set, inputs piecewise constant (uniform in the
 //! box, random corners, or the centre; see [`InputMode`]), one random stream per path derived
@@ -37,12 +48,12 @@ pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_
 pub use inputs::InputMode;
 pub use report::{
     Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SimReport, SimStep,
-    UnsafeHits,
+    TubeReport, UnsafeHits,
 };
-pub use sample::{sample_paths, MAX_SAMPLE_PATHS};
+pub use sample::{sample_paths, sample_substeps, Substeps, MAX_SAMPLE_PATHS};
 pub use workers::thread_count;
 
-use crate::model::ModelInfo;
+use crate::model::{Guarantee, ModelInfo};
 use crate::prs::{Prs, UnsafeKind};
 use crate::system::System;
 use paths::{ChunkStats, Plan, Span};
@@ -259,12 +270,17 @@ fn make_plan<'a, S: System + ?Sized>(
         .map(|u| regions::Region::unsafe_set(&u.shape, n))
         .collect::<Result<Vec<_>, _>>()
         .map_err(SimError::Invalid)?;
+    let tube = match result.guarantee {
+        Guarantee::Uniform => Some(prs::Tube::new(result, &metric).map_err(SimError::Invalid)?),
+        Guarantee::Pointwise => None,
+    };
     Ok(Plan {
         sys,
         seed: opts.seed,
         spans,
         nominal,
         membership: prs::Membership::new(result, &metric),
+        tube,
         metric,
         // The paths start where the sets start.
         initial: initial::InitialSampler::new(&result.initial, n).map_err(SimError::Invalid)?,
@@ -323,6 +339,7 @@ fn report<S: System + ?Sized>(
                 outside,
                 fraction: frac(outside),
                 cp_upper: upper(outside),
+                left_tube: plan.tube.is_some().then_some(total.left_tube[k]),
             }
         })
         .collect();
@@ -342,6 +359,21 @@ fn report<S: System + ?Sized>(
             })
         })
         .count();
+    let pointwise_passed = failing_steps == 0;
+    let tube = plan.tube.as_ref().map(|_| {
+        let outside = total.outside_tube;
+        TubeReport {
+            outside,
+            fraction: frac(outside),
+            cp_upper: binomial::upper_bound(outside, n_paths, alpha),
+            cp_lower: binomial::lower_bound(outside, n_paths, alpha),
+            checks_per_path: plan.steps_per_path() + 1,
+        }
+    });
+    let (passed, decided_by) = match &tube {
+        Some(t) => (t.cp_lower <= result.delta, Guarantee::Uniform),
+        None => (pointwise_passed, Guarantee::Pointwise),
+    };
     let hold = (!info.input_box.is_empty() && opts.inputs != InputMode::Centre)
         .then(|| opts.hold.unwrap_or(result.step));
     let dt = plan.spans.iter().map(|s| s.h).fold(0.0, f64::max);
@@ -350,6 +382,7 @@ fn report<S: System + ?Sized>(
         analysis: result.analysis.clone(),
         method: result.method,
         delta: result.delta,
+        guarantee: result.guarantee,
         paths: n_paths,
         seed: opts.seed,
         dt,
@@ -370,6 +403,7 @@ fn report<S: System + ?Sized>(
             fraction: frac(total.outside_any),
             cp_upper: binomial::upper_bound(total.outside_any, n_paths, alpha),
         },
+        tube,
         unsafe_sets: info
             .unsafe_sets
             .iter()
@@ -385,7 +419,9 @@ fn report<S: System + ?Sized>(
         left_domain: info.has_domain.then_some(total.left_domain),
         diverged: total.diverged,
         verdict: Coverage {
-            passed: failing_steps == 0,
+            passed,
+            decided_by,
+            pointwise_passed,
             alpha,
             alpha_per_step: alpha_step,
             failing_steps,
@@ -478,8 +514,16 @@ mod tests {
         }
     }
 
-    /// With `b != 0`: an input in `[-0.5, 0.5]` and an unsafe half-space `x1 >= 0.4`.
+    /// With `b != 0`: an input in `[-0.5, 0.5]` and an unsafe half-space `x1 >= 0.4`; the
+    /// identity metric.
     fn info(b: f64) -> ModelInfo {
+        info_in(b, vec![1.0, 0.0, 0.0, 1.0])
+    }
+
+    /// [`info`] with the metric `metric` (`2 x 2`, row-major). The analysis is time-uniform
+    /// (the default) with an RK4 nominal: these tests are about the paths, and the validated
+    /// nominal of the engine refuses these systems at t = 0 for now.
+    fn info_in(b: f64, metric: Vec<f64>) -> ModelInfo {
         let inputs = b != 0.0;
         let mut info = ModelInfo {
             name: "m".into(),
@@ -510,14 +554,15 @@ mod tests {
             },
             analyses: vec![],
         };
-        // |(b u, b u)| <= sqrt(2) |b| / 2 over the input box.
-        let constants = Constants::given(&info, vec![1.0, 0.0, 0.0, 1.0], -1.0, 0.3, b.abs());
+        // |(b u, b u)| <= sqrt(2) |b| / 2 over the input box; mu_P(-I) = -1 in any metric.
+        let constants = Constants::given(&info, metric, -1.0, 0.3, b.abs());
         info.analyses.push(Analysis {
             spec: AnalysisSpec {
                 name: "a".into(),
                 delta: 0.05,
                 horizon: 0.5,
                 step: 0.01,
+                integrator: Integrator::Rk4,
                 ..AnalysisSpec::default()
             },
             constants: Ok(constants),
@@ -529,7 +574,9 @@ mod tests {
     /// processor has them) and the baseline loops give the same statistics, in the fast loop
     /// for additive noise (`b = 0`) and in the general one (an input, an unsafe set, Euler
     /// steps finer than the report step); with every state recorded (no threshold) and with
-    /// the quiet bounds (only candidates and states near the PRS boundary recorded). 300 paths:
+    /// the quiet bounds (only candidates and states near the PRS boundary recorded); for the
+    /// time-uniform result as computed, with its spans narrowed (many paths leave the tube,
+    /// some at states near its boundary) and as a pointwise result (no tube). 300 paths:
     /// blocks of 64 and a last one of 44, whose last 4 paths are not a group of eight.
     #[test]
     fn the_extensions_do_not_change_the_paths() {
@@ -539,34 +586,283 @@ mod tests {
                 .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
             s
         };
-        for (b, threshold) in [
-            (0.0, f64::NEG_INFINITY),
-            (0.0, 0.05),
-            (1.0, f64::NEG_INFINITY),
+        let identity = vec![1.0, 0.0, 0.0, 1.0];
+        let skewed = vec![2.0, 0.7, 0.7, 1.0];
+        // The factor narrowing the spans: with an input, R_t and the spans are larger.
+        for (b, metric, threshold, factor) in [
+            (0.0, &identity, f64::NEG_INFINITY, 0.6),
+            (0.0, &identity, 0.05, 0.6),
+            (1.0, &identity, f64::NEG_INFINITY, 0.4),
+            (0.0, &skewed, 0.05, 0.6),
         ] {
-            let (sys, info) = (Sys { b }, info(b));
+            let (sys, info) = (Sys { b }, info_in(b, metric.clone()));
             let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let mut pointwise = r.clone();
+            pointwise.guarantee = Guarantee::Pointwise;
+            for (tube, r) in [
+                ("computed", r.clone()),
+                ("narrow", narrow(&r, factor)),
+                ("pointwise", pointwise),
+            ] {
+                let opts = Options {
+                    dt: Some(0.004),
+                    ..Options::default()
+                };
+                let mut plan = make_plan(&sys, &info, &r, &opts).unwrap();
+                let thresholds = vec![threshold; plan.times.len()];
+                let detected = sorted(plan.run_chunk(0..300, &thresholds));
+                plan.avx512 = false;
+                let avx2 = sorted(plan.run_chunk(0..300, &thresholds));
+                plan.avx2 = false;
+                let baseline = sorted(plan.run_chunk(0..300, &thresholds));
+                let case = format!("b = {b}, metric {metric:?}, threshold {threshold}, {tube}");
+                assert_eq!(detected, baseline, "{case}");
+                assert_eq!(avx2, baseline, "{case}");
+                let records = baseline.candidates.len();
+                if threshold < 0.0 {
+                    assert_eq!(records, 300 * plan.times.len());
+                } else {
+                    assert!(
+                        records > 0 && records < 300 * plan.times.len() / 2,
+                        "{records}"
+                    );
+                }
+                let left: u64 = baseline.left_tube.iter().sum();
+                assert_eq!(left, baseline.outside_tube, "{case}");
+                match tube {
+                    "computed" => assert!(baseline.outside_tube < 30, "{case}"),
+                    "narrow" => assert!(
+                        (30..270).contains(&baseline.outside_tube),
+                        "{case}: {}",
+                        baseline.outside_tube
+                    ),
+                    _ => assert_eq!(baseline.outside_tube, 0, "{case}"),
+                }
+            }
+        }
+    }
+
+    /// `r` with the radius of every span after `t = 0` scaled by `factor`: a tube too narrow
+    /// between report times (the PRS at the report times is unchanged).
+    fn narrow(r: &Prs, factor: f64) -> Prs {
+        let mut r = r.clone();
+        for st in &mut r.steps[1..] {
+            st.span.radius *= factor;
+        }
+        r
+    }
+
+    /// The paths that first left the tube of `r` in each report interval, recounted from every
+    /// Euler-Maruyama state ([`sample_substeps`]) with `Prs::span_contains` and, at report
+    /// times, `Prs::contains_at` alone; and how many of those first exits were at a state
+    /// between report times.
+    fn recount<S: System>(sys: &S, info: &ModelInfo, r: &Prs, opts: &Options) -> (Vec<u64>, u64) {
+        let times: Vec<f64> = r.steps.iter().map(|s| s.t).collect();
+        let fine = sample_substeps(sys, info, &times, Some(&r.initial_center), opts).unwrap();
+        let n = r.n();
+        let mut left = vec![0; times.len()];
+        let mut between = 0;
+        let outside = |k: usize, x: &[f64], report: bool| {
+            !x.iter().all(|v| v.is_finite())
+                || !r.span_contains(k, x)
+                || (report && !r.contains_at(k, x))
+        };
+        for path in &fine.paths {
+            let state = |i: usize| &path[i * n..][..n];
+            if outside(0, state(0), true) {
+                left[0] += 1;
+                continue;
+            }
+            let mut i = 1;
+            'path: for (k, &s) in (1..).zip(&fine.per_interval) {
+                for j in 0..s {
+                    if outside(k, state(i), j + 1 == s) {
+                        left[k] += 1;
+                        between += u64::from(j + 1 < s);
+                        break 'path;
+                    }
+                    i += 1;
+                }
+            }
+        }
+        (left, between)
+    }
+
+    /// One path, leaving a hand-made tube between two report times and coming back: span `k`
+    /// narrowed to a P-ball around the path's state at `t_k` with half the distance of the
+    /// path's farthest state in the interval. The tube check counts it (in interval `k`), while
+    /// every report-time check passes; with the tube as computed, the path never leaves.
+    #[test]
+    fn a_path_leaving_the_tube_between_report_times_is_counted() {
+        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let opts = Options {
+            paths: 1,
+            seed: 3,
+            dt: Some(0.001),
+            ..Options::default()
+        };
+        let times: Vec<f64> = r.steps.iter().map(|s| s.t).collect();
+        let fine = sample_substeps(&sys, &info, &times, Some(&r.initial_center), &opts).unwrap();
+        assert_eq!(fine.per_interval, vec![10; 50]);
+        let k = 20;
+        let first = 1 + (k - 1) * 10;
+        let state = |j: usize| &fine.paths[0][(first + j) * 2..][..2];
+        let end = state(9);
+        let dist = |x: &[f64]| ((x[0] - end[0]).powi(2) + (x[1] - end[1]).powi(2)).sqrt();
+        let far = (0..9).map(|j| dist(state(j))).fold(0.0, f64::max);
+        assert!(far > 1e-3, "{far}");
+        let mut hand_made = r.clone();
+        hand_made.steps[k].span = crate::prs::Span {
+            lo: end.to_vec(),
+            hi: end.to_vec(),
+            radius: far / 2.0,
+        };
+        // Back inside at t_k, outside in between.
+        assert!(hand_made.span_contains(k, end));
+        assert!((0..9).any(|j| !hand_made.span_contains(k, state(j))));
+
+        let simulate = |r: &Prs| simulate(&sys, &info, r, &opts, &mut |_, _| {}).unwrap();
+        let computed = simulate(&r);
+        assert_eq!(computed.tube.as_ref().unwrap().outside, 0);
+        let rep = simulate(&hand_made);
+        let tube = rep.tube.as_ref().unwrap();
+        assert_eq!((tube.outside, tube.fraction), (1, 1.0));
+        for (j, st) in rep.steps.iter().enumerate() {
+            assert_eq!(st.left_tube, Some(u64::from(j == k)), "step {j}");
+            assert_eq!(st.outside, 0, "step {j}");
+        }
+        assert_eq!(rep.horizon.outside_any, 0);
+        assert!(rep.verdict.pointwise_passed);
+        assert_eq!(rep.verdict.decided_by, Guarantee::Uniform);
+        assert_eq!(tube.checks_per_path, 501);
+        assert_eq!(
+            recount(&sys, &info, &hand_made, &opts),
+            (rep.steps.iter().map(|s| s.left_tube.unwrap()).collect(), 1)
+        );
+    }
+
+    /// The tube count is the recount from every Euler-Maruyama state with `Prs::span_contains`
+    /// and `Prs::contains_at` alone, interval by interval, with the tube as computed and
+    /// narrowed: in the fast loops for additive noise (eight-lane groups included), in the
+    /// general one with a metric that is not diagonal, and with inputs and an unsafe set.
+    #[test]
+    fn the_tube_count_is_a_recount_of_every_euler_state() {
+        let identity = vec![1.0, 0.0, 0.0, 1.0];
+        let skewed = vec![2.0, 0.7, 0.7, 1.0];
+        for (b, metric, factor) in [
+            (0.0, &identity, 0.6),
+            (0.0, &skewed, 0.6),
+            (1.0, &identity, 0.4),
+        ] {
+            let (sys, info) = (Sys { b }, info_in(b, metric.clone()));
+            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            for (factor, r) in [(1.0, r.clone()), (factor, narrow(&r, factor))] {
+                let opts = Options {
+                    paths: 300,
+                    seed: 11,
+                    dt: Some(0.004),
+                    hold: Some(0.05),
+                    ..Options::default()
+                };
+                let rep = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+                let (left, between) = recount(&sys, &info, &r, &opts);
+                let case = format!("b = {b}, metric {metric:?}, spans x {factor}");
+                let counted: Vec<u64> = rep.steps.iter().map(|s| s.left_tube.unwrap()).collect();
+                assert_eq!(counted, left, "{case}");
+                let tube = rep.tube.as_ref().unwrap();
+                assert_eq!(tube.outside, left.iter().sum::<u64>(), "{case}");
+                // Every path outside the PRS at a report time has left the tube.
+                assert!(tube.outside >= rep.horizon.outside_any, "{case}");
+                if factor < 1.0 {
+                    // Not vacuous: many first exits, most of them between report times.
+                    assert!(
+                        (30..270).contains(&tube.outside),
+                        "{case}: {}",
+                        tube.outside
+                    );
+                    assert!(2 * between > tube.outside, "{case}: {between}");
+                }
+            }
+        }
+    }
+
+    /// A tube narrowed between report times (its PRS at the report times as computed): the
+    /// uniform check fails while every report time passes; the same result labelled pointwise
+    /// passes and reports no tube; the tube as computed passes with few paths leaving it. 1 and
+    /// 2 threads give the same reports.
+    #[test]
+    fn the_uniform_verdict_is_decided_by_the_tube() {
+        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let run = |r: &Prs, threads: usize| {
             let opts = Options {
-                dt: Some(0.004),
+                paths: 3_000,
+                seed: 5,
+                dt: Some(0.0025),
+                threads: Some(threads),
                 ..Options::default()
             };
-            let mut plan = make_plan(&sys, &info, &r, &opts).unwrap();
-            let thresholds = vec![threshold; plan.times.len()];
-            let detected = sorted(plan.run_chunk(0..300, &thresholds));
-            plan.avx512 = false;
-            let avx2 = sorted(plan.run_chunk(0..300, &thresholds));
-            plan.avx2 = false;
-            let baseline = sorted(plan.run_chunk(0..300, &thresholds));
-            assert_eq!(detected, baseline, "b = {b}, threshold {threshold}");
-            assert_eq!(avx2, baseline, "b = {b}, threshold {threshold}");
-            let records = baseline.candidates.len();
-            if threshold < 0.0 {
-                assert_eq!(records, 300 * plan.times.len());
-            } else {
-                assert!(
-                    records > 0 && records < 300 * plan.times.len() / 2,
-                    "{records}"
-                );
+            simulate(&sys, &info, r, &opts, &mut |_, _| {}).unwrap()
+        };
+        let computed = run(&r, 2);
+        assert_eq!(computed, run(&r, 1));
+        let tube = computed.tube.as_ref().unwrap();
+        assert!(
+            computed.passed() && tube.fraction < r.delta / 5.0,
+            "{tube:?}"
+        );
+        assert!(tube.cp_lower <= tube.fraction && tube.fraction <= tube.cp_upper);
+        assert_eq!(tube.checks_per_path, 201);
+
+        let narrowed = narrow(&r, 0.5);
+        let rep = run(&narrowed, 2);
+        assert_eq!(rep, run(&narrowed, 1));
+        let tube = rep.tube.as_ref().unwrap();
+        assert!(!rep.passed());
+        assert!(tube.cp_lower > r.delta, "{tube:?}");
+        assert_eq!(rep.verdict.decided_by, Guarantee::Uniform);
+        assert!(rep.verdict.pointwise_passed);
+        assert_eq!(rep.verdict.failing_steps, 0);
+        // The per-report-time statistics do not depend on the spans.
+        assert_eq!(
+            rep.steps.iter().map(|s| s.outside).collect::<Vec<_>>(),
+            computed.steps.iter().map(|s| s.outside).collect::<Vec<_>>()
+        );
+
+        let mut pointwise = narrowed.clone();
+        pointwise.guarantee = Guarantee::Pointwise;
+        let rep = run(&pointwise, 2);
+        assert!(rep.passed() && rep.tube.is_none());
+        assert_eq!(rep.verdict.decided_by, Guarantee::Pointwise);
+        assert!(rep.steps.iter().all(|s| s.left_tube.is_none()));
+    }
+
+    /// Malformed spans are refused with a message, not a panic.
+    #[test]
+    fn malformed_spans_are_refused() {
+        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let opts = Options {
+            paths: 10,
+            ..Options::default()
+        };
+        for (what, change) in [
+            (
+                "radius",
+                &(|s: &mut crate::prs::Span| s.radius = f64::NAN) as &dyn Fn(&mut crate::prs::Span),
+            ),
+            ("radius", &|s| s.radius = -1.0),
+            ("corner", &|s| s.lo.pop().map_or((), drop)),
+            ("corner", &|s| s.hi[0] = s.lo[0] - 1.0),
+        ] {
+            let mut bad = r.clone();
+            change(&mut bad.steps[3].span);
+            match simulate(&sys, &info, &bad, &opts, &mut |_, _| {}) {
+                Err(SimError::Invalid(m)) => {
+                    assert!(m.contains("report step 3") && m.contains(what), "{m}")
+                }
+                other => panic!("{other:?}"),
             }
         }
     }

@@ -12,12 +12,20 @@
 //! in AVX-512 lanes where the processor has them; and `step_lanes` for everything else. All
 //! compute the same operations in the same order as [`sample_paths`](super::sample_paths), so
 //! the paths are the same whichever loop runs them.
+//!
+//! For a time-uniform result every loop also checks each path's state after every Euler step
+//! of report interval `k` against the tube over that interval ([`Tube`], the span `k` of the
+//! result; the initial state against span 0), until the path has left it once: the shortcut
+//! ([`Tube::inside_by_shortcut`], in the lanes the same comparison per lane) answers almost
+//! every state, and the others go to [`Tube::inside_slow`], a function of the state alone, so
+//! the loops agree on every decision. A state at a report time outside that time's PRS has
+//! left the tube too (the tube there is that PRS).
 
 use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
 use super::noise::Noise;
 use super::normal::Ziggurat;
-use super::prs::{diag_quad, quad_small, Membership, Metric};
+use super::prs::{diag_quad, diag_quad_to_box, quad_small, Membership, Metric, Tube};
 use super::regions::Region;
 use super::rng::PathRng;
 use crate::system::System;
@@ -60,6 +68,9 @@ pub(crate) struct Plan<'a, S: ?Sized> {
     pub(crate) nominal: Vec<f64>,
     pub(crate) metric: Metric,
     pub(crate) membership: Membership<'a>,
+    /// The time-uniform tube of a uniform result (`None`: pointwise, nothing to check between
+    /// report times).
+    pub(crate) tube: Option<Tube<'a>>,
     pub(crate) initial: InitialSampler,
     pub(crate) inputs: InputSchedule,
     pub(crate) noise: Noise,
@@ -86,6 +97,11 @@ pub(crate) struct ChunkStats {
     pub(crate) candidates: Vec<(u32, f64)>,
     /// Paths outside the PRS at one report step at least.
     pub(crate) outside_any: u64,
+    /// Paths that left the time-uniform tube at one Euler step at least (0 without a tube).
+    pub(crate) outside_tube: u64,
+    /// Per report step `k`, the paths that left the tube for the first time in the report
+    /// interval ending there (`k = 0`: at the start).
+    pub(crate) left_tube: Vec<u64>,
     /// Per unsafe set, paths that entered it.
     pub(crate) unsafe_hits: Vec<u64>,
     /// Per unsafe set, the earliest entry time.
@@ -102,6 +118,8 @@ impl ChunkStats {
             outside: vec![0; steps],
             candidates: Vec::new(),
             outside_any: 0,
+            outside_tube: 0,
+            left_tube: vec![0; steps],
             unsafe_hits: vec![0; sets],
             first_hit: vec![f64::INFINITY; sets],
             left_domain: 0,
@@ -122,6 +140,10 @@ impl ChunkStats {
             *a += b;
         }
         self.outside_any += other.outside_any;
+        self.outside_tube += other.outside_tube;
+        for (a, b) in self.left_tube.iter_mut().zip(&other.left_tube) {
+            *a += b;
+        }
         for (a, b) in self.unsafe_hits.iter_mut().zip(&other.unsafe_hits) {
             *a += b;
         }
@@ -179,7 +201,20 @@ struct Path {
     /// Its state is finite.
     alive: bool,
     outside_any: bool,
+    /// It has left the time-uniform tube (then it is not checked against it again).
+    left_tube: bool,
     left_domain: bool,
+}
+
+impl Path {
+    /// The path leaves the tube in report interval `k` (counted once).
+    #[inline(always)]
+    fn leave_tube(&mut self, k: usize, st: &mut ChunkStats) {
+        if !self.left_tube {
+            self.left_tube = true;
+            st.left_tube[k] += 1;
+        }
+    }
 }
 
 /// The state of [`LANES`] paths and the worker's scratch, allocated once per chunk, never per
@@ -221,6 +256,8 @@ struct Step<'a> {
     /// Its start and end times.
     t: f64,
     t_end: f64,
+    /// Its report interval `(t_{k-1}, t_k]`.
+    k: usize,
     span: &'a Span,
     /// At a report time: what to record.
     report: Option<Report<'a>>,
@@ -259,6 +296,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             hold: None,
             alive: false,
             outside_any: false,
+            left_tube: false,
             left_domain: false,
         };
         let mut l = Lanes {
@@ -298,11 +336,13 @@ impl<S: System + ?Sized> Plan<'_, S> {
             path.rng = PathRng::new(self.seed, first + a as u64);
             path.hold = None;
             path.outside_any = false;
+            path.left_tube = false;
             path.left_domain = false;
             let x = &mut l.x[a * nn..][..n];
             self.initial.sample(&mut path.rng, self.zig, x, &mut l.init);
             let qa = self.metric.quad(x, &self.nominal[..n]);
             self.record(0, x, qa, thresholds[0], st, path);
+            self.check_tube(0, x, path, st);
             let hit = &mut l.hit[a * sets..][..sets];
             self.check_sets(0.0, x, hit, &mut path.left_domain, st);
         }
@@ -351,15 +391,25 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 let step = Step {
                     t,
                     t_end,
+                    k,
                     span,
                     report,
                     lanes,
                 };
                 let (x, paths) = (&mut l.x[start * nn..], &mut l.paths[start..lanes]);
+                let tube = self.tube.is_some();
                 if additive && report.is_none() {
-                    self.additive::<D, false>(dim, &step, &l.ds, x, paths, st);
+                    if tube {
+                        self.additive::<D, false, true>(dim, &step, &l.ds, x, paths, st);
+                    } else {
+                        self.additive::<D, false, false>(dim, &step, &l.ds, x, paths, st);
+                    }
                 } else if additive && report.is_some_and(|r| r.quiet.is_some()) {
-                    self.additive::<D, true>(dim, &step, &l.ds, x, paths, st);
+                    if tube {
+                        self.additive::<D, true, true>(dim, &step, &l.ds, x, paths, st);
+                    } else {
+                        self.additive::<D, true, false>(dim, &step, &l.ds, x, paths, st);
+                    }
                 } else if self.noise.diagonal().is_some() {
                     self.general::<D, true>(dim, &step, l, st);
                 } else {
@@ -369,6 +419,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
         for path in &l.paths[..lanes] {
             st.outside_any += u64::from(path.outside_any);
+            st.outside_tube += u64::from(path.left_tube);
             st.left_domain += u64::from(path.left_domain);
             st.diverged += u64::from(!path.alive);
         }
@@ -440,6 +491,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 let hit = &mut l.hit[a * sets..][..sets];
                 self.check_sets(step.t_end, x, hit, &mut path.left_domain, st);
             }
+            self.check_tube(step.k, x, path, st);
             let Some(rep) = step.report else { continue };
             let (q, a) = if n <= SMALL {
                 quad_small(&upper, x, rep.c)
@@ -465,9 +517,10 @@ impl<S: System + ?Sized> Plan<'_, S> {
     /// or domain, at most [`SMALL`] states, a non-negative diagonal metric and (at a report
     /// time) a bound from [`Lanes::quiet`]: the hot loop of most linear and many nonlinear
     /// models, with every constant in a register. `scales` is `G_ii sqrt(h)`; `paths` are the
-    /// block's; `REPORT`: the step ends at a report time.
+    /// block's; `REPORT`: the step ends at a report time; `TUBE`: check the tube (a uniform
+    /// result).
     #[inline(always)]
-    fn additive_lanes<D: Dim, const REPORT: bool>(
+    fn additive_lanes<D: Dim, const REPORT: bool, const TUBE: bool>(
         &self,
         dim: D,
         step: &Step<'_>,
@@ -494,6 +547,15 @@ impl<S: System + ?Sized> Plan<'_, S> {
             }
             _ => (0, f64::NEG_INFINITY, f64::NEG_INFINITY),
         };
+        // The tube over this report interval: its box and "clearly inside" bound.
+        let (mut lo, mut hi, mut q_in) = ([0.0; SMALL], [0.0; SMALL], f64::INFINITY);
+        let (lo, hi) = (&mut lo[..n], &mut hi[..n]);
+        if let (true, Some(tube)) = (TUBE, &self.tube) {
+            let (l, u, q) = tube.diag_bounds(step.k);
+            lo.copy_from_slice(l);
+            hi.copy_from_slice(u);
+            q_in = q;
+        }
         for (x, path) in x.chunks_exact_mut(n).zip(paths) {
             if !path.alive {
                 if REPORT {
@@ -507,6 +569,14 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 x[i] += f[i] * h + ds[i] * zig.sample(&mut r);
             }
             path.rng = r;
+            // `Tube::inside_by_shortcut` for this metric, with the constants in registers.
+            if TUBE && !path.left_tube {
+                // Not `q < q_in` (NaN included).
+                let q = diag_quad_to_box(w, x, lo, hi);
+                if q.partial_cmp(&q_in) != Some(std::cmp::Ordering::Less) {
+                    self.tube_slow(step.k, x, path, st);
+                }
+            }
             if REPORT {
                 // Most states are inside the PRS and not quantile candidates.
                 let q = diag_quad(w, x, c);
@@ -521,7 +591,9 @@ impl<S: System + ?Sized> Plan<'_, S> {
     /// [`additive_lanes`](Self::additive_lanes) for eight paths (`paths`, states `x`) through
     /// every span, in the lanes of AVX-512 registers ([`super::avx512`]): the same draws and
     /// the same IEEE operations in the same order per lane (the drift by
-    /// [`System::drift_x8`]), so the same paths and records. `quiet` is [`Lanes::quiet`].
+    /// [`System::drift_x8`]), so the same paths and records; the tube's shortcut is the same
+    /// comparison per lane, and the lanes it does not answer go to the same scalar test.
+    /// `quiet` is [`Lanes::quiet`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
     fn additive_x8<D: Dim>(
@@ -542,15 +614,38 @@ impl<S: System + ?Sized> Plan<'_, S> {
         for (a, path) in paths.iter().enumerate() {
             live |= u8::from(path.alive) << a;
         }
+        // Lanes still to check against the tube (none without one); an ended path has left it
+        // (its state was not finite at some step), and is not stepped by the other loops.
+        let mut pending = 0u8;
+        if self.tube.is_some() {
+            for (a, path) in paths.iter().enumerate() {
+                pending |= u8::from(path.alive && !path.left_tube) << a;
+            }
+        }
         let mut group = super::avx512::Group8::new(n, x, std::array::from_fn(|a| paths[a].rng));
         let mut f = [X8::splat(0.0); SMALL];
         for (k, span) in (1..).zip(&self.spans) {
             let h = span.h;
             let ds = std::array::from_fn(|i| if i < n { g[i] * span.sqrt_h } else { 0.0 });
+            let (lo, hi, q_in) = match &self.tube {
+                Some(tube) => tube.diag_bounds(k),
+                None => (&[][..], &[][..], f64::INFINITY),
+            };
             for step in 0..span.steps {
                 let t = span.t0 + f64::from(step) * h;
                 self.sys.drift_x8(&group.states()[..n], t, &mut f[..n]);
                 group.step(n, &f, h, &ds, self.zig, live);
+                if pending != 0 {
+                    let mut out = group.outside_box(n, w, lo, hi, q_in) & pending;
+                    while out != 0 {
+                        let a = out.trailing_zeros() as usize;
+                        out &= out - 1;
+                        self.tube_slow(k, &group.lane(a)[..n], &mut paths[a], st);
+                        if paths[a].left_tube {
+                            pending &= !(1 << a);
+                        }
+                    }
+                }
             }
             // Lanes to record: ended paths, and states not below the quiet bound (or NaN).
             let c = &self.nominal[k * n..][..n];
@@ -568,6 +663,9 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 self.record(k, &xa[..n], qa, thresholds[k], st, path);
                 if !path.alive {
                     live &= !(1 << a);
+                }
+                if path.left_tube {
+                    pending &= !(1 << a);
                 }
             }
         }
@@ -605,7 +703,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
 
     /// [`additive_lanes`](Self::additive_lanes), compiled for the processor's extensions.
     #[inline(never)]
-    fn additive<D: Dim, const REPORT: bool>(
+    fn additive<D: Dim, const REPORT: bool, const TUBE: bool>(
         &self,
         dim: D,
         step: &Step<'_>,
@@ -617,15 +715,17 @@ impl<S: System + ?Sized> Plan<'_, S> {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` says the processor has the extensions.
-            return unsafe { self.additive_avx2::<D, REPORT>(dim, step, scales, x, paths, st) };
+            return unsafe {
+                self.additive_avx2::<D, REPORT, TUBE>(dim, step, scales, x, paths, st)
+            };
         }
-        self.additive_lanes::<D, REPORT>(dim, step, scales, x, paths, st);
+        self.additive_lanes::<D, REPORT, TUBE>(dim, step, scales, x, paths, st);
     }
 
     /// [`additive_lanes`](Self::additive_lanes) with AVX2 and BMI2 instructions.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,bmi1,bmi2")]
-    unsafe fn additive_avx2<D: Dim, const REPORT: bool>(
+    unsafe fn additive_avx2<D: Dim, const REPORT: bool, const TUBE: bool>(
         &self,
         dim: D,
         step: &Step<'_>,
@@ -634,7 +734,29 @@ impl<S: System + ?Sized> Plan<'_, S> {
         paths: &mut [Path],
         st: &mut ChunkStats,
     ) {
-        self.additive_lanes::<D, REPORT>(dim, step, scales, x, paths, st);
+        self.additive_lanes::<D, REPORT, TUBE>(dim, step, scales, x, paths, st);
+    }
+
+    /// Checks `path`'s state `x` in report interval `k` against the tube, if there is one and
+    /// the path has not left it yet.
+    #[inline(always)]
+    fn check_tube(&self, k: usize, x: &[f64], path: &mut Path, st: &mut ChunkStats) {
+        if let Some(tube) = &self.tube {
+            if !path.left_tube && !tube.inside_by_shortcut(&self.metric, k, x) {
+                self.tube_slow(k, x, path, st);
+            }
+        }
+    }
+
+    /// [`check_tube`](Self::check_tube) for a state the shortcut did not find inside.
+    #[cold]
+    #[inline(never)]
+    fn tube_slow(&self, k: usize, x: &[f64], path: &mut Path, st: &mut ChunkStats) {
+        if let Some(tube) = &self.tube {
+            if !tube.inside_slow(&self.metric, k, x) {
+                path.leave_tube(k, st);
+            }
+        }
     }
 
     /// Records `path`'s state `x` at report step `k` (its membership and, above the candidate
@@ -664,6 +786,10 @@ impl<S: System + ?Sized> Plan<'_, S> {
         if !inside {
             st.outside[k] += 1;
             path.outside_any = true;
+            // The tube at a report time is that time's PRS.
+            if self.tube.is_some() {
+                path.leave_tube(k, st);
+            }
         }
         if q > thr {
             st.candidates.push((k as u32, q));

@@ -2,7 +2,7 @@
 //! `report`).
 
 use super::inputs::InputMode;
-use crate::model::Method;
+use crate::model::{Guarantee, Method};
 use crate::prs::UnsafeKind;
 
 /// Everything a simulation measured, ready to be serialised. The same seed and options give the
@@ -15,8 +15,11 @@ pub struct SimReport {
     pub analysis: String,
     /// Its method.
     pub method: Method,
-    /// The PRS's probability level: each PRS should hold `X_t` with probability `>= 1 - delta`.
+    /// The PRS's probability level: the tube should hold the whole path (uniform), or each PRS
+    /// `X_t` (pointwise), with probability `>= 1 - delta`.
     pub delta: f64,
+    /// What the probability level of the analysis is about, and so what the verdict tests.
+    pub guarantee: Guarantee,
     /// Number of sample paths.
     pub paths: u64,
     /// Random seed.
@@ -40,6 +43,8 @@ pub struct SimReport {
     pub steps: Vec<SimStep>,
     /// Violations over the whole horizon.
     pub horizon: HorizonReport,
+    /// For a uniform result, the paths that left the tube (`None` for a pointwise result).
+    pub tube: Option<TubeReport>,
     /// Per unsafe set, the paths that entered it.
     pub unsafe_sets: Vec<UnsafeHits>,
     /// Paths that left the spec's domain at some Euler step (`None` without a domain).
@@ -82,10 +87,15 @@ pub struct SimStep {
     pub fraction: f64,
     /// One-sided Clopper-Pearson upper bound of the violation probability at `confidence`.
     pub cp_upper: f64,
+    /// For a uniform result, the paths that left the tube for the first time in the report
+    /// interval ending here (`(t_{k-1}, t_k]`; at `t = 0`, at the start); `None` for a
+    /// pointwise result.
+    pub left_tube: Option<u64>,
 }
 
-/// Paths outside the PRS at one report time at least. The PRS bounds the probability at each
-/// time, not uniformly in time, so this may exceed `delta` without contradicting it.
+/// Paths outside the PRS at one report time at least. A pointwise PRS bounds the probability
+/// at each time, not uniformly in time, so this may exceed `delta` without contradicting it;
+/// for a uniform result these paths left the tube (see [`TubeReport`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct HorizonReport {
     /// Paths outside at one report time or more.
@@ -94,6 +104,26 @@ pub struct HorizonReport {
     pub fraction: f64,
     /// One-sided Clopper-Pearson upper bound at `confidence`.
     pub cp_upper: f64,
+}
+
+/// The time-uniform check: the paths whose state left the tube at some time. Every
+/// Euler-Maruyama state of report interval `(t_{k-1}, t_k]` is checked against the result's
+/// span `k` ([`Prs::span_contains`](crate::prs::Prs::span_contains), the tube over that
+/// interval; the initial state against span 0), and the state at each report time against that
+/// time's PRS as well (the tube there); a non-finite state is outside.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TubeReport {
+    /// Paths that left the tube at least once.
+    pub outside: u64,
+    /// `outside / paths`.
+    pub fraction: f64,
+    /// One-sided Clopper-Pearson upper bound of the probability of leaving, at `confidence`.
+    pub cp_upper: f64,
+    /// One-sided Clopper-Pearson lower bound at `confidence`: the uniform coverage check
+    /// fails when it exceeds `delta`.
+    pub cp_lower: f64,
+    /// States checked per path: the initial one and one per Euler-Maruyama step.
+    pub checks_per_path: u64,
 }
 
 /// One unsafe set's hits.
@@ -111,12 +141,19 @@ pub struct UnsafeHits {
     pub first_hit_t: Option<f64>,
 }
 
-/// The coverage check: it fails when some report time's violation probability is, with
-/// confidence, above `delta`.
+/// The coverage check. For a uniform result it fails when the probability of leaving the
+/// tube is, with confidence, above `delta` ([`TubeReport::cp_lower`], one event: no
+/// correction); for a pointwise result, when some report time's violation probability is
+/// (Bonferroni over the report times). The per-report-time statistics are reported for both.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Coverage {
-    /// No report time fails.
+    /// The check passed: the uniform one for a uniform result, the per-report-time one for a
+    /// pointwise result.
     pub passed: bool,
+    /// Which check decides [`passed`](Self::passed) (the result's guarantee).
+    pub decided_by: Guarantee,
+    /// No report time fails the per-report-time check (the verdict of a pointwise result).
+    pub pointwise_passed: bool,
     /// `1 - confidence`: the probability of a false failure when every PRS is valid.
     pub alpha: f64,
     /// `alpha / (report times)`: the level of each step's lower bound (Bonferroni).

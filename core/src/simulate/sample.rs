@@ -1,6 +1,7 @@
 //! A few recorded sample paths, for plots: the Euler-Maruyama paths of [`simulate`](super::simulate)
 //! (same random streams, same initial states, inputs and noise, same steps), with the state
-//! kept at every report time instead of being reduced to statistics.
+//! kept at every report time ([`sample_paths`]) or after every Euler-Maruyama step
+//! ([`sample_substeps`]) instead of being reduced to statistics.
 
 use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
@@ -11,8 +12,23 @@ use super::{Options, SimError};
 use crate::model::ModelInfo;
 use crate::system::System;
 
-/// Most paths [`sample_paths`] records: they are all kept in memory.
+/// Most paths [`sample_paths`] and [`sample_substeps`] record: they are all kept in memory.
 pub const MAX_SAMPLE_PATHS: u64 = 100_000;
+
+/// Most state coordinates [`sample_substeps`] records in all (1 GiB).
+const MAX_SUBSTEP_VALUES: u64 = 1 << 27;
+
+/// Sample paths recorded after every Euler-Maruyama step (see [`sample_substeps`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Substeps {
+    /// Per report interval `(t_{k-1}, t_k]` (index `k - 1`), its number of Euler-Maruyama
+    /// steps, as [`simulate`](super::simulate) splits it.
+    pub per_interval: Vec<u32>,
+    /// Per path, the initial state and then the state after each Euler-Maruyama step, flat
+    /// (`n` values each): `1 + sum(per_interval)` states; the last state of interval `k` is
+    /// the state at `t_k`.
+    pub paths: Vec<Vec<f64>>,
+}
 
 /// Simulates `opts.paths` sample paths of `sys` over the report times `times` (increasing,
 /// starting at 0) and returns, per path, its states at those times, flat: the state at
@@ -32,6 +48,33 @@ pub fn sample_paths<S: System + ?Sized>(
     center: Option<&[f64]>,
     opts: &Options,
 ) -> Result<Vec<Vec<f64>>, SimError> {
+    record(sys, info, times, center, opts, false).map(|s| s.paths)
+}
+
+/// [`sample_paths`] with the state kept after every Euler-Maruyama step: what
+/// [`simulate`](super::simulate) checks against the tube of a time-uniform result, to be
+/// checked again independently (or plotted between report times). At most
+/// [`MAX_SAMPLE_PATHS`] paths and `2^27` recorded values in all.
+pub fn sample_substeps<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    times: &[f64],
+    center: Option<&[f64]>,
+    opts: &Options,
+) -> Result<Substeps, SimError> {
+    record(sys, info, times, center, opts, true)
+}
+
+/// The paths of [`sample_paths`], with the states of every Euler step (`every_step`) or of the
+/// report times.
+fn record<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    times: &[f64],
+    center: Option<&[f64]>,
+    opts: &Options,
+    every_step: bool,
+) -> Result<Substeps, SimError> {
     let usage = |m: String| Err(SimError::Usage(m));
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
     if opts.paths > MAX_SAMPLE_PATHS.min(MAX_PATHS) {
@@ -78,6 +121,17 @@ pub fn sample_paths<S: System + ?Sized>(
     if per_path.saturating_mul(2 * (m + p + 1) as u64) >= DRAWS_PER_PATH {
         return usage(format!("dt = {dt} gives too many Euler steps"));
     }
+    let kept = if every_step {
+        per_path + 1
+    } else {
+        times.len() as u64
+    };
+    if every_step && kept.saturating_mul(n as u64).saturating_mul(opts.paths) > MAX_SUBSTEP_VALUES {
+        return usage(format!(
+            "{} paths of {kept} states of {n} coordinates are too many values to record",
+            opts.paths
+        ));
+    }
     let initial = InitialSampler::new(&info.initial, n).map_err(SimError::Invalid)?;
     let inputs = InputSchedule::new(&info.input_box, opts.inputs, hold);
     let zig = Ziggurat::get();
@@ -96,7 +150,7 @@ pub fn sample_paths<S: System + ?Sized>(
             }
             nz
         });
-        let mut record = Vec::with_capacity(times.len() * n);
+        let mut record = Vec::with_capacity(kept as usize * n);
         record.extend_from_slice(&x);
         let mut interval = None;
         for (k, &nsub) in substeps.iter().enumerate() {
@@ -114,12 +168,20 @@ pub fn sample_paths<S: System + ?Sized>(
                 }
                 sys.drift(&x, &u, t, &mut f);
                 noise.apply(sys, &mut x, &f, t, h, sqrt_h, &mut z, &mut g);
+                if every_step {
+                    record.extend_from_slice(&x);
+                }
             }
-            record.extend_from_slice(&x);
+            if !every_step {
+                record.extend_from_slice(&x);
+            }
         }
         paths.push(record);
     }
-    Ok(paths)
+    Ok(Substeps {
+        per_interval: substeps,
+        paths,
+    })
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 
 use super::result::unsafe_kind;
 use super::summary_indices;
+use reachc_core::model::Guarantee;
 use reachc_core::simulate::{InitialSampling, InputMode, NoiseKind, SimReport};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -20,6 +21,7 @@ struct Json<'a> {
     analysis: &'a str,
     method: &'static str,
     delta: f64,
+    guarantee: &'static str,
     paths: u64,
     seed: u64,
     dt: f64,
@@ -32,6 +34,7 @@ struct Json<'a> {
     confidence: f64,
     steps: Vec<StepJson>,
     horizon: HorizonJson,
+    outside_tube: Option<TubeJson>,
     unsafe_sets: Vec<UnsafeJson<'a>>,
     left_domain: Option<u64>,
     diverged: u64,
@@ -55,6 +58,19 @@ struct StepJson {
     outside: u64,
     fraction: f64,
     cp_upper: f64,
+    /// Uniform results only: the paths first leaving the tube in the interval ending here.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    left_tube: Option<u64>,
+}
+
+#[derive(Serialize)]
+struct TubeJson {
+    count: u64,
+    fraction: f64,
+    cp_upper: f64,
+    cp_lower: f64,
+    checks_per_path: u64,
+    checked: &'static str,
 }
 
 #[derive(Serialize)]
@@ -76,6 +92,8 @@ struct UnsafeJson<'a> {
 #[derive(Serialize)]
 struct CoverageJson {
     status: &'static str,
+    decided_by: &'static str,
+    pointwise_status: &'static str,
     alpha: f64,
     alpha_per_step: f64,
     failing_steps: usize,
@@ -93,6 +111,21 @@ const COMPARED: &str = "distance |X_t - x*_t|_P with P the analysis' metric and 
     radius when the deterministic set is a point); outside = X_t not in the PRS \
     (engine::contains)";
 
+/// What the tube check of a uniform result checks.
+const TUBE_CHECKED: &str = "all times at once: every path's state after every Euler-Maruyama \
+    step of each report interval against the PRS over that interval (the result's span), the \
+    initial state against the PRS at t = 0, and the state at each report time against that \
+    time's PRS; outside_tube counts the paths that left at least once";
+
+/// `"pass"` or `"fail"`.
+fn status(passed: bool) -> &'static str {
+    if passed {
+        "pass"
+    } else {
+        "fail"
+    }
+}
+
 impl<'a> Json<'a> {
     fn of(r: &'a SimReport) -> Json<'a> {
         Json {
@@ -100,6 +133,7 @@ impl<'a> Json<'a> {
             analysis: &r.analysis,
             method: r.method.name(),
             delta: r.delta,
+            guarantee: r.guarantee.name(),
             paths: r.paths,
             seed: r.seed,
             dt: r.dt,
@@ -126,6 +160,7 @@ impl<'a> Json<'a> {
                     outside: s.outside,
                     fraction: s.fraction,
                     cp_upper: s.cp_upper,
+                    left_tube: s.left_tube,
                 })
                 .collect(),
             horizon: HorizonJson {
@@ -133,6 +168,14 @@ impl<'a> Json<'a> {
                 fraction: r.horizon.fraction,
                 cp_upper: r.horizon.cp_upper,
             },
+            outside_tube: r.tube.as_ref().map(|t| TubeJson {
+                count: t.outside,
+                fraction: t.fraction,
+                cp_upper: t.cp_upper,
+                cp_lower: t.cp_lower,
+                checks_per_path: t.checks_per_path,
+                checked: TUBE_CHECKED,
+            }),
             unsafe_sets: r
                 .unsafe_sets
                 .iter()
@@ -147,7 +190,9 @@ impl<'a> Json<'a> {
             left_domain: r.left_domain,
             diverged: r.diverged,
             verdict: CoverageJson {
-                status: if r.passed() { "pass" } else { "fail" },
+                status: status(r.passed()),
+                decided_by: r.verdict.decided_by.name(),
+                pointwise_status: status(r.verdict.pointwise_passed),
                 alpha: r.verdict.alpha,
                 alpha_per_step: r.verdict.alpha_per_step,
                 failing_steps: r.verdict.failing_steps,
@@ -199,16 +244,19 @@ fn noise(kind: NoiseKind) -> String {
 }
 
 /// A readable summary: what was simulated, a table at about ten report times plus the last, the
-/// horizon-wide and unsafe-set counts, and the verdict.
+/// horizon-wide count, the tube's (uniform results: what was checked, paths that left it), the
+/// unsafe-set counts, and the verdict (the uniform one for a uniform result, with the
+/// per-report-time figures alongside).
 pub fn summary(r: &SimReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "Monte Carlo check of analysis `{}` of model `{}` ({} method, delta = {})",
+        "Monte Carlo check of analysis `{}` of model `{}` ({} method, delta = {}, {} guarantee)",
         r.analysis,
         r.model,
         r.method.name(),
-        r.delta
+        r.delta,
+        r.guarantee.name()
     );
     // dt is a quotient (step / substeps): show it without its last-digit noise.
     let dt: f64 = format!("{:.10e}", r.dt).parse().unwrap_or(r.dt);
@@ -246,12 +294,26 @@ pub fn summary(r: &SimReport) -> String {
             st.cp_upper
         );
     }
-    let _ = writeln!(
+    let _ = write!(
         s,
         "  over the horizon: {} paths ({:.3e}) outside the PRS at some report time (CP upper \
-         {:.3e}); the PRS bounds each time separately, not uniformly in time",
+         {:.3e})",
         r.horizon.outside_any, r.horizon.fraction, r.horizon.cp_upper
     );
+    if r.guarantee == Guarantee::Pointwise {
+        s.push_str("; the PRS bounds each time separately, not uniformly in time");
+    }
+    s.push('\n');
+    if let Some(t) = &r.tube {
+        let _ = writeln!(
+            s,
+            "  tube, all times at once: {} paths ({:.3e}) left it at some time (Clopper-Pearson \
+             bounds [{:.3e}, {:.3e}] at confidence {}); checked at every Euler-Maruyama step ({} \
+             states per path) against the PRS over its report interval, and at each report time \
+             against that time's PRS",
+            t.outside, t.fraction, t.cp_lower, t.cp_upper, r.confidence, t.checks_per_path
+        );
+    }
     for u in &r.unsafe_sets {
         let first = u
             .first_hit_t
@@ -275,11 +337,10 @@ pub fn summary(r: &SimReport) -> String {
         let _ = writeln!(s, "  diverged (non-finite state): {} paths", r.diverged);
     }
     let v = &r.verdict;
-    let _ = writeln!(
-        s,
-        "  coverage: {} ({} of {} report times with a Clopper-Pearson lower bound above delta at \
-         level 1 - {:.1e}; worst t = {:.4}: {} outside, lower bound {:.3e})",
-        if r.passed() { "PASS" } else { "FAIL" },
+    let verdict = if r.passed() { "PASS" } else { "FAIL" };
+    let per_time = format!(
+        "{} of {} report times with a Clopper-Pearson lower bound above delta at level 1 - \
+         {:.1e}; worst t = {:.4}: {} outside, lower bound {:.3e}",
         v.failing_steps,
         r.steps.len(),
         v.alpha_per_step,
@@ -287,5 +348,26 @@ pub fn summary(r: &SimReport) -> String {
         v.worst_outside,
         v.worst_cp_lower
     );
+    match &r.tube {
+        Some(t) => {
+            let _ = writeln!(
+                s,
+                "  coverage: {verdict} (uniform: the fraction of paths leaving the tube has a \
+                 Clopper-Pearson lower bound of {:.3e} at level 1 - {:.1e}, {} delta = {}; per \
+                 report time, reported only: {per_time})",
+                t.cp_lower,
+                v.alpha,
+                if t.cp_lower > r.delta {
+                    "above"
+                } else {
+                    "not above"
+                },
+                r.delta
+            );
+        }
+        None => {
+            let _ = writeln!(s, "  coverage: {verdict} ({per_time})");
+        }
+    }
     s
 }
