@@ -424,8 +424,6 @@ pub enum Unproved {
     },
     /// The transformed drift `T f(T^-1 y)` was formed with rounded coefficients.
     TransformedDrift,
-    /// The constants hold only in the domain, and the result assumes the state stays in it.
-    Domain,
 }
 
 impl Prs {

@@ -139,9 +139,6 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
             delta,
             horizon: 1.5,
             step: 0.01,
-            // These tests are about the paths: an RK4 nominal (the engine's validated nominal
-            // refuses a non-zero initial box of these systems at t = 0 for now).
-            integrator: Integrator::Rk4,
             ..AnalysisSpec::default()
         },
         constants: Ok(constants),

@@ -18,6 +18,10 @@ pub struct ResultFile {
     pub method: Method,
     /// Probability level.
     pub delta: f64,
+    /// What `delta` is about: all times at once, or each time separately (results written
+    /// before time-uniform tubes are pointwise).
+    #[serde(default)]
+    pub guarantee: Guarantee,
     /// State names.
     pub states: Vec<String>,
     /// Indices of the output states.
@@ -31,6 +35,17 @@ pub struct ResultFile {
     pub initial_center: Vec<f64>,
     /// One record per report time.
     pub steps: Vec<Step>,
+}
+
+/// The guarantee of a result (`"uniform"` or `"pointwise"`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Guarantee {
+    /// One event for the whole horizon.
+    Uniform,
+    /// Each time separately.
+    #[default]
+    Pointwise,
 }
 
 /// The method of a result (`"contraction"` or `"interval"`).

@@ -4,7 +4,7 @@
 //! pixels.
 
 use super::geometry::{Plane, Point, Projected};
-use super::input::{Method, ResultFile, Shape, Step};
+use super::input::{Guarantee, Method, ResultFile, Shape, Step};
 use super::regions::Region;
 use reachc_runtime::model::{Analysis, ModelInfo};
 
@@ -162,10 +162,13 @@ pub fn sets_scene(
         None if contraction => "P-ball",
         None => "box",
     };
+    let holds = match result.guarantee {
+        Guarantee::Uniform => "holds X_t for all t at once with probability ≥ 1 - δ",
+        Guarantee::Pointwise => "holds X_t with probability ≥ 1 - δ at each t",
+    };
     let notes = vec![
         format!(
-            "PRS (solid) = deterministic {shape} (dashed) + B_P(r_t): holds X_t with \
-             probability ≥ 1 - δ, δ = {}",
+            "PRS (solid) = deterministic {shape} (dashed) + B_P(r_t): {holds}, δ = {}",
             result.delta
         ),
         "projections onto the plotted states: exact".into(),

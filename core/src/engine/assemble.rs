@@ -192,10 +192,6 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
     if let Some(epochs) = radii.epochs {
         rigorous.push(Proved::UniformTube { epochs });
     }
-    let mut not_validated = header.not_validated;
-    if run.info.has_domain {
-        not_validated.push(Unproved::Domain);
-    }
     Prs {
         model: run.info.name.clone(),
         analysis: run.spec.name.clone(),
@@ -229,7 +225,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
         verdict,
         validation: Validation {
             rigorous,
-            not_validated,
+            not_validated: header.not_validated,
             conditional_on_domain: run.info.has_domain,
         },
     }

@@ -434,7 +434,8 @@ impl<'a> Embedding<'a> {
             }
             let nu = rows.iter().fold(Interval::ZERO, |m, r| m.max(*r));
             let nu_h = nu * h;
-            if !(nu_h.hi() <= 0.5) {
+            // (NaN fails too.)
+            if nu_h.hi().partial_cmp(&0.5) != Some(std::cmp::Ordering::Less) {
                 return None;
             }
             // E = dmax h / (1 - nu h) solves E = (dmax + nu E) h.

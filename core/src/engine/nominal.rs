@@ -23,14 +23,12 @@ pub(crate) fn rk4(sys: &dyn System, x: &[f64], u: &[f64], t: f64, h: f64) -> Vec
     rk4_step(&mut |x, t, out| sys.drift(x, u, t, out), x, t, h).0
 }
 
+/// The right-hand side of `x' = rhs(x, t)`, writing into its last argument.
+pub(crate) type Rhs<'a> = dyn FnMut(&[f64], f64, &mut [f64]) + 'a;
+
 /// One classical Runge-Kutta step of length `h` of `x' = rhs(x, t)` from `x` at `t`: the end
 /// and the slope at the start.
-pub(crate) fn rk4_step(
-    rhs: &mut dyn FnMut(&[f64], f64, &mut [f64]),
-    x: &[f64],
-    t: f64,
-    h: f64,
-) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn rk4_step(rhs: &mut Rhs, x: &[f64], t: f64, h: f64) -> (Vec<f64>, Vec<f64>) {
     let n = x.len();
     let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
     let mut tmp = vec![0.0; n];

@@ -520,9 +520,8 @@ mod tests {
         info_in(b, vec![1.0, 0.0, 0.0, 1.0])
     }
 
-    /// [`info`] with the metric `metric` (`2 x 2`, row-major). The analysis is time-uniform
-    /// (the default) with an RK4 nominal: these tests are about the paths, and the validated
-    /// nominal of the engine refuses these systems at t = 0 for now.
+    /// [`info`] with the metric `metric` (`2 x 2`, row-major); the analysis is time-uniform
+    /// (the default).
     fn info_in(b: f64, metric: Vec<f64>) -> ModelInfo {
         let inputs = b != 0.0;
         let mut info = ModelInfo {
@@ -562,7 +561,6 @@ mod tests {
                 delta: 0.05,
                 horizon: 0.5,
                 step: 0.01,
-                integrator: Integrator::Rk4,
                 ..AnalysisSpec::default()
             },
             constants: Ok(constants),

@@ -700,9 +700,6 @@ mod tests {
                 delta: 0.01,
                 horizon: 1.0,
                 step: 0.1,
-                // The validated nominal of the engine refuses this system at t = 0 for now;
-                // these tests are about membership.
-                integrator: Integrator::Rk4,
                 ..AnalysisSpec::default()
             },
             // Valid for P = I and for the skewed P below (generous c, sigma).
@@ -797,12 +794,7 @@ mod tests {
     #[test]
     fn the_tube_agrees_with_span_contains() {
         let mut rng = PathRng::new(7, 0);
-        for (method, metric) in [
-            (Method::Contraction, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Contraction, vec![2.0, 0.7, 0.7, 1.0]),
-            (Method::Interval, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Interval, vec![2.0, 0.7, 0.7, 1.0]),
-        ] {
+        for (method, metric) in methods_and_metrics() {
             let r = result(method, metric);
             let m = Metric::new(&r.constants.metric, 2);
             let tube = Tube::new(&r, &m).unwrap();
@@ -859,17 +851,22 @@ mod tests {
         }
     }
 
+    /// Both methods, each with the identity and a skewed metric.
+    fn methods_and_metrics() -> [(Method, Vec<f64>); 4] {
+        [
+            (Method::Contraction, vec![1.0, 0.0, 0.0, 1.0]),
+            (Method::Contraction, vec![2.0, 0.7, 0.7, 1.0]),
+            (Method::Interval, vec![1.0, 0.0, 0.0, 1.0]),
+            (Method::Interval, vec![2.0, 0.7, 0.7, 1.0]),
+        ]
+    }
+
     /// Points at relative P-distances from far inside to far outside, many within rounding of
     /// the boundary: the shortcuts never disagree with `Prs::contains_at`.
     #[test]
     fn shortcuts_agree_with_contains() {
         let mut rng = PathRng::new(5, 0);
-        for (method, metric) in [
-            (Method::Contraction, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Contraction, vec![2.0, 0.7, 0.7, 1.0]),
-            (Method::Interval, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Interval, vec![2.0, 0.7, 0.7, 1.0]),
-        ] {
+        for (method, metric) in methods_and_metrics() {
             let r = result(method, metric);
             let m = Metric::new(&r.constants.metric, 2);
             let mem = Membership::new(&r, &m);

@@ -419,11 +419,6 @@ fn unproved(u: &Unproved) -> String {
              below the integration error)"
                 .into()
         }
-        Unproved::Domain => {
-            "conditional on staying in the domain: the constants hold only there, and the \
-             result assumes the state does not leave it"
-                .into()
-        }
     }
 }
 
@@ -644,8 +639,20 @@ pub fn summary(prs: &Prs) -> String {
         ),
     };
     let _ = writeln!(s, "  verdict: {verdict}");
+    if prs.validation.conditional_on_domain {
+        let _ = writeln!(
+            s,
+            "  condition: the constants hold only in the domain; the result assumes the state \
+             does not leave it"
+        );
+    }
     let not_validated: Vec<String> = prs.validation.not_validated.iter().map(unproved).collect();
-    let _ = writeln!(s, "  not validated: {}", not_validated.join("; "));
+    let not_validated = if not_validated.is_empty() {
+        "nothing (every bound above is proved)".to_string()
+    } else {
+        not_validated.join("; ")
+    };
+    let _ = writeln!(s, "  not validated: {not_validated}");
     s
 }
 
