@@ -1,7 +1,8 @@
 //! The pendulum's delta-PRS with generated (compiled) code: contraction (401 report steps,
-//! step 0.01, horizon 4) and interval in y = T x with each inclusion function (400 Euler
-//! steps; the immrax comparison in docs/benchmarks.md). Compare with
-//! `cargo bench -p reachc --bench prs` (the interpreter).
+//! step 0.01, horizon 4, validated nominal) and interval in y = T x with each inclusion
+//! function: the paper's set-up (`paper_interval`, 400 Euler steps: like for like with immrax
+//! in docs/benchmarks.md) and reachc's default (`interval`, validated steps). Compare with
+//! `cargo bench -p reachc-compiler --bench prs` (the interpreter).
 
 use pendulum_buildrs::{info, Pendulum};
 
@@ -21,12 +22,24 @@ fn contraction_prs_compiled(bencher: divan::Bencher) {
     });
 }
 
-/// The interval-based PRS of the pendulum in y = T x (the paper's Fig. 6, right), per
-/// inclusion function: one whole analysis (box trajectory, stochastic radius, report).
+/// The interval-based PRS of the pendulum in y = T x (the paper's Fig. 6, right, 400 Euler
+/// steps), per inclusion function: one whole analysis (box trajectory, stochastic radius,
+/// report).
 #[divan::bench(args = ["natural", "jacobian", "mixed"])]
 fn interval_prs_compiled(bencher: divan::Bencher, inclusion: &str) {
+    interval_prs(bencher, "paper_interval", inclusion);
+}
+
+/// [`interval_prs_compiled`] on validated steps (the spec's `interval`, time-uniform).
+#[divan::bench(args = ["natural", "jacobian", "mixed"])]
+fn validated_interval_prs_compiled(bencher: divan::Bencher, inclusion: &str) {
+    interval_prs(bencher, "interval", inclusion);
+}
+
+/// One whole interval analysis `name` with `inclusion`, timed.
+fn interval_prs(bencher: divan::Bencher, name: &str, inclusion: &str) {
     let info = info();
-    let analysis = interval_analysis(&info, inclusion);
+    let analysis = interval_analysis(&info, name, inclusion);
     bencher.bench(|| {
         reachc_runtime::engine::run(&Pendulum, &info, &analysis)
             .unwrap()
@@ -40,7 +53,7 @@ fn interval_prs_compiled(bencher: divan::Bencher, inclusion: &str) {
 #[divan::bench(args = ["natural", "jacobian", "mixed"])]
 fn interval_reach_compiled(bencher: divan::Bencher, inclusion: &str) {
     let info = info();
-    let analysis = interval_analysis(&info, inclusion);
+    let analysis = interval_analysis(&info, "paper_interval", inclusion);
     bencher.bench(|| {
         reachc_runtime::engine::interval_boxes(&Pendulum, &info, &analysis.spec)
             .unwrap()
@@ -48,13 +61,14 @@ fn interval_reach_compiled(bencher: divan::Bencher, inclusion: &str) {
     });
 }
 
-/// The pendulum's analysis `interval` with the given inclusion function.
+/// The pendulum's analysis `name` with the given inclusion function.
 fn interval_analysis(
     info: &reachc_runtime::ModelInfo,
+    name: &str,
     inclusion: &str,
 ) -> reachc_runtime::model::Analysis {
     use reachc_runtime::model::Inclusion;
-    let mut analysis = info.analysis("interval").unwrap().clone();
+    let mut analysis = info.analysis(name).unwrap().clone();
     analysis.spec.inclusion = match inclusion {
         "natural" => Inclusion::Natural,
         "mixed" => Inclusion::Mixed,
