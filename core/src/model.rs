@@ -4,6 +4,7 @@
 //!
 //! Matrices are flat row-major vectors: entry `(i, j)` of an `r x c` matrix is `[i * c + j]`.
 
+use crate::interval::Interval;
 use std::fmt;
 
 /// A closed interval `[lo, hi]` of reals given by its ends (`-inf` and `inf` allowed), as plain
@@ -88,6 +89,24 @@ impl InitialSet {
             boxes: x0.iter().map(|&b| Some(b)).collect(),
             balls: Vec::new(),
         }
+    }
+
+    /// A box holding the set (balls by their bounding boxes, rounded outward), or why not
+    /// (inconsistent data).
+    pub fn bounding_box(&self) -> Result<Vec<Bounds>, String> {
+        let (center, half) =
+            crate::engine::radius::initial_center_and_halfwidths(self, self.boxes.len())?;
+        Ok(self
+            .boxes
+            .iter()
+            .zip(center.iter().zip(&half))
+            .map(|(b, (&c, &h))| {
+                b.unwrap_or_else(|| {
+                    let (c, h) = (Interval::point(c), Interval::point(h));
+                    Bounds::new((c - h).lo(), (c + h).hi())
+                })
+            })
+            .collect())
     }
 }
 
@@ -247,12 +266,16 @@ impl Guarantee {
     }
 }
 
-/// Where the contraction rate `c_t` of a contraction analysis comes from.
+/// Where the contraction rate `c_t` (and the noise level `sigma_t`, the input gain `rho_t`) of
+/// an analysis comes from.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Rate {
-    /// One rate for the whole run, certified by the compiler over the domain ([`Constants::c`]).
+    /// Certified per internal step on a region holding the time-uniform tube over that step
+    /// (method.md section 8.3): needs `guarantee = uniform`, no global rate, no domain.
     #[default]
-    Certified,
+    Local,
+    /// One rate for the whole run, certified by the compiler over the domain ([`Constants::c`]).
+    Global,
     /// Estimated per report step from sample paths (the paper's approach for the unicycle):
     /// the pooled one-sided Lipschitz quotient between sampled states and the nominal. Not a
     /// guarantee, and labelled so.
@@ -266,7 +289,8 @@ impl Rate {
     /// Its name in specs and reports.
     pub fn name(self) -> &'static str {
         match self {
-            Rate::Certified => "certified",
+            Rate::Local => "local",
+            Rate::Global => "global",
             Rate::Empirical { .. } => "empirical",
         }
     }
@@ -342,7 +366,7 @@ impl Default for AnalysisSpec {
             step: 0.01,
             metric: MetricChoice::Identity,
             radius: RadiusRule::Amgf,
-            rate: Rate::Certified,
+            rate: Rate::Local,
             inclusion: Inclusion::Jacobian,
             integrator: Integrator::Validated,
             guarantee: Guarantee::Uniform,
@@ -367,6 +391,8 @@ pub struct Analysis {
 pub struct Constants {
     /// The metric `P`, `n x n` row-major, symmetric positive definite.
     pub metric: Vec<f64>,
+    /// Where `P` comes from (given, or synthesised for which region).
+    pub metric_region: MetricRegion,
     /// Contraction rate: `mu_P(D_x f) <= c` over the region, for all inputs and times (`inf`
     /// for a [`Rate::Empirical`] analysis: the compiler does not bound it then).
     pub c: f64,
@@ -388,12 +414,38 @@ impl Constants {
     pub fn given(info: &ModelInfo, metric: Vec<f64>, c: f64, sigma: f64, rho: f64) -> Constants {
         Constants {
             metric,
+            metric_region: MetricRegion::Given,
             c,
             sigma,
             rho,
             provenance: Provenance::Given,
             region: info.region(f64::INFINITY),
         }
+    }
+}
+
+/// Where the metric `P` of an analysis comes from. Any `P` is sound (the rates are certified
+/// for the `P` used); the region says where it was chosen to be tight.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MetricRegion {
+    /// Given in the spec (`identity` or a matrix), or by hand.
+    Given,
+    /// Synthesised for the Jacobian over the domain (the global rate's region).
+    Domain,
+    /// Synthesised for the Jacobian over the initial set's bounding box during the first report
+    /// step (where the tube starts; used when the domain admits no contracting metric).
+    InitialSet,
+}
+
+impl fmt::Display for MetricRegion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            MetricRegion::Given => "given in the spec",
+            MetricRegion::Domain => "synthesised for the Jacobian over the domain",
+            MetricRegion::InitialSet => {
+                "synthesised for the Jacobian over the initial set during the first report step"
+            }
+        })
     }
 }
 
@@ -424,6 +476,12 @@ pub enum Provenance {
     },
     /// Given by hand (a hand-written system, a test): not certified by reachc.
     Given,
+    /// The compiler could not bound them over the domain (`c`, `sigma`, `rho` are infinite):
+    /// only an analysis with [`Rate::Local`] can run, bounding them on the tube at run time.
+    Unbounded {
+        /// Why (the unbounded entry).
+        why: String,
+    },
 }
 
 /// The set of matrices (`D_x f`, `G` or `D_u f` over the region) a constant is the worst case
@@ -509,8 +567,12 @@ impl fmt::Display for InputGain {
 
 impl fmt::Display for Provenance {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let Provenance::Certified { c, sigma, rho } = self else {
-            return f.write_str("given by hand, not certified by reachc");
+        let (c, sigma, rho) = match self {
+            Provenance::Certified { c, sigma, rho } => (c, sigma, rho),
+            Provenance::Given => return f.write_str("given by hand, not certified by reachc"),
+            Provenance::Unbounded { why } => {
+                return write!(f, "not bounded over the domain ({why})");
+            }
         };
         match c {
             Some(c) => write!(f, "c: {c}; ")?,

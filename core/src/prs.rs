@@ -7,8 +7,8 @@
 use crate::engine::interval;
 use crate::interval::Interval;
 use crate::model::{
-    Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, Provenance, RadiusRule, Rate,
-    UnsafeShape,
+    Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricRegion, Provenance,
+    RadiusRule, Rate, UnsafeShape,
 };
 use crate::reach::InputPlan;
 
@@ -77,15 +77,43 @@ pub struct Prs {
     pub verdict: Verdict,
     /// Which parts are proved and which are not.
     pub validation: Validation,
+    /// With local rates, the region of each internal step and the rates certified on it (empty
+    /// otherwise).
+    pub regions: Vec<RateRegion>,
 }
 
 /// Where the contraction rate `c_t` came from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RateUsed {
-    /// Certified, or estimated from sample paths (no guarantee).
+    /// Local, global, or estimated from sample paths (no guarantee).
     pub rate: Rate,
-    /// The largest rate used on any step (the certified `c` for a certified rate).
+    /// The largest rate used on any step (the certified `c` for a global rate).
     pub max_c: f64,
+    /// The smallest rate used on any step.
+    pub min_c: f64,
+    /// Local rates: the time from which no region closed and the domain's global constants
+    /// took over (the result is conditional on the domain then); `None`: local throughout.
+    pub global_from: Option<f64>,
+}
+
+/// One internal step `[t0, t1]` of a run with local rates: the box `D_k` that holds the
+/// deterministic set and the time-uniform tube over the step, and the rates certified on it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RateRegion {
+    /// Start of the step.
+    pub t0: f64,
+    /// End of the step.
+    pub t1: f64,
+    /// Lower corner of `D_k`.
+    pub lo: Vec<f64>,
+    /// Upper corner of `D_k`.
+    pub hi: Vec<f64>,
+    /// `c_k >= mu_P(D_x f)` over `D_k`, the input box and the step's times.
+    pub c: f64,
+    /// `sigma_k`, the noise level over the same.
+    pub sigma: f64,
+    /// `rho_k`, the input gain over the same.
+    pub rho: f64,
 }
 
 /// The constants of Assumption 1, as used.
@@ -101,6 +129,8 @@ pub struct ConstantsUsed {
     pub provenance: Provenance,
     /// The metric `P`, `n x n` row-major.
     pub metric: Vec<f64>,
+    /// Where `P` comes from.
+    pub metric_region: MetricRegion,
     /// Upper bounds of `sqrt((P^-1)_ii)`: the P-ball of radius `r` around `c` lies in the box
     /// `|x_i - c_i| <= r spread_i`.
     pub spread: Vec<f64>,
@@ -392,6 +422,14 @@ pub enum Proved {
     ValidatedEmbedding {
         /// The number of internal steps.
         steps: usize,
+    },
+    /// Local rates: `c`, `sigma`, `rho` certified per internal step on a region holding the
+    /// tube over that step (interval Jacobian, verified eigenvalue bounds); no domain needed.
+    LocalRates {
+        /// The number of regions (internal steps).
+        regions: usize,
+        /// Where the metric was synthesised.
+        metric: MetricRegion,
     },
     /// The time-uniform tube: Ville's inequality on `epochs` epochs at `delta / epochs` each.
     UniformTube {

@@ -4,7 +4,7 @@
 use crate::engine::{self, check_initial, Inputs, Needs, Run, RunError, Setup};
 use crate::interval::Interval;
 use crate::model::{
-    Analysis, AnalysisSpec, Bounds, Inclusion, InitialSet, Method, ModelInfo, Rate,
+    Analysis, AnalysisSpec, Bounds, Guarantee, Inclusion, InitialSet, Method, ModelInfo, Rate,
 };
 use crate::prs::Prs;
 use crate::system::System;
@@ -54,19 +54,37 @@ impl<'a> Reach<'a> {
     ) -> Result<Reach<'a>, RunError> {
         let spec = &analysis.spec;
         let needs = match (spec.method, spec.rate) {
-            (Method::Interval, Rate::Certified) => Needs {
+            (_, Rate::Local) if spec.guarantee != Guarantee::Uniform => {
+                return Err(RunError::Unsupported(
+                    "local rates with a pointwise guarantee (the proof that the process never \
+                     leaves the regions needs the time-uniform tube): use `rate = global`"
+                        .into(),
+                ))
+            }
+            (_, Rate::Local) => Needs {
+                c: false,
+                sigma: false,
+                rho: false,
+            },
+            (Method::Interval, Rate::Global) => Needs {
                 c: true,
+                sigma: true,
                 rho: false,
             },
             (Method::Interval, rate) => {
                 return Err(RunError::Unsupported(format!(
-                    "a {} rate with the interval method (it uses the certified rate)",
+                    "a {} rate with the interval method (it uses a certified rate)",
                     rate.name()
                 )))
             }
-            (Method::Contraction, Rate::Certified) => Needs { c: true, rho: true },
+            (Method::Contraction, Rate::Global) => Needs {
+                c: true,
+                sigma: true,
+                rho: true,
+            },
             (Method::Contraction, Rate::Empirical { .. }) => Needs {
                 c: false,
+                sigma: true,
                 rho: true,
             },
         };
@@ -147,7 +165,8 @@ impl<'a> Reach<'a> {
     }
 
     fn run_from(&self, initial: &InitialSet, inputs: Inputs) -> Result<Prs, RunError> {
-        check_initial(self.info, initial)?;
+        // Local rates hold wherever the tube goes: the domain does not constrain them.
+        check_initial(self.info, initial, self.spec.rate != Rate::Local)?;
         let run = Run {
             sys: self.sys,
             info: self.info,

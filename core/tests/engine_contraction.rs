@@ -191,6 +191,7 @@ fn analysis(delta: f64, horizon: f64, step: f64, constants: Constants) -> Analys
             step,
             guarantee: Guarantee::Pointwise,
             integrator: Integrator::Rk4,
+            rate: Rate::Global,
             ..AnalysisSpec::default()
         },
         constants: Ok(constants),

@@ -6,7 +6,8 @@
 
 use reachc_core::interval::Interval;
 use reachc_core::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method, ModelInfo,
+    Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
+    ModelInfo, Rate,
 };
 use reachc_core::prs::Prs;
 use reachc_core::{Reach, System};
@@ -139,6 +140,7 @@ fn model(name: &str, x0: &[(f64, f64)], c: f64) -> ModelInfo {
                 guarantee: Guarantee::Pointwise,
                 horizon: 2.0,
                 step: 0.1,
+                rate: Rate::Global,
                 ..AnalysisSpec::default()
             },
             constants: Ok(constants.clone()),

@@ -139,6 +139,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
             delta,
             horizon: 1.5,
             step: 0.01,
+            rate: Rate::Global,
             ..AnalysisSpec::default()
         },
         constants: Ok(constants),

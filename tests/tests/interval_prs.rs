@@ -195,7 +195,7 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
                 };
                 let v = &mut variant.spec;
                 v.transform = v.transform.take().filter(|_| v.method == Method::Interval);
-                (v.method, v.rate, v.inclusion) = (Method::Interval, Rate::Certified, inclusion);
+                (v.method, v.rate, v.inclusion) = (Method::Interval, Rate::Global, inclusion);
                 v.horizon = horizon.unwrap_or(v.horizon);
                 if n > 100 {
                     // Validated steps of the 1000-state chain through the interpreter cost

@@ -16,7 +16,9 @@ use std::fmt;
 
 use nalgebra::{DMatrix, SymmetricEigen};
 use reachc_core::interval::Interval;
-use reachc_core::model::{Bounds, Constants, InputGain, MatrixBound, Provenance, Region};
+use reachc_core::model::{
+    Bounds, Constants, InputGain, MatrixBound, MetricRegion, Provenance, Region,
+};
 
 use super::psd::{certify_min, is_psd, is_zero, sqrt_up, IMat, Pencil};
 use super::{bound_matrix, eval_box, split_atoms, time_range, Derivatives};
@@ -733,6 +735,8 @@ fn noise_and_input(
     let (rho, gain) = input_gain(&jac_u, p, &h)?;
     Ok(Constants {
         metric: metric.to_vec(),
+        // A caller that synthesised the metric says where.
+        metric_region: MetricRegion::Given,
         c: f64::INFINITY,
         sigma,
         rho,

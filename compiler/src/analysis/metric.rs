@@ -33,6 +33,7 @@ use super::contraction::{
 use super::psd::IMat;
 use super::{time_range, Derivatives};
 use crate::model::Model;
+use reachc_core::interval::Interval;
 
 /// Up to this many states the full metric is optimised; above, only a diagonal one.
 pub const FULL_METRIC_MAX_DIM: usize = 30;
@@ -51,11 +52,20 @@ const EIGEN_MAX_DIM: usize = 200;
 ///
 /// Errors: an unbounded entry of `D_x f` (as for [`super::constants`]).
 pub fn synthesize_metric(model: &Model, d: &Derivatives) -> Result<Vec<f64>, ConstantsError> {
+    synthesize_metric_over(model, d, time_range(model))
+}
+
+/// [`synthesize_metric`] for the Jacobian over the model's domain and the times `time`.
+pub fn synthesize_metric_over(
+    model: &Model,
+    d: &Derivatives,
+    time: Interval,
+) -> Result<Vec<f64>, ConstantsError> {
     let n = model.states.len();
     if n == 0 {
         return Ok(Vec::new());
     }
-    let dec = decompose(model, &d.jac_x, "D_x f", time_range(model))?;
+    let dec = decompose(model, &d.jac_x, "D_x f", time)?;
     let full = dec.all_free();
     if matches!(full, MatrixSet::Vertices { .. }) {
         return Ok(metric_for(&full, n));

@@ -17,5 +17,5 @@ pub use contraction::{
     constants, constants_without_rate, ConstantsError, MAX_SIGN_INPUTS, MAX_VERTEX_ATOMS,
 };
 pub use derivatives::{Derivatives, GradEntry};
-pub use metric::{synthesize_metric, FULL_METRIC_MAX_DIM};
+pub use metric::{synthesize_metric, synthesize_metric_over, FULL_METRIC_MAX_DIM};
 pub use transform::Frame;

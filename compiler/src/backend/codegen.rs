@@ -41,8 +41,8 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
 use reachc_core::model::{
     Analysis, Ball, Bounds, Constants, Guarantee, Inclusion, InitialSet, InputGain, Integrator,
-    MatrixBound, Method, MetricChoice, ModelInfo, Provenance, RadiusRule, Rate, UnsafeSet,
-    UnsafeShape,
+    MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Provenance, RadiusRule, Rate,
+    UnsafeSet, UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -1500,9 +1500,15 @@ impl InfoWriter {
             list(r.input_box.iter().map(|&b| range(b)))
         };
         let time = range(r.time);
+        let metric_region = match c.metric_region {
+            MetricRegion::Given => quote!(MetricRegion::Given),
+            MetricRegion::Domain => quote!(MetricRegion::Domain),
+            MetricRegion::InitialSet => quote!(MetricRegion::InitialSet),
+        };
         quote! {
             Constants {
                 metric: #metric,
+                metric_region: #metric_region,
                 c: #cc,
                 sigma: #sigma,
                 rho: #rho,
@@ -1541,7 +1547,8 @@ impl InfoWriter {
             RadiusRule::PaperOptimal => quote!(RadiusRule::PaperOptimal),
         };
         let rate = match a_spec.rate {
-            Rate::Certified => quote!(Rate::Certified),
+            Rate::Local => quote!(Rate::Local),
+            Rate::Global => quote!(Rate::Global),
             Rate::Empirical { paths } => quote!(Rate::Empirical { paths: #paths }),
         };
         let integrator = match a_spec.integrator {
@@ -1622,6 +1629,10 @@ fn provenance(p: &Provenance) -> TokenStream {
     };
     match p {
         Provenance::Given => quote!(Provenance::Given),
+        Provenance::Unbounded { why } => {
+            let why = string(why);
+            quote!(Provenance::Unbounded { why: #why })
+        }
         Provenance::Certified { c, sigma, rho } => {
             let c = option(c, matrix);
             let sigma = matrix(sigma);
@@ -1657,7 +1668,8 @@ fn info_doc(info: &ModelInfo) -> TokenStream {
             Ok(c) => format!(
                 "c = {}, sigma = {}, rho = {}\n    {}",
                 match a.spec.rate {
-                    Rate::Certified => short(c.c),
+                    Rate::Global => short(c.c),
+                    Rate::Local => format!("local (global {})", short(c.c)),
                     Rate::Empirical { paths } => format!("empirical ({paths} paths)"),
                 },
                 short(c.sigma),

@@ -4,11 +4,14 @@
 use reachc_core::model::{Analysis, ModelInfo};
 
 use crate::analysis::{
-    constants, constants_without_rate, synthesize_metric, ConstantsError, Derivatives, Frame,
+    constants, constants_without_rate, synthesize_metric, synthesize_metric_over, time_range,
+    ConstantsError, Derivatives, Frame,
 };
 use crate::diagnostics::Diagnostic;
 use crate::ir::Names;
 use crate::model::{self, MetricChoice, Model, Rate};
+use reachc_core::interval::Interval;
+use reachc_core::model::{Constants, MetricRegion, Provenance};
 
 /// A model ready for code generation or interpretation.
 #[derive(Clone, Debug)]
@@ -37,15 +40,30 @@ pub fn prepare(model: &mut Model) -> Prepared {
     let mut analyses = Vec::new();
     let mut frames: Vec<Frame> = Vec::new();
     for a in model.analyses.clone() {
-        let metric = match &a.spec.metric {
+        let metric = || match &a.spec.metric {
             MetricChoice::Identity => Ok(identity(n)),
             MetricChoice::Matrix(m) => Ok(m.clone()),
             MetricChoice::Auto => synthesize_metric(model, &derivatives),
         };
-        // An empirical rate needs only sigma and rho from here.
-        let derived = metric.and_then(|p| match a.spec.rate {
-            Rate::Certified => constants(model, &derivatives, &p),
-            Rate::Empirical { .. } => constants_without_rate(model, &derivatives, &p),
+        // An empirical rate needs only sigma and rho from here; local rates need only a
+        // metric (the global constants, where bounded, tighten them where they hold).
+        let region = match a.spec.metric {
+            MetricChoice::Auto => MetricRegion::Domain,
+            _ => MetricRegion::Given,
+        };
+        let derived = match a.spec.rate {
+            Rate::Global => metric().and_then(|p| constants(model, &derivatives, &p)),
+            Rate::Empirical { .. } => {
+                metric().and_then(|p| constants_without_rate(model, &derivatives, &p))
+            }
+            Rate::Local => local_constants(model, &derivatives, &a.spec),
+        }
+        .map(|c| match a.spec.rate {
+            Rate::Local => c,
+            _ => Constants {
+                metric_region: region,
+                ..c
+            },
         });
         let constants = derived.map_err(|e| {
             let (message, help) = explain(model, &derivatives, &e);
@@ -89,6 +107,73 @@ pub fn prepare(model: &mut Model) -> Prepared {
         info,
         warnings,
     }
+}
+
+/// The constants of a local-rate analysis: its metric (given; or synthesised over the domain
+/// when that contracts, else over the initial set during the first report step), and the global
+/// constants for that metric where the compiler can bound them (infinite otherwise).
+fn local_constants(
+    model: &Model,
+    d: &Derivatives,
+    spec: &reachc_core::model::AnalysisSpec,
+) -> Result<Constants, ConstantsError> {
+    let n = model.states.len();
+    let (metric, region) = match &spec.metric {
+        MetricChoice::Identity => (identity(n), MetricRegion::Given),
+        MetricChoice::Matrix(m) => (m.clone(), MetricRegion::Given),
+        MetricChoice::Auto => {
+            let global = synthesize_metric(model, d).and_then(|p| constants(model, d, &p));
+            match global {
+                Ok(c) if c.c < 0.0 => {
+                    return Ok(Constants {
+                        metric_region: MetricRegion::Domain,
+                        ..c
+                    })
+                }
+                _ => (
+                    initial_metric(model, d, spec.step),
+                    MetricRegion::InitialSet,
+                ),
+            }
+        }
+    };
+    match constants(model, d, &metric) {
+        Ok(c) => Ok(Constants {
+            metric_region: region,
+            ..c
+        }),
+        Err(e @ ConstantsError::Unbounded { .. }) => {
+            let time = time_range(model);
+            Ok(Constants {
+                metric,
+                metric_region: region,
+                c: f64::INFINITY,
+                sigma: f64::INFINITY,
+                rho: f64::INFINITY,
+                provenance: Provenance::Unbounded {
+                    why: explain(model, d, &e).0,
+                },
+                region: reachc_core::model::Region {
+                    domain: model.domain.clone(),
+                    input_box: model.input_box.clone(),
+                    time: reachc_core::model::Bounds::new(time.lo(), time.hi()),
+                },
+            })
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// A metric synthesised for the Jacobian over the initial set's bounding box and
+/// `t in [0, step]` (the identity if that fails).
+fn initial_metric(model: &Model, d: &Derivatives, step: f64) -> Vec<f64> {
+    let n = model.states.len();
+    let Ok(start) = model.initial.bounding_box() else {
+        return identity(n);
+    };
+    let mut at_start = model.clone();
+    at_start.domain = start;
+    synthesize_metric_over(&at_start, d, Interval::new(0.0, step)).unwrap_or_else(|_| identity(n))
 }
 
 fn identity(n: usize) -> Vec<f64> {

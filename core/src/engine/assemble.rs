@@ -3,13 +3,14 @@
 //! each report time and over each report interval, the safety margins over those intervals,
 //! the verdicts.
 
+use super::local::Found;
 use super::radius::Stochastic;
 use super::safety::{Check, Context};
 use super::transform::Frame;
 use super::uniform::{Scale, Tube};
 use super::Run;
 use crate::interval::Interval;
-use crate::model::{Guarantee, Inclusion, Method};
+use crate::model::{Guarantee, Inclusion, Method, Rate};
 use crate::prs::{
     ConstantsUsed, DetSet, Proved, Prs, R1Bound, RateUsed, RuleUsed, Span, Step, TransformUsed,
     Unproved, UnsafeVerdict, Validation, Verdict,
@@ -35,6 +36,9 @@ pub(super) struct Deterministic {
     pub(super) pieces: Vec<Piece>,
     /// The transform of a parallelotope result (for exact half-space support functions).
     pub(super) frame: Option<Frame>,
+    /// The time-uniform tube the rates were certified with (local rates: the regions hold
+    /// this tube, so the result must use it); `None`: laid out here from the scale.
+    pub(super) tube: Option<Tube>,
 }
 
 /// What the result says besides the sets, as the engine determined it.
@@ -94,9 +98,10 @@ impl Radii {
                     t0 = p.t1;
                     (h, p.rates.0, p.rates.1)
                 }));
-                let first = det.pieces.iter().position(|p| p.end.is_some()).unwrap_or(0);
-                let s_last = scale.s.last().map_or(0.0, |s| s.hi());
-                let tube = Tube::new(run.setup.n, run.spec.delta, scale.s[first + 1].lo(), s_last);
+                let tube = det.tube.clone().unwrap_or_else(|| {
+                    let first = det.pieces.iter().position(|p| p.end.is_some()).unwrap_or(0);
+                    Tube::for_scale(run.setup.n, run.spec.delta, &scale, first + 1)
+                });
                 // Per report interval: the radius over the hull of psi and S along it (the
                 // tube's bound holds for every time whose psi and S lie in the hulls).
                 let mut guaranteed = Vec::with_capacity(pointwise.len());
@@ -122,7 +127,7 @@ impl Radii {
 
 /// The result of a run: the radii along the internal steps, the PRS at each report time and
 /// over each report interval, the margins over the intervals, and the verdicts.
-pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
+pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Option<Found>) -> Prs {
     let setup = run.setup;
     let w = spread(run);
     let context = Context {
@@ -158,6 +163,8 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
     });
     // The report interval being gathered: the hull of the steps' deterministic sets.
     let mut gathered: Option<Span> = None;
+    // The largest rates over the report interval being gathered.
+    let mut rates = (f64::NEG_INFINITY, f64::NEG_INFINITY);
     let internal_steps = det.pieces.len();
     let mut report = 0;
     for piece in det.pieces {
@@ -165,6 +172,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
             None => piece.over,
             Some(g) => g.hull(&piece.over),
         });
+        rates = (rates.0.max(piece.rates.0), rates.1.max(piece.rates.1));
         let Some(end) = piece.end else {
             continue;
         };
@@ -173,7 +181,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
         report += 1;
         let mut span = gathered.take().expect("a report interval has a step");
         span.radius = (Interval::point(span.radius) + Interval::point(r_over)).hi();
-        let (c, sigma) = piece.rates;
+        let (c, sigma) = std::mem::replace(&mut rates, (f64::NEG_INFINITY, f64::NEG_INFINITY));
         steps.push(Step {
             t: piece.t1,
             prs_radius: (Interval::point(end.radius()) + Interval::point(r_end)).hi(),
@@ -226,8 +234,27 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header) -> Prs {
         validation: Validation {
             rigorous,
             not_validated: header.not_validated,
-            conditional_on_domain: run.info.has_domain,
+            // Local rates need no domain (the tube never leaves its regions), unless the
+            // domain's constants took over.
+            conditional_on_domain: run.info.has_domain
+                && (run.spec.rate != Rate::Local || header.rate.global_from.is_some()),
         },
+        regions: local.map(|found| found.regions).unwrap_or_default(),
+    }
+}
+
+/// The rate record of a run: its kind and the range of the rates its pieces used.
+pub(super) fn rate_used(rate: Rate, pieces: &[Piece], local: Option<&Found>) -> RateUsed {
+    let (min_c, max_c) = pieces
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.rates.0), hi.max(p.rates.0))
+        });
+    RateUsed {
+        rate,
+        max_c,
+        min_c,
+        global_from: local.and_then(|found| found.global_from),
     }
 }
 
@@ -240,6 +267,7 @@ pub(super) fn constants_used(run: &Run, rho: f64) -> ConstantsUsed {
         rho,
         provenance: consts.provenance.clone(),
         metric: consts.metric.clone(),
+        metric_region: consts.metric_region,
         spread: spread(run),
     }
 }

@@ -3,13 +3,13 @@
 //! zero for an exact solution): on validated steps by default (`defect.rs`), or one
 //! unvalidated RK4 or Euler step per report step when the spec asks for it.
 
-use super::assemble::{assemble, constants_used, Deterministic, Header, Piece};
+use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::defect::{Nominal, NominalStep};
 use super::radius::expm1_over;
-use super::{nominal, radius, rates, Run, RunError};
+use super::{local, nominal, radius, rates, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
-use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, Unproved};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, Span, Unproved};
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -38,9 +38,31 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     let steps = nominal_steps(run, &x0, r1, &grid, &inputs)?;
     let validated = spec.integrator == Integrator::Validated;
 
-    // Per report interval rates (None: the certified constant throughout).
-    let empirical = match spec.rate {
-        Rate::Certified => None,
+    // The rates on each step: certified per step on the tube (local), the compiler's
+    // constant, or estimated per report interval (empirical).
+    let (pieces, local) = match spec.rate {
+        Rate::Local => {
+            let local = local::passes(run, |stepper| {
+                let pieces = along(&steps, &grid, r1, r2, |step, _, t0, r| {
+                    let h = Interval::point(step.t1) - Interval::point(t0);
+                    let rates = stepper.step(&step.lo, &step.hi, (t0, step.t1), |q| {
+                        let next = advance(r, (q.c, q.rho), r2, step.defect, h);
+                        r.hi().max(next.hi())
+                    })?;
+                    Ok((rates.c, rates.sigma, rates.rho))
+                })?;
+                let first = pieces.iter().position(|p| p.end.is_some()).unwrap_or(0) + 1;
+                Ok((pieces, first))
+            })?;
+            let found = local::Found::of(&local);
+            (local.result, Some(found))
+        }
+        Rate::Global => (
+            along(&steps, &grid, r1, r2, |_, _, _, _| {
+                Ok((consts.c, consts.sigma, rho))
+            })?,
+            None,
+        ),
         Rate::Empirical { paths } => {
             let mut traj = vec![x0.clone()];
             traj.extend(
@@ -49,44 +71,15 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
                     .filter(|(s, k)| s.t1 == grid[k + 1])
                     .map(|(s, _)| s.x1.clone()),
             );
-            Some(rates::empirical(run, metric, &grid, &traj, &inputs, paths)?)
+            let c = rates::empirical(run, metric, &grid, &traj, &inputs, paths)?;
+            (
+                along(&steps, &grid, r1, r2, |_, k, _, _| {
+                    Ok((c[k + 1], consts.sigma, rho))
+                })?,
+                None,
+            )
         }
     };
-    // The rate on report interval k (ending at grid[k + 1]).
-    let c_on = |k: usize| empirical.as_ref().map_or(consts.c, |c| c[k + 1]);
-
-    // R along the steps: R' = c R + rho r2 + defect.
-    let gain = Interval::point(rho) * Interval::point(r2);
-    let mut r = Interval::point(r1);
-    let mut t0 = 0.0;
-    let mut pieces = Vec::with_capacity(steps.len());
-    for (step, k) in steps {
-        let c = c_on(k);
-        let h = Interval::point(step.t1) - Interval::point(t0);
-        let r_prev = r.hi();
-        r = if c.is_finite() {
-            let forcing = gain + Interval::point(step.defect);
-            Interval::point((r * (Interval::point(c) * h).exp() + forcing * expm1_over(c, h)).hi())
-        } else {
-            Interval::point(f64::INFINITY)
-        };
-        // R is monotone on the step (a linear ODE with constant forcing): its largest value
-        // is at one end.
-        pieces.push(Piece {
-            t1: step.t1,
-            rates: (c, consts.sigma),
-            over: Span {
-                lo: step.lo,
-                hi: step.hi,
-                radius: r_prev.max(r.hi()),
-            },
-            end: (step.t1 == grid[k + 1]).then(|| DetSet::Ball {
-                center: step.x1,
-                radius: r.hi(),
-            }),
-        });
-        t0 = step.t1;
-    }
     let internal = pieces.len();
     let det = Deterministic {
         start: DetSet::Ball {
@@ -95,16 +88,18 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         },
         pieces,
         frame: None,
+        tube: local.as_ref().map(|found| found.tube.clone()),
     };
-
-    let max_c = empirical.as_ref().map_or(consts.c, |r| {
-        r.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-    });
-    let certified = spec.rate == Rate::Certified;
-    let mut rigorous = vec![Proved::Constants {
-        c: certified,
-        rho: true,
-        provenance: consts.provenance.clone(),
+    let mut rigorous = vec![match spec.rate {
+        Rate::Local => Proved::LocalRates {
+            regions: internal,
+            metric: consts.metric_region,
+        },
+        rate => Proved::Constants {
+            c: rate == Rate::Global,
+            rho: true,
+            provenance: consts.provenance.clone(),
+        },
     }];
     let mut not_validated = Vec::new();
     if validated {
@@ -129,10 +124,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     let header = Header {
         method: Method::Contraction,
         inclusion: None,
-        rate: RateUsed {
-            rate: spec.rate,
-            max_c,
-        },
+        rate: rate_used(spec.rate, &det.pieces, local.as_ref()),
         constants: constants_used(run, rho),
         radius_rule,
         kappa,
@@ -145,7 +137,53 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         rigorous,
         not_validated,
     };
-    Ok(assemble(run, det, header))
+    Ok(assemble(run, det, header, local))
+}
+
+/// The pieces along the nominal's steps, `R` following `R' = c R + rho r2 + |d|_P` with the
+/// rates `rates(step, report interval, t0, R at t0)` gives for each step (`c`, `sigma`, `rho`).
+fn along(
+    steps: &[(NominalStep, usize)],
+    grid: &[f64],
+    r1: f64,
+    r2: f64,
+    mut rates: impl FnMut(&NominalStep, usize, f64, Interval) -> Result<(f64, f64, f64), RunError>,
+) -> Result<Vec<Piece>, RunError> {
+    let mut r = Interval::point(r1);
+    let mut t0 = 0.0;
+    let mut pieces = Vec::with_capacity(steps.len());
+    for (step, k) in steps {
+        let (c, sigma, rho) = rates(step, *k, t0, r)?;
+        let h = Interval::point(step.t1) - Interval::point(t0);
+        let r_prev = r.hi();
+        r = advance(r, (c, rho), r2, step.defect, h);
+        // R is monotone on the step (a linear ODE with constant forcing): its largest value
+        // is at one end.
+        pieces.push(Piece {
+            t1: step.t1,
+            rates: (c, sigma),
+            over: Span {
+                lo: step.lo.clone(),
+                hi: step.hi.clone(),
+                radius: r_prev.max(r.hi()),
+            },
+            end: (step.t1 == grid[k + 1]).then(|| DetSet::Ball {
+                center: step.x1.clone(),
+                radius: r.hi(),
+            }),
+        });
+        t0 = step.t1;
+    }
+    Ok(pieces)
+}
+
+/// `R` after a step of length `h` from `r`: `R' = c R + rho r2 + defect` (upper bound).
+fn advance(r: Interval, (c, rho): (f64, f64), r2: f64, defect: f64, h: Interval) -> Interval {
+    if !c.is_finite() {
+        return Interval::point(f64::INFINITY);
+    }
+    let forcing = Interval::point(rho) * Interval::point(r2) + Interval::point(defect);
+    Interval::point((r * (Interval::point(c) * h).exp() + forcing * expm1_over(c, h)).hi())
 }
 
 /// The nominal's steps with their report interval: validated internal steps, or one step of
@@ -163,11 +201,18 @@ fn nominal_steps(
         // The defect may add about 1% of the PRS's natural size (the initial radius, or the
         // stochastic radius sqrt(sigma^2 T kappa)) over the horizon.
         let (kappa, _) = radius::stochastic_factor(run.setup.n, spec);
+        let sigma = if consts.sigma.is_finite() {
+            consts.sigma
+        } else {
+            noise_scale(run, x0)
+        };
         let scale = r1
-            .max(consts.sigma * (spec.horizon * kappa).sqrt())
+            .max(sigma * (spec.horizon * kappa).sqrt())
             .max(1e-9 * x0.iter().fold(1.0f64, |m, v| m.max(v.abs())));
         let tolerance = 1e-2 * scale / spec.horizon.max(f64::MIN_POSITIVE);
-        let domain = run.info.has_domain.then_some(&run.info.domain[..]);
+        // Local rates need no domain (the regions follow the tube).
+        let domain =
+            (run.info.has_domain && spec.rate != Rate::Local).then_some(&run.info.domain[..]);
         return Nominal::new(run.sys, &consts.metric, tolerance, domain).steps(x0, grid, inputs);
     }
     let traj = nominal::integrate(run.sys, x0, inputs, grid, spec.integrator).map_err(|k| {
@@ -197,4 +242,22 @@ fn nominal_steps(
             )
         })
         .collect())
+}
+
+/// A noise level for accuracy targets when the compiler could not bound `sigma`:
+/// `sqrt(trace(P G G'))` at the initial centre and `t = 0` (at least `|P^(1/2) G|_2` there).
+fn noise_scale(run: &Run, x0: &[f64]) -> f64 {
+    let (n, m) = (run.setup.n, run.sys.m());
+    let metric = &run.setup.consts.metric;
+    let mut g = vec![0.0; n * m];
+    run.sys.diffusion(x0, 0.0, &mut g);
+    let mut trace = 0.0;
+    for l in 0..m {
+        for i in 0..n {
+            for j in 0..n {
+                trace += metric[i * n + j] * g[i * m + l] * g[j * m + l];
+            }
+        }
+    }
+    trace.max(0.0).sqrt()
 }

@@ -26,13 +26,13 @@
 //! integrated numerically (RK4 or Euler, no remainder bound), so the box is an enclosure only
 //! up to the time-discretisation error. The result says so.
 
-use super::assemble::{assemble, constants_used, Deterministic, Header, Piece};
+use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::embedding::{BoxStep, Embedding};
 use super::transform::{self, Frame};
-use super::{nominal, radius, validate, Run, RunError};
+use super::{local, nominal, radius, validate, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
-use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, RateUsed, Span, TransformUsed, Unproved};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, Span, TransformUsed, Unproved};
 use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
@@ -95,7 +95,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         }
     };
     let internal = steps.len();
-    let pieces = steps
+    let mut pieces: Vec<Piece> = steps
         .into_iter()
         .map(|step| {
             let (lo, hi) = x_box(&step.over_lo, &step.over_hi);
@@ -111,13 +111,39 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
             }
         })
         .collect();
+    // Local rates: certified per step on the box widened by the tube.
+    let local = if spec.rate == Rate::Local {
+        let local = local::passes(run, |stepper| {
+            let mut t0 = 0.0;
+            let mut rates = Vec::with_capacity(pieces.len());
+            for p in &pieces {
+                let r = stepper.step(&p.over.lo, &p.over.hi, (t0, p.t1), |_| p.over.radius)?;
+                rates.push((r.c, r.sigma));
+                t0 = p.t1;
+            }
+            let first = pieces.iter().position(|p| p.end.is_some()).unwrap_or(0) + 1;
+            Ok((rates, first))
+        })?;
+        for (p, &r) in pieces.iter_mut().zip(&local.result) {
+            p.rates = r;
+        }
+        Some(local::Found::of(&local))
+    } else {
+        None
+    };
     let transform = frame.as_ref().map(Frame::used);
     let validated = spec.integrator == Integrator::Validated;
     let mut rigorous = vec![
-        Proved::Constants {
-            c: true,
-            rho: false,
-            provenance: consts.provenance.clone(),
+        match spec.rate {
+            Rate::Local => Proved::LocalRates {
+                regions: internal,
+                metric: consts.metric_region,
+            },
+            _ => Proved::Constants {
+                c: true,
+                rho: false,
+                provenance: consts.provenance.clone(),
+            },
         },
         Proved::Inclusion(inclusion),
     ];
@@ -148,14 +174,12 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         start: det_set(start),
         pieces,
         frame,
+        tube: local.as_ref().map(|found| found.tube.clone()),
     };
     let header = Header {
         method: Method::Interval,
         inclusion: Some(inclusion),
-        rate: RateUsed {
-            rate: Rate::Certified,
-            max_c: consts.c,
-        },
+        rate: rate_used(spec.rate, &det.pieces, local.as_ref()),
         constants: constants_used(run, consts.rho),
         radius_rule,
         kappa,
@@ -171,7 +195,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         rigorous,
         not_validated,
     };
-    Ok(assemble(run, det, header))
+    Ok(assemble(run, det, header, local))
 }
 
 /// The input box of each report step: the model's box, or the plan's point.

@@ -24,8 +24,9 @@ mod embedding;
 mod hermite;
 pub(crate) mod interval;
 pub(crate) mod linalg;
+mod local;
 mod nominal;
-mod radius;
+pub(crate) mod radius;
 mod rates;
 mod safety;
 pub(crate) mod transform;
@@ -87,6 +88,7 @@ impl std::error::Error for RunError {}
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Needs {
     pub(crate) c: bool,
+    pub(crate) sigma: bool,
     pub(crate) rho: bool,
 }
 
@@ -114,7 +116,7 @@ impl<'a> Setup<'a> {
         needs: Needs,
     ) -> Result<Setup<'a>, RunError> {
         let consts = constants.as_ref().map_err(|why| {
-            let used: Vec<&str> = [("c", needs.c), ("sigma", true), ("rho", needs.rho)]
+            let used: Vec<&str> = [("c", needs.c), ("sigma", needs.sigma), ("rho", needs.rho)]
                 .iter()
                 .filter(|(_, used)| *used)
                 .map(|(name, _)| *name)
@@ -137,7 +139,7 @@ impl<'a> Setup<'a> {
         }
         for (what, v, used) in [
             ("c", consts.c, needs.c),
-            ("sigma", consts.sigma, true),
+            ("sigma", consts.sigma, needs.sigma),
             ("rho", consts.rho, needs.rho),
         ] {
             if used && !v.is_finite() {
@@ -301,12 +303,16 @@ fn covered(info: &ModelInfo, spec: &AnalysisSpec, consts: &Constants) -> Result<
 }
 
 /// Checks an initial set against the model: one entry per state, and inside the domain when the
-/// spec has one (the constants hold only there).
-pub(crate) fn check_initial(info: &ModelInfo, initial: &InitialSet) -> Result<(), RunError> {
+/// spec has one and `in_domain` asks for it (the global constants hold only there).
+pub(crate) fn check_initial(
+    info: &ModelInfo,
+    initial: &InitialSet,
+    in_domain: bool,
+) -> Result<(), RunError> {
     let n = info.states.len();
     let (center, half) =
         radius::initial_center_and_halfwidths(initial, n).map_err(RunError::Invalid)?;
-    if info.has_domain {
+    if info.has_domain && in_domain {
         for i in 0..n {
             // Boxes as given; ball coordinates by their bounding boxes (rounded outward).
             let Bounds { lo, hi } = initial.boxes[i].unwrap_or_else(|| {

@@ -37,17 +37,34 @@ impl Scale {
     /// Along steps of lengths `h` (enclosures) with constant rates `(c, sigma)` on each:
     /// `psi_(k+1) = psi_k + c h`, `S_(k+1) = S_k + sigma^2 e^(-2 psi_k) int_0^h e^(-2 c s) ds`.
     pub(super) fn new(steps: impl Iterator<Item = (Interval, f64, f64)>) -> Scale {
-        let (mut psi, mut s) = (vec![Interval::ZERO], vec![Interval::ZERO]);
+        let mut scale = Scale {
+            psi: vec![Interval::ZERO],
+            s: vec![Interval::ZERO],
+        };
         for (h, c, sigma) in steps {
-            let (p, v) = (psi[psi.len() - 1], s[s.len() - 1]);
-            let sigma2 = Interval::point(sigma).sqr();
-            let gain = sigma2 * (Interval::point(-2.0) * p).exp() * expm1_over(-2.0 * c, h);
-            psi.push(p + Interval::point(c) * h);
-            // S is non-decreasing: its lower end never falls below the previous one.
-            let next = v + gain;
-            s.push(Interval::new(next.lo().max(v.lo()), next.hi()));
+            scale.push(h, c, sigma);
         }
-        Scale { psi, s }
+        scale
+    }
+
+    /// The enclosures at the end of one more step (see [`Scale::new`]).
+    pub(super) fn next(&self, h: Interval, c: f64, sigma: f64) -> (Interval, Interval) {
+        let (p, v) = (self.psi[self.psi.len() - 1], self.s[self.s.len() - 1]);
+        let sigma2 = Interval::point(sigma).sqr();
+        let gain = sigma2 * (Interval::point(-2.0) * p).exp() * expm1_over(-2.0 * c, h);
+        // S is non-decreasing: its lower end never falls below the previous one.
+        let next = v + gain;
+        (
+            p + Interval::point(c) * h,
+            Interval::new(next.lo().max(v.lo()), next.hi()),
+        )
+    }
+
+    /// Appends one more step.
+    pub(super) fn push(&mut self, h: Interval, c: f64, sigma: f64) {
+        let (psi, s) = self.next(h, c, sigma);
+        self.psi.push(psi);
+        self.s.push(s);
     }
 }
 
@@ -99,6 +116,19 @@ impl Tube {
             })
             .collect();
         Tube { n, epochs }
+    }
+
+    /// The tube for a run whose scale is `scale`, its first report time at step index
+    /// `first` (index into `scale`).
+    pub(super) fn for_scale(n: usize, delta: f64, scale: &Scale, first: usize) -> Tube {
+        let s_last = scale.s.last().map_or(0.0, |s| s.hi());
+        let s_first = scale.s.get(first).map_or(s_last, |s| s.lo());
+        Tube::new(n, delta, s_first, s_last)
+    }
+
+    /// The horizon's `S` the epochs were laid out for.
+    pub(super) fn s_last(&self) -> f64 {
+        self.epochs.last().map_or(0.0, |e| e.s_end)
     }
 
     /// The number of epochs (the union bound's `K`).

@@ -54,7 +54,10 @@ struct RateJson {
     note: String,
     #[serde(skip_serializing_if = "Option::is_none")]
     paths: Option<u64>,
+    min_c: f64,
     max_c: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    global_from: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -64,6 +67,7 @@ struct ConstantsJson<'a> {
     rho: f64,
     how: String,
     metric: Vec<&'a [f64]>,
+    metric_from: String,
 }
 
 #[derive(Serialize)]
@@ -167,9 +171,11 @@ impl<'a> Json<'a> {
                 note: rate_note(prs.rate.rate),
                 paths: match prs.rate.rate {
                     Rate::Empirical { paths } => Some(paths),
-                    Rate::Certified => None,
+                    Rate::Local | Rate::Global => None,
                 },
+                min_c: prs.rate.min_c,
                 max_c: prs.rate.max_c,
+                global_from: prs.rate.global_from,
             },
             constants: ConstantsJson {
                 c: prs.constants.c,
@@ -177,6 +183,7 @@ impl<'a> Json<'a> {
                 rho: prs.constants.rho,
                 how: prs.constants.provenance.to_string(),
                 metric: rows(&prs.constants.metric),
+                metric_from: prs.constants.metric_region.to_string(),
             },
             radius_rule: RuleJson {
                 rule: prs.radius_rule.rule.name(),
@@ -302,7 +309,11 @@ pub(crate) fn unsafe_kind(kind: UnsafeKind) -> &'static str {
 /// guarantee.
 fn rate_note(rate: Rate) -> String {
     match rate {
-        Rate::Certified => {
+        Rate::Local => "c_t, sigma_t and rho_t certified on each internal step over a box \
+             holding the deterministic set and the time-uniform tube on that step (interval \
+             Jacobian, verified eigenvalue bounds): no global rate and no domain needed"
+            .into(),
+        Rate::Global => {
             "one rate c for the whole horizon, certified by the compiler over the domain".into()
         }
         Rate::Empirical { paths } => format!(
@@ -390,6 +401,10 @@ fn proved(p: &Proved) -> String {
             "embedding system on {steps} validated steps (the comparison principle on each \
              step's hull, time as an interval): the boxes hold over whole steps, not only at \
              report times"
+        ),
+        Proved::LocalRates { regions, metric } => format!(
+            "local rates on {regions} regions, each holding the tube over its step, so the \
+             process never leaves them on the tube's event (metric {metric})"
         ),
         Proved::UniformTube { epochs } => format!(
             "time-uniform tube: Ville's inequality on the averaged-MGF supermartingale over \
@@ -529,20 +544,48 @@ pub fn summary(prs: &Prs) -> String {
     );
     let _ = writeln!(s, "  {}", guarantee_sentence(prs));
     let k = &prs.constants;
-    let c = match prs.rate.rate {
-        Rate::Certified => format!("{:.6}", k.c),
-        rate => format!(
-            "c_t ({} rate, at most {})",
-            rate.name(),
-            num(prs.rate.max_c)
-        ),
-    };
-    let _ = writeln!(
-        s,
-        "  constants: c = {c}, sigma = {:.6}, rho = {:.6} ({})",
-        k.sigma, k.rho, k.provenance
-    );
-    if prs.rate.rate != Rate::Certified {
+    match prs.rate.rate {
+        Rate::Global => {
+            let _ = writeln!(
+                s,
+                "  constants: c = {:.6}, sigma = {:.6}, rho = {:.6} ({})",
+                k.c, k.sigma, k.rho, k.provenance
+            );
+        }
+        Rate::Local => {
+            let sigma = prs.regions.iter().map(|r| r.sigma).fold(0.0, f64::max);
+            let _ = writeln!(
+                s,
+                "  rates: local, c_t in [{}, {}], sigma_t at most {} (global: c = {}, sigma = \
+                 {}; {})",
+                num(prs.rate.min_c),
+                num(prs.rate.max_c),
+                num(sigma),
+                num(k.c),
+                num(k.sigma),
+                k.provenance
+            );
+            if let Some(t) = prs.rate.global_from {
+                let _ = writeln!(
+                    s,
+                    "  from t = {t}, no region around the tube closed: the global constants over \
+                     the domain took over (the result is conditional on the domain)"
+                );
+            }
+        }
+        rate => {
+            let _ = writeln!(
+                s,
+                "  constants: c = c_t ({} rate, at most {}), sigma = {:.6}, rho = {:.6} ({})",
+                rate.name(),
+                num(prs.rate.max_c),
+                k.sigma,
+                k.rho,
+                k.provenance
+            );
+        }
+    }
+    if prs.rate.rate != Rate::Global {
         let _ = writeln!(s, "  rate: {}", rate_note(prs.rate.rate));
     }
     let n = prs.n().max(1);
@@ -554,7 +597,12 @@ pub fn summary(prs: &Prs) -> String {
             format!("[{}]", cells.join(", "))
         })
         .collect();
-    let _ = writeln!(s, "  metric P = [{}]", rows.join(", "));
+    let _ = writeln!(
+        s,
+        "  metric P = [{}] ({})",
+        rows.join(", "),
+        k.metric_region
+    );
     let rule = match prs.radius_rule.eps {
         Some(eps) => format!("{} (eps = {eps:.6})", prs.radius_rule.rule.name()),
         None => prs.radius_rule.rule.name().to_string(),

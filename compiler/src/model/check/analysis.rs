@@ -125,8 +125,11 @@ impl Checker<'_> {
             None => Some(RadiusRule::Amgf),
             Some((e, _)) => self.radius_rule(e),
         };
+        // Local rates need the time-uniform tube; a pointwise analysis defaults to the global
+        // rate.
         let rate = match f.get("rate") {
-            None => Some(Rate::Certified),
+            None if guarantee == Some(Guarantee::Pointwise) => Some(Rate::Global),
+            None => Some(Rate::Local),
             Some((e, _)) => self.rate(e),
         };
         let transform = match f.get("transform") {
@@ -156,11 +159,27 @@ impl Checker<'_> {
         else {
             return;
         };
+        if let (Rate::Local, Guarantee::Pointwise, Some((e, _))) = (rate, guarantee, f.get("rate"))
+        {
+            self.fail::<()>(
+                Diagnostic::error(
+                    "local rates need `guarantee = uniform`",
+                    e.span.clone(),
+                    "with a pointwise guarantee",
+                )
+                .with_help(
+                    "the proof that the process never leaves the regions of the local rates uses \
+                     the time-uniform tube: remove `guarantee = pointwise`, or write \
+                     `rate = global`",
+                ),
+            );
+            return;
+        }
         if let (Rate::Empirical { .. }, Some((e, _))) = (rate, f.get("rate")) {
             let conflict = if method != Method::Contraction {
                 Some((
                     "needs `method = contraction`",
-                    "the interval method uses the certified rate",
+                    "the interval method uses a certified rate (`local` or `global`)",
                 ))
             } else if metric == Metric::Auto {
                 Some((
@@ -341,14 +360,15 @@ impl Checker<'_> {
         }
     }
 
-    /// `certified` or `empirical(paths = N)`.
+    /// `local`, `global` or `empirical(paths = N)`.
     fn rate(&mut self, e: &Expr) -> Option<Rate> {
-        let help = "write `certified` or `empirical(paths = 2000)`";
+        let help = "write `local`, `global` or `empirical(paths = 2000)`";
         let bad = |msg: &str, span: Span, label: &str| {
             Diagnostic::error(msg, span, label).with_help(help)
         };
         match &e.kind {
-            ExprKind::Name(id) if id.name == "certified" => Some(Rate::Certified),
+            ExprKind::Name(id) if id.name == "local" => Some(Rate::Local),
+            ExprKind::Name(id) if id.name == "global" => Some(Rate::Global),
             ExprKind::Call { func, args } if func.name == "empirical" => {
                 let key = "paths";
                 let [a] = args.as_slice() else {
@@ -385,7 +405,7 @@ impl Checker<'_> {
             _ => self.fail(bad(
                 "unknown rate",
                 e.span.clone(),
-                "expected certified or empirical(...)",
+                "expected local, global or empirical(...)",
             )),
         }
     }

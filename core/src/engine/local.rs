@@ -1,0 +1,630 @@
+//! Local rates on the tube (method.md section 8.3, `rate = local`): per internal step, `c_k`,
+//! `sigma_k` and `rho_k` certified over a box `D_k` that holds the deterministic set over the
+//! step widened by the time-uniform tube's radius. Up to the first exit from the regions, the
+//! pair `(X_t, x_t)` stays in a convex `D_k`, so the proof's contraction step and the
+//! supermartingale hold with the local rates; on Ville's event the process is strictly inside
+//! the tube, hence inside `D_k`, so it never exits. No global rate and no domain are needed.
+//!
+//! The regions depend on the tube and the tube on the rates, so each step guesses a region from
+//! the previous rates, certifies rates over it, and accepts them only if the tube they give over
+//! the step lies strictly inside the region; otherwise it inflates and retries.
+//!
+//! The certificate over a box, for `P = L L'` (`R = L'`, `|x|_P = |R x|`):
+//! `mu_P(J) = lambda_max(sym(R J R^-1))` bounded over the interval Jacobian by the midpoint's
+//! verified `lambda_max` plus the spectral radius bound of the radius matrix (or interval
+//! Cholesky, whichever is smaller; Gershgorin for large sparse systems);
+//! `sigma^2 = lambda_max(R G G' R')` over the interval `G`; `rho` by columns of `R D_u f`
+//! scaled by the input box's half-widths. Where the compiler's global constants hold on the
+//! region (no domain, or the region inside it), the smaller of the two is used.
+
+use super::linalg;
+use super::uniform::{Scale, Tube};
+use super::{Run, RunError};
+use crate::interval::Interval;
+use crate::model::Bounds;
+use crate::prs::RateRegion;
+use crate::system::System;
+
+/// Up to this many states the rates use dense interval matrices; above, a diagonal metric and
+/// Gershgorin bounds in time proportional to the Jacobian's non-zeros.
+pub(crate) const DENSE_MAX: usize = 64;
+
+/// The most Jacobian entries enumerated at their ends (`2^6` vertex matrices per bound).
+const VERTEX_ENTRIES: usize = 6;
+
+/// Attempts per step to find a region that holds its own tube.
+const MAX_TRIES: usize = 12;
+
+/// Each attempt's region exceeds what the current rates need by this factor.
+const INFLATE: f64 = 1.25;
+
+/// Passes over the horizon: the tube's epochs are laid out from the previous pass's scale.
+const MAX_PASSES: usize = 3;
+
+/// Rates certified over a region.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Rates {
+    pub(super) c: f64,
+    pub(super) sigma: f64,
+    pub(super) rho: f64,
+}
+
+impl Rates {
+    fn max(self, o: Rates) -> Rates {
+        Rates {
+            c: self.c.max(o.c),
+            sigma: self.sigma.max(o.sigma),
+            rho: self.rho.max(o.rho),
+        }
+    }
+
+    fn is_finite(self) -> bool {
+        self.c.is_finite() && self.sigma.is_finite() && self.rho.is_finite()
+    }
+}
+
+/// Certifies [`Rates`] over boxes of states, for the analysis' metric.
+pub(super) struct Certifier<'a> {
+    sys: &'a dyn System,
+    states: &'a [String],
+    n: usize,
+    /// `R = L'`, upper triangular, and an enclosure of `R^-1` (dense route), or the diagonal
+    /// of `R` (sparse route).
+    r: Vec<Interval>,
+    r_inv: Vec<Interval>,
+    dense: bool,
+    pattern: Vec<(usize, usize)>,
+    inputs: Vec<Interval>,
+    half: Vec<Interval>,
+    /// The compiler's constants, with the box they hold on (`None`: all of R^n).
+    global: Option<(Rates, Option<Vec<Bounds>>)>,
+}
+
+/// Why no rates: the Jacobian entry with the largest magnitude over the region.
+struct Grew {
+    entry: Option<(usize, usize, Interval)>,
+}
+
+impl<'a> Certifier<'a> {
+    /// The certifier of a run: its metric, input box and the compiler's constants.
+    pub(super) fn new(run: &Run<'a>) -> Result<Certifier<'a>, RunError> {
+        let (sys, n, consts) = (run.sys, run.setup.n, run.setup.consts);
+        let chol = linalg::cholesky(&linalg::to_intervals(&consts.metric), n)
+            .ok_or_else(|| RunError::Invalid("the metric is not positive definite".into()))?;
+        let diagonal = (0..n).all(|i| (0..n).all(|j| i == j || consts.metric[i * n + j] == 0.0));
+        let dense = n <= DENSE_MAX;
+        if !dense && !diagonal {
+            return Err(RunError::Unsupported(format!(
+                "local rates for more than {DENSE_MAX} states need a diagonal metric (give \
+                 `metric = identity` or `rate = global`)"
+            )));
+        }
+        let (r, r_inv) = if dense {
+            let mut r = vec![Interval::ZERO; n * n];
+            let mut r_inv = vec![Interval::ZERO; n * n];
+            for j in 0..n {
+                let mut e = vec![Interval::ZERO; n];
+                e[j] = Interval::ONE;
+                // Column j of L^-1 is row j of R^-1 = (L^-1)'.
+                let col = linalg::forward_solve(&chol, n, &e);
+                for i in 0..n {
+                    r[i * n + j] = chol[j * n + i];
+                    r_inv[j * n + i] = col[i];
+                }
+            }
+            (r, r_inv)
+        } else {
+            let d: Vec<Interval> = (0..n).map(|i| chol[i * n + i]).collect();
+            let inv = d.iter().map(|x| x.recip()).collect();
+            (d, inv)
+        };
+        let inputs: Vec<Interval> = run
+            .info
+            .input_box
+            .iter()
+            .map(|b| Interval::new(b.lo, b.hi))
+            .collect();
+        let half = inputs.iter().map(|u| Interval::point(u.rad())).collect();
+        let global = Rates {
+            c: consts.c,
+            sigma: consts.sigma,
+            rho: consts.rho,
+        };
+        let domain = run.info.has_domain.then(|| run.info.domain.clone());
+        Ok(Certifier {
+            sys,
+            states: &run.info.states,
+            n,
+            r,
+            r_inv,
+            dense,
+            pattern: if dense {
+                Vec::new()
+            } else {
+                sys.jac_x_pattern()
+            },
+            inputs: inputs
+                .iter()
+                .map(|u| Interval::new(u.lo(), u.hi()))
+                .collect(),
+            half,
+            global: Some((global, domain)),
+        })
+    }
+
+    /// Rates over the box `x` of states, inputs in the input box, times in `t`.
+    fn rates(&self, x: &[Interval], t: Interval) -> Result<Rates, Grew> {
+        let local = Rates {
+            c: self.rate(x, t)?,
+            sigma: self.noise(x, t),
+            rho: self.gain(x, t),
+        };
+        let Some((global, domain)) = &self.global else {
+            return Ok(local);
+        };
+        let inside = domain.as_ref().is_none_or(|d| {
+            x.iter()
+                .zip(d)
+                .all(|(v, b)| v.lo() >= b.lo && v.hi() <= b.hi)
+        });
+        Ok(if inside {
+            Rates {
+                c: local.c.min(global.c),
+                sigma: local.sigma.min(global.sigma),
+                rho: local.rho.min(global.rho),
+            }
+        } else {
+            local
+        })
+    }
+
+    /// An upper bound of `mu_P(D_x f)` over the box.
+    fn rate(&self, x: &[Interval], t: Interval) -> Result<f64, Grew> {
+        let n = self.n;
+        if self.dense {
+            let mut j = vec![Interval::ZERO; n * n];
+            self.sys.jac_x_interval(x, &self.inputs, t, &mut j);
+            if let Some(k) = j.iter().position(|v| !v.is_bounded()) {
+                return Err(Grew {
+                    entry: Some((k / n, k % n, j[k])),
+                });
+            }
+            let rate = self.vertex_rate(&j);
+            if rate.is_finite() {
+                Ok(rate)
+            } else {
+                Err(Grew {
+                    entry: largest(&j, n),
+                })
+            }
+        } else {
+            let mut j = vec![Interval::ZERO; self.pattern.len()];
+            self.sys.jac_x_sparse_interval(x, &self.inputs, t, &mut j);
+            // Gershgorin on sym(D J D^-1): row i gets the diagonal's upper end and half the
+            // magnitudes of (i, j) and (j, i).
+            let mut row = vec![Interval::ZERO; n];
+            for (&(i, k), &v) in self.pattern.iter().zip(&j) {
+                if !v.is_bounded() {
+                    return Err(Grew {
+                        entry: Some((i, k, v)),
+                    });
+                }
+                let b = self.r[i] * v * self.r_inv[k];
+                if i == k {
+                    row[i] += Interval::point(b.hi());
+                } else {
+                    let half = Interval::point(b.mag()) * Interval::point(0.5);
+                    row[i] += half;
+                    row[k] += half;
+                }
+            }
+            Ok(row.iter().map(|v| v.hi()).fold(f64::NEG_INFINITY, f64::max))
+        }
+    }
+
+    /// An upper bound of `lambda_max(sym(R J R^-1))` over the interval matrix `j` (dense). The
+    /// bound is convex in `J`, so its supremum over the widest entries' ranges is attained at
+    /// their ends: those entries are enumerated at their ends (the others stay intervals).
+    fn vertex_rate(&self, j: &[Interval]) -> f64 {
+        let n = self.n;
+        let mut wide: Vec<usize> = (0..n * n).filter(|&k| j[k].width() > 0.0).collect();
+        wide.sort_by(|&a, &b| j[b].width().total_cmp(&j[a].width()));
+        wide.truncate(VERTEX_ENTRIES);
+        let mut vertex = j.to_vec();
+        let mut worst = f64::NEG_INFINITY;
+        for mask in 0..1usize << wide.len() {
+            for (bit, &k) in wide.iter().enumerate() {
+                let end = if mask >> bit & 1 == 1 {
+                    j[k].hi()
+                } else {
+                    j[k].lo()
+                };
+                vertex[k] = Interval::point(end);
+            }
+            let b = product(&product(&self.r, &vertex, n, n, n), &self.r_inv, n, n, n);
+            worst = worst.max(lambda_max(&symmetric_part(&b, n), n));
+        }
+        worst
+    }
+
+    /// An upper bound of `sqrt(lambda_max(R G G' R'))` over the box (infinite if unbounded).
+    fn noise(&self, x: &[Interval], t: Interval) -> f64 {
+        let (n, m) = (self.n, self.sys.m());
+        if m == 0 {
+            return 0.0;
+        }
+        let mut g = vec![Interval::ZERO; n * m];
+        self.sys.diffusion_interval(x, t, &mut g);
+        if self.dense {
+            let rg = product(&self.r, &g, n, n, m);
+            let mut w = vec![Interval::ZERO; n * n];
+            for i in 0..n {
+                for k in 0..=i {
+                    let mut s = Interval::ZERO;
+                    for l in 0..m {
+                        s += rg[i * m + l] * rg[k * m + l];
+                    }
+                    w[i * n + k] = s;
+                    w[k * n + i] = s;
+                }
+            }
+            lambda_max(&w, n).max(0.0).sqrt().next_up()
+        } else {
+            // ||M||_2 <= sqrt(||M||_1 ||M||_inf) on the magnitudes of M = R G.
+            let (mut rows, mut cols) = (vec![Interval::ZERO; n], vec![Interval::ZERO; m]);
+            for i in 0..n {
+                for l in 0..m {
+                    let v = Interval::point((self.r[i] * g[i * m + l]).mag());
+                    rows[i] += v;
+                    cols[l] += v;
+                }
+            }
+            let top = |v: &[Interval]| v.iter().map(|x| x.hi()).fold(0.0, f64::max);
+            (Interval::point(top(&rows)) * Interval::point(top(&cols)))
+                .sqrt()
+                .hi()
+        }
+    }
+
+    /// An upper bound of `sup |D_u f v|_P` over `|v|_U <= 1` (the sum of the column norms of
+    /// `R D_u f diag(h)`).
+    fn gain(&self, x: &[Interval], t: Interval) -> f64 {
+        let (n, p) = (self.n, self.sys.p());
+        if p == 0 {
+            return 0.0;
+        }
+        let mut ju = vec![Interval::ZERO; n * p];
+        self.sys.jac_u_interval(x, &self.inputs, t, &mut ju);
+        let m = if self.dense {
+            product(&self.r, &ju, n, n, p)
+        } else {
+            (0..n * p).map(|k| self.r[k / p] * ju[k]).collect()
+        };
+        let mut total = Interval::ZERO;
+        for j in 0..p {
+            let mut s = Interval::ZERO;
+            for i in 0..n {
+                s += Interval::point(m[i * p + j].mag()).sqr();
+            }
+            total += s.sqrt() * self.half[j];
+        }
+        total.hi()
+    }
+
+    /// The diagnostic for a region whose rates cannot be bounded or do not settle.
+    fn explain(&self, t0: f64, x: &[Interval], grew: Option<Grew>) -> RunError {
+        let region: Vec<String> = self
+            .states
+            .iter()
+            .zip(x)
+            .map(|(s, v)| format!("{s} in [{:.4e}, {:.4e}]", v.lo(), v.hi()))
+            .collect();
+        let entry = grew
+            .and_then(|g| g.entry)
+            .or_else(|| {
+                let mut j = vec![Interval::ZERO; self.n * self.n];
+                self.sys
+                    .jac_x_interval(x, &self.inputs, Interval::point(t0), &mut j);
+                largest(&j, self.n)
+            })
+            .map(|(i, k, v)| {
+                format!(
+                    "; the Jacobian entry d f[{}] / d {} grew to [{:.4e}, {:.4e}] there",
+                    self.states[i],
+                    self.states[k],
+                    v.lo(),
+                    v.hi()
+                )
+            })
+            .unwrap_or_default();
+        RunError::NonFinite(format!(
+            "the local rates cannot be certified at t = {t0}: no region around the tube holds \
+             the tube its own rates give (last region tried: {}){entry}. A shorter horizon, a \
+             smaller initial set or less noise may help",
+            region.join(", ")
+        ))
+    }
+}
+
+/// `A B` for interval matrices `r x k` and `k x c`.
+fn product(a: &[Interval], b: &[Interval], r: usize, k: usize, c: usize) -> Vec<Interval> {
+    let mut out = vec![Interval::ZERO; r * c];
+    for i in 0..r {
+        for l in 0..k {
+            let ail = a[i * k + l];
+            if ail == Interval::ZERO {
+                continue;
+            }
+            for j in 0..c {
+                out[i * c + j] += ail * b[l * c + j];
+            }
+        }
+    }
+    out
+}
+
+/// `(B + B') / 2`.
+fn symmetric_part(b: &[Interval], n: usize) -> Vec<Interval> {
+    let mut s = vec![Interval::ZERO; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            s[i * n + j] = (b[i * n + j] + b[j * n + i]) * Interval::point(0.5);
+        }
+    }
+    s
+}
+
+/// A rigorous upper bound of `lambda_max` over the symmetric matrices in `s`: the smaller of
+/// the interval-Cholesky route and `lambda_max(mid) + rho(rad)` (Collatz-Wielandt with the unit
+/// vector, i.e. the largest row sum of the radii), which stays tight for wide enclosures.
+fn lambda_max(s: &[Interval], n: usize) -> f64 {
+    let direct = linalg::lambda_max_upper(s, n);
+    let mid: Vec<Interval> = s.iter().map(|v| Interval::point(v.mid())).collect();
+    let mut spread = 0.0f64;
+    for i in 0..n {
+        let mut row = Interval::ZERO;
+        for j in 0..n {
+            let v = s[i * n + j];
+            // |v - mid| <= max(hi - mid, mid - lo), rounded up.
+            let m = mid[i * n + j];
+            row += (Interval::point(v.hi()) - m)
+                .abs()
+                .max((m - Interval::point(v.lo())).abs());
+        }
+        spread = spread.max(row.hi());
+    }
+    let split = (Interval::point(linalg::lambda_max_upper(&mid, n)) + Interval::point(spread)).hi();
+    direct.min(split)
+}
+
+/// The entry of largest magnitude (non-finite first).
+fn largest(j: &[Interval], n: usize) -> Option<(usize, usize, Interval)> {
+    let k = (0..j.len()).max_by(|&a, &b| {
+        let key = |v: Interval| {
+            if v.is_bounded() {
+                v.mag()
+            } else {
+                f64::INFINITY
+            }
+        };
+        key(j[a]).total_cmp(&key(j[b]))
+    })?;
+    Some((k / n, k % n, j[k]))
+}
+
+/// Steps along the horizon, certifying each step's rates on a region holding its tube.
+pub(super) struct Stepper<'a> {
+    cert: &'a Certifier<'a>,
+    /// The tube the regions must hold; `None` in the first pass (the deterministic set only:
+    /// an estimate of the scale for laying out the epochs).
+    tube: Option<&'a Tube>,
+    /// `B_P(r)` lies in the box `|d_i| <= r w_i`.
+    w: &'a [f64],
+    pub(super) scale: Scale,
+    pub(super) regions: Vec<RateRegion>,
+    /// The last accepted rates (the next step's first guess).
+    last: Option<Rates>,
+    /// Where the local rates could not be closed and the domain's global constants took over
+    /// (the result is conditional on the domain from then on).
+    pub(super) global_from: Option<f64>,
+}
+
+impl<'a> Stepper<'a> {
+    pub(super) fn new(cert: &'a Certifier<'a>, tube: Option<&'a Tube>, w: &'a [f64]) -> Self {
+        Stepper {
+            cert,
+            tube,
+            w,
+            scale: Scale::new(std::iter::empty()),
+            regions: Vec::new(),
+            last: None,
+            global_from: None,
+        }
+    }
+
+    /// The rates of the step `[t0, t1]` whose deterministic set lies in the box `[lo, hi]`
+    /// widened by the P-radius `det(rates)` (which may depend on the rates: `R_t` of the
+    /// contraction method). When no region closes, the domain's global constants take over if
+    /// the spec has a domain and they are finite (the result becomes conditional on the domain,
+    /// as with `rate = global`); otherwise the error says where and why.
+    pub(super) fn step(
+        &mut self,
+        lo: &[f64],
+        hi: &[f64],
+        (t0, t1): (f64, f64),
+        det: impl Fn(Rates) -> f64,
+    ) -> Result<Rates, RunError> {
+        let h = Interval::point(t1) - Interval::point(t0);
+        let found = match self.global_from {
+            None => self.close(lo, hi, (t0, t1), h, &det),
+            Some(_) => Err(None),
+        };
+        let (rates, region) = match found {
+            Ok(found) => found,
+            Err(why) => {
+                // The same semantics as `rate = global` from here on: the constants hold on
+                // the domain, and the result is conditional on the process staying in it.
+                let fallback = self.cert.global.as_ref().and_then(|(g, domain)| {
+                    let domain = domain.as_ref()?;
+                    g.is_finite().then(|| {
+                        let region = domain.iter().map(|b| Interval::new(b.lo, b.hi)).collect();
+                        (*g, region)
+                    })
+                });
+                match (fallback, why) {
+                    (Some(found), _) => {
+                        self.global_from.get_or_insert(t0);
+                        found
+                    }
+                    (None, Some(why)) => return Err(why),
+                    (None, None) => {
+                        return Err(self.cert.explain(t0, &widen(lo, hi, 0.0, self.w), None))
+                    }
+                }
+            }
+        };
+        self.scale.push(h, rates.c, rates.sigma);
+        self.regions.push(RateRegion {
+            t0,
+            t1,
+            lo: region.iter().map(|v: &Interval| v.lo()).collect(),
+            hi: region.iter().map(|v| v.hi()).collect(),
+            c: rates.c,
+            sigma: rates.sigma,
+            rho: rates.rho,
+        });
+        self.last = Some(rates);
+        Ok(rates)
+    }
+
+    /// Guess, verify, inflate: rates certified over a region that holds the tube they give.
+    fn close(
+        &self,
+        lo: &[f64],
+        hi: &[f64],
+        (t0, t1): (f64, f64),
+        h: Interval,
+        det: &impl Fn(Rates) -> f64,
+    ) -> Result<(Rates, Vec<Interval>), Option<RunError>> {
+        let time = Interval::new(t0, t1);
+        let last = self.scale.psi.len() - 1;
+        let (psi0, s0) = (self.scale.psi[last], self.scale.s[last]);
+        // The P-radius the region must hold with these rates: the deterministic set's and the
+        // tube's largest over the step.
+        let need = |r: Rates| -> f64 {
+            let tube = self.tube.map_or(0.0, |tube| {
+                let (psi1, s1) = self.scale.next(h, r.c, r.sigma);
+                tube.radius(psi0.hull(psi1), s0.hull(s1))
+            });
+            (Interval::point(det(r)) + Interval::point(tube)).hi()
+        };
+        // Absolute floor of the region's margin, so a zero-width tube still gets a region.
+        let floor = 1e-9 * lo.iter().chain(hi).fold(1.0f64, |m, v| m.max(v.abs()));
+        let mut tried = widen(lo, hi, floor, self.w);
+        let certify = |region: &[Interval]| {
+            self.cert
+                .rates(region, time)
+                .map_err(|grew| Some(self.cert.explain(t0, region, Some(grew))))
+        };
+        let mut guess = match self.last {
+            Some(prev) => prev,
+            None => certify(&tried)?,
+        };
+        for _ in 0..MAX_TRIES {
+            let g = need(guess) * INFLATE + floor;
+            if !g.is_finite() {
+                break;
+            }
+            tried = widen(lo, hi, g, self.w);
+            let rates = certify(&tried)?;
+            if !rates.is_finite() {
+                break;
+            }
+            if need(rates) < g {
+                return Ok((rates, tried));
+            }
+            guess = guess.max(rates);
+        }
+        Err(Some(self.cert.explain(t0, &tried, None)))
+    }
+}
+
+/// The box `[lo, hi]` widened by the P-ball of radius `g` (rounded outward).
+fn widen(lo: &[f64], hi: &[f64], g: f64, w: &[f64]) -> Vec<Interval> {
+    lo.iter()
+        .zip(hi)
+        .zip(w)
+        .map(|((&a, &b), &w)| {
+            let d = Interval::point(g) * Interval::point(w);
+            Interval::new((Interval::point(a) - d).lo(), (Interval::point(b) + d).hi())
+        })
+        .collect()
+}
+
+/// A run's local rates: the passes' last result, the tube it holds and its regions.
+pub(super) struct Local<T> {
+    pub(super) result: T,
+    pub(super) tube: Tube,
+    pub(super) regions: Vec<RateRegion>,
+    /// When the domain's global constants took over (see [`Stepper::step`]).
+    pub(super) global_from: Option<f64>,
+}
+
+/// What a run's result keeps of its local rates.
+pub(super) struct Found {
+    pub(super) tube: Tube,
+    pub(super) regions: Vec<RateRegion>,
+    pub(super) global_from: Option<f64>,
+}
+
+impl Found {
+    pub(super) fn of<T>(local: &Local<T>) -> Found {
+        Found {
+            tube: local.tube.clone(),
+            regions: local.regions.clone(),
+            global_from: local.global_from,
+        }
+    }
+}
+
+/// Runs `pass` (one sweep of the horizon with a [`Stepper`]; returns its result and the index
+/// into the scale of the first report time) until the tube's epochs fit the scale: the first
+/// pass without a tube, then with the epochs of the previous pass's scale.
+pub(super) fn passes<T>(
+    run: &Run,
+    mut pass: impl FnMut(&mut Stepper) -> Result<(T, usize), RunError>,
+) -> Result<Local<T>, RunError> {
+    let cert = Certifier::new(run)?;
+    let w: Vec<f64> = run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect();
+    let (n, delta) = (run.setup.n, run.spec.delta);
+    let mut stepper = Stepper::new(&cert, None, &w);
+    let (_, first) = pass(&mut stepper)?;
+    let mut tube = Tube::for_scale(n, delta, &stepper.scale, first);
+    let mut passes = 1;
+    loop {
+        let (result, first, scale, regions, global_from) = {
+            let mut stepper = Stepper::new(&cert, Some(&tube), &w);
+            let (result, first) = pass(&mut stepper)?;
+            (
+                result,
+                first,
+                stepper.scale,
+                stepper.regions,
+                stepper.global_from,
+            )
+        };
+        passes += 1;
+        let s_last = scale.s.last().map_or(0.0, |s| s.hi());
+        // Accepted when the epochs reach the horizon's S (any epochs are sound; these are
+        // tight), or after the last pass.
+        if s_last <= tube.s_last() * (1.0 + 1e-6) || passes >= MAX_PASSES {
+            return Ok(Local {
+                result,
+                tube,
+                regions,
+                global_from,
+            });
+        }
+        tube = Tube::for_scale(n, delta, &scale, first);
+    }
+}
