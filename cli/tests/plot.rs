@@ -83,12 +83,25 @@ fn run_plot_writes_both_figures_for_each_analysis() {
         "paper_contraction",
         "paper_interval",
     ];
-    let expected: Vec<String> = analyses
+    // The local-rate analyses (the first two) also get the rates figure.
+    let mut expected: Vec<String> = analyses
         .iter()
-        .flat_map(|a| {
-            ["radius.png", "radius.svg", "sets.png", "sets.svg"].map(|f| format!("{a}_{f}"))
+        .enumerate()
+        .flat_map(|(k, a)| {
+            let rates = if k < 2 {
+                &["rates.png", "rates.svg"][..]
+            } else {
+                &[]
+            };
+            ["radius.png", "radius.svg"]
+                .iter()
+                .chain(rates)
+                .chain(&["sets.png", "sets.svg"])
+                .map(|f| format!("{a}_{f}"))
+                .collect::<Vec<_>>()
         })
         .collect();
+    expected.sort();
     // Exactly the pictures: no temporary files left behind.
     assert_eq!(files(&plots), expected);
     for a in analyses {
@@ -114,6 +127,9 @@ fn run_plot_writes_both_figures_for_each_analysis() {
     }
     let interval = svg(&plots.join("interval_sets.svg"));
     assert!(interval.contains("deterministic parallelotope"));
+    let rates = svg(&plots.join("contraction_rates.svg"));
+    assert!(rates.contains("pendulum / contraction: contraction rate"));
+    assert!(rates.contains("local") && rates.contains("sigma_t"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

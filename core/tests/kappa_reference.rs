@@ -291,6 +291,24 @@ fn log_phi_lower_against_closed_forms() {
     assert_eq!(log_phi_lower(7, 0.0), 0.0);
 }
 
+/// Beyond the series' range (z > 1e4) one Stirling-bounded term is below the closed form and
+/// within `2 ln z` (plus the rounding margin, 1e-9 relative) of it.
+#[test]
+fn log_phi_lower_for_huge_z_stays_below_and_close() {
+    for &n in &[1usize, 3, 5] {
+        for &z in &[1.0001e4, 3.7e5, 1e9, 2.5e15, 1e40] {
+            let lo = log_phi_lower(n, z);
+            let exact = log_phi_closed(n, z);
+            assert!(
+                lo <= exact * (1.0 - 1e-14),
+                "n = {n}, z = {z}: {lo} > {exact}"
+            );
+            let tol = 2.0 * z.ln() + 1e-9 * exact;
+            assert!(exact - lo <= tol, "n = {n}, z = {z}: {lo} vs {exact}");
+        }
+    }
+}
+
 #[test]
 fn large_n_and_small_delta_are_finite() {
     for &n in &[500usize, 1000, 2000] {

@@ -42,5 +42,5 @@ for spec in unicycle unicycle_lookahead; do
         --paths 200 --envelope > /dev/null
 done
 "$reachc" plot "$out/unicycle_lookahead/contraction.json" --spec specs/unicycle_lookahead.sde \
-    --times 0.03,0.06,0.09 --paths 200 > /dev/null
+    --times 0.03,0.09,0.2 --paths 200 > /dev/null
 echo "wrote $out/linear, $out/pendulum, $out/unicycle and $out/unicycle_lookahead"

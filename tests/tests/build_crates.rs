@@ -692,10 +692,12 @@ fn generated_code_agrees_with_the_interpreter() {
         "duffing",
         "linear",
         "linear_n",
+        "lorenz",
         "pendulum",
         "unicycle",
         "unicycle_lookahead",
         "vanderpol",
+        "vanderpol_feedback",
     ];
     let keywords = workspace().join("tests/good/rust_keywords.sde");
     // Every shipped spec that gets `drift_x8` is probed.

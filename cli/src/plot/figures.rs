@@ -1,6 +1,7 @@
-//! The two figures, drawn with plotters on any backend (SVG or bitmap, see
+//! The figures, drawn with plotters on any backend (SVG or bitmap, see
 //! [`super::output`]): the sets in a 2-D projection (deterministic sets dashed, PRS solid, as
-//! in the paper's figures; sample paths, the nominal, unsafe sets) and the radii against time.
+//! in the paper's figures; sample paths, the nominal, unsafe sets), the radii against time and, for
+//! time-varying rates, the contraction rate against time.
 //! Each figure has a legend panel on its right, so nothing is drawn over the data.
 
 use plotters::coord::ranged1d::{Ranged, ValueFormatter};
@@ -13,7 +14,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::font::FAMILY;
 use super::geometry::Point;
 use super::output::Draw;
-use super::scene::{RadiusScene, SetsScene};
+use super::scene::{RadiusScene, RatesScene, SetsScene};
 
 /// Size of the sets figure.
 pub const SETS_SIZE: (u32, u32) = (1100, 780);
@@ -578,6 +579,63 @@ impl RadiusScene {
             notes.push(note);
         }
         legend(legend_area, s, &entries, &notes)
+    }
+}
+
+impl Draw for RatesScene {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        s: u32,
+    ) -> Result<(), String> {
+        let (w, _) = area.dim_in_pixel();
+        let (plot_area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s));
+        let right = self
+            .times
+            .last()
+            .copied()
+            .filter(|t| *t > 0.0)
+            .unwrap_or(1.0);
+        let values = self.c.iter().flatten().copied();
+        let (lo, hi) = values.fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        let pad = 0.08 * (hi - lo).max(1e-9);
+        let mut chart = chart_builder(&plot_area, &self.title, s)
+            .build_cartesian_2d(0.0..right, lo - pad..hi + pad)
+            .map_err(err)?;
+        let y_span = hi - lo;
+        let x_fmt = |v: &f64| tick(*v, right);
+        let y_fmt = |v: &f64| tick(*v, y_span.max(v.abs()));
+        mesh(&mut chart, s, ["t", "c_t"], [&x_fmt, &y_fmt])?;
+        // Zero: contraction below, growth above.
+        chart
+            .draw_series(LineSeries::new(
+                [(0.0, 0.0), (right, 0.0)],
+                BLACK.mix(0.4).stroke_width(s),
+            ))
+            .map_err(err)?;
+        // Each rate holds on its report interval: a step curve.
+        let mut run = Vec::new();
+        let mut t0 = 0.0;
+        let colour = PALETTE[3];
+        for (t, c) in self.times.iter().zip(&self.c) {
+            match c {
+                Some(c) => run.extend([(t0, *c), (*t, *c)]),
+                None => {
+                    chart
+                        .draw_series(LineSeries::new(
+                            std::mem::take(&mut run),
+                            colour.stroke_width(2 * s),
+                        ))
+                        .map_err(err)?;
+                }
+            }
+            t0 = *t;
+        }
+        chart
+            .draw_series(LineSeries::new(run, colour.stroke_width(2 * s)))
+            .map_err(err)?;
+        let entries = [(Mark::Line(colour.to_rgba(), 2), "c_t".to_string())];
+        legend(&legend_area, s, &entries, &self.notes)
     }
 }
 

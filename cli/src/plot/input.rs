@@ -33,6 +33,9 @@ pub struct ResultFile {
     pub transform: Option<Transform>,
     /// Centre of the initial set (where `simulate` evaluates a constant diffusion).
     pub initial_center: Vec<f64>,
+    /// Where the rates come from (results written before local rates have none).
+    #[serde(default)]
+    pub rate: Option<RateKind>,
     /// One record per report time.
     pub steps: Vec<Step>,
 }
@@ -70,6 +73,16 @@ pub enum Shape {
     Parallelotope,
 }
 
+/// Where a result's rates come from.
+#[derive(Clone, Debug, Deserialize)]
+pub struct RateKind {
+    /// `"local"`, `"global"` or `"empirical"`.
+    pub kind: String,
+    /// Local rates: when the domain's global constants took over.
+    #[serde(default)]
+    pub global_from: Option<f64>,
+}
+
 /// The constants of a result (only the metric is drawn).
 #[derive(Clone, Debug, Deserialize)]
 pub struct Constants {
@@ -97,6 +110,12 @@ pub struct Step {
     pub r_t: f64,
     /// PRS radius (interval method: a P-ball containing the PRS).
     pub prs_radius: f64,
+    /// The largest contraction rate over the report interval ending here (`null`: unbounded).
+    #[serde(default)]
+    pub c: Option<f64>,
+    /// The largest noise level over the same.
+    #[serde(default)]
+    pub sigma: Option<f64>,
 }
 
 /// A deterministic set: `p_ball`, `box` or `parallelotope` (see docs/results.md).

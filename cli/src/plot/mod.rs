@@ -167,7 +167,8 @@ fn renderings<F: Draw>(
 }
 
 /// Plots a result: `DIR/<analysis>_sets.svg/.png` (the sets at the chosen times, sample paths
-/// and unsafe sets when the model is given) and `DIR/<analysis>_radius.svg/.png`. Returns the
+/// and unsafe sets when the model is given), `DIR/<analysis>_radius.svg/.png` and, when the
+/// rates vary in time (local or empirical), `DIR/<analysis>_rates.svg/.png` (`c_t`). Returns the
 /// files written; the error is a message (nothing is written then).
 pub fn plot_result(
     result: &ResultFile,
@@ -221,6 +222,15 @@ pub fn plot_result(
         &result.analysis,
         "radius",
     ));
+    if let Some(rates) = scene::rates_scene(result) {
+        files.extend(renderings(
+            &rates,
+            figures::RADIUS_SIZE,
+            dir,
+            &result.analysis,
+            "rates",
+        ));
+    }
     write_all(dir, files)
 }
 

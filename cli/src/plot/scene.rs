@@ -67,6 +67,63 @@ pub struct RadiusScene {
     pub notes: Vec<String>,
 }
 
+/// The rates figure of a result whose rates vary in time (`rate = local` or `empirical`):
+/// `c_t` against time.
+#[derive(Clone, Debug)]
+pub struct RatesScene {
+    /// Title.
+    pub title: String,
+    /// Report times after 0 (each rate holds on the report interval ending there).
+    pub times: Vec<f64>,
+    /// `c_t`, the largest over each report interval (`None`: not finite).
+    pub c: Vec<Option<f64>>,
+    /// Lines for the legend panel.
+    pub notes: Vec<String>,
+}
+
+/// The rates figure of a result with time-varying rates, `None` for one global rate.
+pub fn rates_scene(result: &ResultFile) -> Option<RatesScene> {
+    let rate = result.rate.as_ref().filter(|r| r.kind != "global")?;
+    let steps = result.steps.get(1..).unwrap_or_default();
+    let sigma = steps
+        .iter()
+        .filter_map(|s| s.sigma)
+        .filter(|v| v.is_finite());
+    let (lo, hi) = sigma.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+        (a.min(v), b.max(v))
+    });
+    let mut notes = vec![format!(
+        "{} rates: c_t is the largest contraction rate (mu_P of the Jacobian) over each report \
+         interval",
+        rate.kind
+    )];
+    if lo <= hi {
+        notes.push(format!("noise level sigma_t in [{lo:.4}, {hi:.4}]"));
+    }
+    match rate.kind.as_str() {
+        "local" => notes.push(
+            "certified on boxes holding the tube over each internal step: where c_t > 0 the \
+             tube grows"
+                .into(),
+        ),
+        _ => notes.push("EMPIRICAL: estimated from sample paths, not a guarantee".into()),
+    }
+    if let Some(t) = rate.global_from {
+        notes.push(format!(
+            "from t = {t}: the domain's global constants (no local region closed)"
+        ));
+    }
+    Some(RatesScene {
+        title: format!("{} / {}: contraction rate", result.model, result.analysis),
+        times: steps.iter().map(|s| s.t).collect(),
+        c: steps
+            .iter()
+            .map(|s| s.c.filter(|v| v.is_finite()))
+            .collect(),
+        notes,
+    })
+}
+
 /// The deterministic set of a step in the plane.
 fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
     let d = &step.det_set;

@@ -110,7 +110,8 @@ pub fn prepare(model: &mut Model) -> Prepared {
 }
 
 /// The constants of a local-rate analysis: its metric (given; or synthesised over the domain
-/// when that contracts, else over the initial set during the first report step), and the global
+/// when the compiler can bound the rate there, so that the local rates are never above the
+/// global ones; else over the initial set during the first report step), and the global
 /// constants for that metric where the compiler can bound them (infinite otherwise).
 fn local_constants(
     model: &Model,
@@ -124,7 +125,7 @@ fn local_constants(
         MetricChoice::Auto => {
             let global = synthesize_metric(model, d).and_then(|p| constants(model, d, &p));
             match global {
-                Ok(c) if c.c < 0.0 => {
+                Ok(c) if c.c.is_finite() => {
                     return Ok(Constants {
                         metric_region: MetricRegion::Domain,
                         ..c

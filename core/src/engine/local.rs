@@ -32,6 +32,9 @@ pub(crate) const DENSE_MAX: usize = 64;
 /// The most Jacobian entries enumerated at their ends (`2^6` vertex matrices per bound).
 const VERTEX_ENTRIES: usize = 6;
 
+/// Up to this many states the vertex refinement runs (its cost grows as `2^6 n^3`).
+const VERTEX_DIM: usize = 8;
+
 /// Attempts per step to find a region that holds its own tube.
 const MAX_TRIES: usize = 12;
 
@@ -78,6 +81,8 @@ pub(super) struct Certifier<'a> {
     half: Vec<Interval>,
     /// The compiler's constants, with the box they hold on (`None`: all of R^n).
     global: Option<(Rates, Option<Vec<Bounds>>)>,
+    /// The noise level when `G` is the same everywhere and at all times (bounded once).
+    constant_noise: Option<f64>,
 }
 
 /// Why no rates: the Jacobian entry with the largest magnitude over the region.
@@ -131,7 +136,7 @@ impl<'a> Certifier<'a> {
             rho: consts.rho,
         };
         let domain = run.info.has_domain.then(|| run.info.domain.clone());
-        Ok(Certifier {
+        let mut cert = Certifier {
             sys,
             states: &run.info.states,
             n,
@@ -149,37 +154,70 @@ impl<'a> Certifier<'a> {
                 .collect(),
             half,
             global: Some((global, domain)),
-        })
+            constant_noise: None,
+        };
+        // A diffusion whose enclosure over all states and times is a point (up to rounding) is
+        // constant: its noise level, bounded once over everything, holds on every region.
+        let (m, everywhere) = (sys.m(), vec![Interval::ENTIRE; n]);
+        let mut g = vec![Interval::ZERO; n * m];
+        sys.diffusion_interval(&everywhere, Interval::new(0.0, run.spec.horizon), &mut g);
+        if g.iter()
+            .all(|v| v.is_bounded() && v.width() <= 1e-12 * v.mag())
+        {
+            cert.constant_noise = Some(cert.noise(&everywhere, Interval::point(0.0)));
+        }
+        Ok(cert)
     }
 
-    /// Rates over the box `x` of states, inputs in the input box, times in `t`.
-    fn rates(&self, x: &[Interval], t: Interval) -> Result<Rates, Grew> {
-        let local = Rates {
-            c: self.rate(x, t)?,
-            sigma: self.noise(x, t),
-            rho: self.gain(x, t),
-        };
-        let Some((global, domain)) = &self.global else {
-            return Ok(local);
-        };
-        let inside = domain.as_ref().is_none_or(|d| {
-            x.iter()
-                .zip(d)
-                .all(|(v, b)| v.lo() >= b.lo && v.hi() <= b.hi)
-        });
-        Ok(if inside {
-            Rates {
-                c: local.c.min(global.c),
-                sigma: local.sigma.min(global.sigma),
-                rho: local.rho.min(global.rho),
+    /// Rates over the box `x` of states, inputs in the input box, times in `t`, and whether
+    /// they lean on the domain: where the box leaves the spec's domain and the compiler's
+    /// constants are smaller than the box's own, those are used, conditional on the process
+    /// staying in the domain (the semantics of `rate = global`), so local rates are never
+    /// above the global ones.
+    ///
+    /// `lean`: whether the deterministic set lies in the domain (only then may the rates lean
+    /// on it).
+    fn rates(&self, x: &[Interval], t: Interval, lean: bool) -> Result<(Rates, bool), Grew> {
+        let (global, inside) = match &self.global {
+            Some((g, domain)) if g.is_finite() => {
+                let inside = domain.as_ref().is_none_or(|d| within(x, d));
+                (Some(*g).filter(|_| inside || lean), inside)
             }
-        } else {
-            local
+            _ => (None, false),
+        };
+        let sigma = match self.constant_noise {
+            Some(sigma) => sigma,
+            None => self.noise(x, t),
+        };
+        let cap = global.filter(|_| inside).map(|g| g.c);
+        let local = match self.rate(x, t, cap) {
+            Ok(c) => Rates {
+                c,
+                sigma,
+                rho: self.gain(x, t),
+            },
+            // Unbounded on the box: the domain's constants if there are any.
+            Err(grew) => match global {
+                Some(g) => return Ok((g, !inside)),
+                None => return Err(grew),
+            },
+        };
+        Ok(match global {
+            Some(g) => {
+                let min = Rates {
+                    c: local.c.min(g.c),
+                    sigma: local.sigma.min(g.sigma),
+                    rho: local.rho.min(g.rho),
+                };
+                (min, !inside && min != local)
+            }
+            None => (local, false),
         })
     }
 
-    /// An upper bound of `mu_P(D_x f)` over the box.
-    fn rate(&self, x: &[Interval], t: Interval) -> Result<f64, Grew> {
+    /// An upper bound of `mu_P(D_x f)` over the box; `cap`, a rate known to hold there, spares
+    /// the vertex refinement when the direct bound cannot beat it.
+    fn rate(&self, x: &[Interval], t: Interval, cap: Option<f64>) -> Result<f64, Grew> {
         let n = self.n;
         if self.dense {
             let mut j = vec![Interval::ZERO; n * n];
@@ -189,7 +227,11 @@ impl<'a> Certifier<'a> {
                     entry: Some((k / n, k % n, j[k])),
                 });
             }
-            let rate = self.vertex_rate(&j);
+            let b = product(&product(&self.r, &j, n, n, n), &self.r_inv, n, n, n);
+            let mut rate = lambda_max(&symmetric_part(&b, n), n);
+            if n <= VERTEX_DIM && cap.is_none_or(|cap| rate < cap) {
+                rate = rate.min(self.vertex_rate(&j));
+            }
             if rate.is_finite() {
                 Ok(rate)
             } else {
@@ -444,9 +486,10 @@ impl<'a> Stepper<'a> {
 
     /// The rates of the step `[t0, t1]` whose deterministic set lies in the box `[lo, hi]`
     /// widened by the P-radius `det(rates)` (which may depend on the rates: `R_t` of the
-    /// contraction method). When no region closes, the domain's global constants take over if
-    /// the spec has a domain and they are finite (the result becomes conditional on the domain,
-    /// as with `rate = global`); otherwise the error says where and why.
+    /// contraction method). Where a region leans on the domain's constants, or no region closes
+    /// and the spec has a domain with finite constants (then those hold for the step), the
+    /// result becomes conditional on the domain from that step on, as with `rate = global`;
+    /// otherwise a step that does not close is an error that says where and why.
     pub(super) fn step(
         &mut self,
         lo: &[f64],
@@ -455,12 +498,13 @@ impl<'a> Stepper<'a> {
         det: impl Fn(Rates) -> f64,
     ) -> Result<Rates, RunError> {
         let h = Interval::point(t1) - Interval::point(t0);
-        let found = match self.global_from {
-            None => self.close(lo, hi, (t0, t1), h, &det),
-            Some(_) => Err(None),
-        };
-        let (rates, region) = match found {
-            Ok(found) => found,
+        let (rates, region) = match self.close(lo, hi, (t0, t1), h, &det) {
+            Ok((rates, region, conditional)) => {
+                if conditional {
+                    self.global_from.get_or_insert(t0);
+                }
+                (rates, region)
+            }
             Err(why) => {
                 // The same semantics as `rate = global` from here on: the constants hold on
                 // the domain, and the result is conditional on the process staying in it.
@@ -505,7 +549,7 @@ impl<'a> Stepper<'a> {
         (t0, t1): (f64, f64),
         h: Interval,
         det: &impl Fn(Rates) -> f64,
-    ) -> Result<(Rates, Vec<Interval>), Option<RunError>> {
+    ) -> Result<(Rates, Vec<Interval>, bool), Option<RunError>> {
         let time = Interval::new(t0, t1);
         let last = self.scale.psi.len() - 1;
         let (psi0, s0) = (self.scale.psi[last], self.scale.s[last]);
@@ -521,14 +565,21 @@ impl<'a> Stepper<'a> {
         // Absolute floor of the region's margin, so a zero-width tube still gets a region.
         let floor = 1e-9 * lo.iter().chain(hi).fold(1.0f64, |m, v| m.max(v.abs()));
         let mut tried = widen(lo, hi, floor, self.w);
+        // The rates may lean on the domain only where the deterministic set lies in it, with
+        // any rates up to the global ones (the deterministic radius grows with the rates).
+        let lean = self.cert.global.as_ref().is_some_and(|(g, domain)| {
+            domain
+                .as_ref()
+                .is_some_and(|d| g.is_finite() && within(&widen(lo, hi, det(*g), self.w), d))
+        });
         let certify = |region: &[Interval]| {
             self.cert
-                .rates(region, time)
+                .rates(region, time, lean)
                 .map_err(|grew| Some(self.cert.explain(t0, region, Some(grew))))
         };
         let mut guess = match self.last {
             Some(prev) => prev,
-            None => certify(&tried)?,
+            None => certify(&tried)?.0,
         };
         for _ in 0..MAX_TRIES {
             let g = need(guess) * INFLATE + floor;
@@ -536,17 +587,25 @@ impl<'a> Stepper<'a> {
                 break;
             }
             tried = widen(lo, hi, g, self.w);
-            let rates = certify(&tried)?;
+            // `conditional`: the rates lean on the domain (see `Certifier::rates`).
+            let (rates, conditional) = certify(&tried)?;
             if !rates.is_finite() {
                 break;
             }
             if need(rates) < g {
-                return Ok((rates, tried));
+                return Ok((rates, tried, conditional));
             }
             guess = guess.max(rates);
         }
         Err(Some(self.cert.explain(t0, &tried, None)))
     }
+}
+
+/// Whether the box `x` lies in the box `d`.
+fn within(x: &[Interval], d: &[Bounds]) -> bool {
+    x.iter()
+        .zip(d)
+        .all(|(v, b)| v.lo() >= b.lo && v.hi() <= b.hi)
 }
 
 /// The box `[lo, hi]` widened by the P-ball of radius `g` (rounded outward).

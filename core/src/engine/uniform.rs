@@ -172,6 +172,10 @@ impl Tube {
         let target = (lambda.sqr() * Interval::point(s) * Interval::point(0.5)
             + Interval::point(e.log_inv_delta))
         .hi();
+        // A vacuous radius (an exploding S): no finite bound is worth computing.
+        if target.is_nan() || target > 1e50 {
+            return f64::INFINITY;
+        }
         // Increasing in z; >= 0 at an upper bound of the root.
         let gap = |z: f64| log_phi_lower(self.n, z) - target;
         // ln Phi_n(0) = 0 < target, and ln Phi_n(z) <= z: the root is at least the target.
