@@ -251,8 +251,7 @@ impl Draw for SetsScene {
         s: u32,
     ) -> Result<(), String> {
         let (i, f) = (|v: i32| v * s as i32, |v: u32| f64::from(v * s));
-        let (w, _) = area.dim_in_pixel();
-        let (plot_area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s));
+        let (plot_area, legend_area) = panels(area, s);
         // The view holds the sets, the paths and the bounded unsafe sets.
         let bounded = self.regions.iter().filter_map(|(_, r)| r.bounds());
         let (vx, vy) = view(
@@ -455,6 +454,15 @@ impl Draw for SetsScene {
     }
 }
 
+/// The plot and legend panels of a figure (the legend on the right, `s` the pixel scale).
+fn panels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: u32,
+) -> (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>) {
+    let (w, _) = area.dim_in_pixel();
+    area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s))
+}
+
 /// Radii spanning more than this ratio are drawn on a logarithmic axis.
 const LOG_RATIO: f64 = 1e3;
 
@@ -464,8 +472,7 @@ impl Draw for RadiusScene {
         area: &DrawingArea<DB, Shift>,
         s: u32,
     ) -> Result<(), String> {
-        let (w, _) = area.dim_in_pixel();
-        let (plot_area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s));
+        let (plot_area, legend_area) = panels(area, s);
         let t_last = self.times.last().copied().unwrap_or(1.0);
         let right = if t_last > 0.0 { t_last } else { 1.0 };
         let quantiles = self.quantile.iter().flat_map(|(q, _)| q.iter().flatten());
@@ -588,8 +595,7 @@ impl Draw for RatesScene {
         area: &DrawingArea<DB, Shift>,
         s: u32,
     ) -> Result<(), String> {
-        let (w, _) = area.dim_in_pixel();
-        let (plot_area, legend_area) = area.split_horizontally(w.saturating_sub(LEGEND_WIDTH * s));
+        let (plot_area, legend_area) = panels(area, s);
         let right = self
             .times
             .last()

@@ -202,13 +202,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
 fn run_inputs(run: &Run, nominal: &[Vec<f64>]) -> Vec<Vec<Interval>> {
     match run.inputs {
         super::Inputs::Box => {
-            let ubox: Vec<Interval> = run
-                .info
-                .input_box
-                .iter()
-                .map(|b| Interval::new(b.lo, b.hi))
-                .collect();
-            vec![ubox; nominal.len()]
+            vec![super::input_intervals(run.info); nominal.len()]
         }
         super::Inputs::Plan(_) => nominal
             .iter()

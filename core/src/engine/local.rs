@@ -123,12 +123,7 @@ impl<'a> Certifier<'a> {
             let inv = d.iter().map(|x| x.recip()).collect();
             (d, inv)
         };
-        let inputs: Vec<Interval> = run
-            .info
-            .input_box
-            .iter()
-            .map(|b| Interval::new(b.lo, b.hi))
-            .collect();
+        let inputs = super::input_intervals(run.info);
         let half = inputs.iter().map(|u| Interval::point(u.rad())).collect();
         let global = Rates {
             c: consts.c,

@@ -165,6 +165,14 @@ impl<'a> Setup<'a> {
     }
 }
 
+/// The input box as intervals, one per input.
+pub(crate) fn input_intervals(info: &ModelInfo) -> Vec<Interval> {
+    info.input_box
+        .iter()
+        .map(|b| Interval::new(b.lo, b.hi))
+        .collect()
+}
+
 /// The inputs of a run.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Inputs<'a> {
