@@ -120,3 +120,35 @@ fn a_time_varying_diffusion_gets_sigma_per_step() {
         });
     assert!(lo < 0.01 && hi > 0.19, "{lo} {hi}");
 }
+
+/// On every shipped spec (but the 1000-state chain, whose equations chain10 has), every analysis
+/// with local rates gives a PRS at the horizon no larger than the same analysis with the global
+/// rate, where the compiler could bound one.
+#[test]
+fn local_rates_are_never_looser_than_the_global_rate() {
+    for path in reachc_e2e::shipped_specs()
+        .into_iter()
+        .filter(|p| !p.ends_with("chain1000.sde"))
+    {
+        let (sys, info) = interpreter_of(load(&path).unwrap().model);
+        for analysis in info.analyses.iter().filter(|a| a.spec.rate == Rate::Local) {
+            let Ok(consts) = &analysis.constants else {
+                continue;
+            };
+            let name = format!("{} / {}", path.display(), analysis.spec.name);
+            let local = reachc_runtime::engine::run(&sys, &info, analysis).unwrap();
+            if !consts.c.is_finite() {
+                continue;
+            }
+            let mut global = analysis.clone();
+            global.spec.rate = Rate::Global;
+            let global = reachc_runtime::engine::run(&sys, &info, &global).unwrap();
+            let (l, g) = (
+                local.steps.last().unwrap().prs_radius,
+                global.steps.last().unwrap().prs_radius,
+            );
+            assert!(l <= g * (1.0 + 1e-9), "{name}: {l} > {g}");
+            assert!(local.rate.max_c <= consts.c, "{name}");
+        }
+    }
+}

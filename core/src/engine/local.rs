@@ -81,6 +81,10 @@ pub(super) struct Certifier<'a> {
     half: Vec<Interval>,
     /// The compiler's constants, with the box they hold on (`None`: all of R^n).
     global: Option<(Rates, Option<Vec<Bounds>>)>,
+    /// Whether the run may lean on the domain's constants at all (its initial set lies in
+    /// the domain), and whether each step's hull (the nominal's) must lie in it too.
+    lean_start: bool,
+    lean_hull: bool,
     /// The noise level when `G` is the same everywhere and at all times (bounded once).
     constant_noise: Option<f64>,
 }
@@ -131,6 +135,16 @@ impl<'a> Certifier<'a> {
             rho: consts.rho,
         };
         let domain = run.info.has_domain.then(|| run.info.domain.clone());
+        // Leaning on the domain's constants (conditional on staying in it) takes what
+        // `rate = global` takes: an initial set in the domain, and for the contraction method
+        // a nominal in it.
+        let lean_start = domain.as_ref().is_some_and(|d| {
+            run.initial.bounding_box().is_ok_and(|b| {
+                b.iter()
+                    .zip(d)
+                    .all(|(x, dom)| x.lo >= dom.lo && x.hi <= dom.hi)
+            })
+        });
         let mut cert = Certifier {
             sys,
             states: &run.info.states,
@@ -149,6 +163,8 @@ impl<'a> Certifier<'a> {
                 .collect(),
             half,
             global: Some((global, domain)),
+            lean_start,
+            lean_hull: run.spec.method == crate::model::Method::Contraction,
             constant_noise: None,
         };
         // A diffusion whose enclosure over all states and times is a point (up to rounding) is
@@ -170,8 +186,7 @@ impl<'a> Certifier<'a> {
     /// staying in the domain (the semantics of `rate = global`), so local rates are never
     /// above the global ones.
     ///
-    /// `lean`: whether the deterministic set lies in the domain (only then may the rates lean
-    /// on it).
+    /// `lean`: whether the step may lean on the domain ([`Certifier::may_lean`]).
     fn rates(&self, x: &[Interval], t: Interval, lean: bool) -> Result<(Rates, bool), Grew> {
         let (global, inside) = match &self.global {
             Some((g, domain)) if g.is_finite() => {
@@ -208,6 +223,15 @@ impl<'a> Certifier<'a> {
             }
             None => (local, false),
         })
+    }
+
+    /// Whether a step whose deterministic hull is `[lo, hi]` may lean on the domain's constants:
+    /// what `rate = global` requires of a run (see `lean_start`, `lean_hull`).
+    fn may_lean(&self, lo: &[f64], hi: &[f64], w: &[f64]) -> bool {
+        let Some((_, Some(domain))) = &self.global else {
+            return false;
+        };
+        self.lean_start && (!self.lean_hull || within(&widen(lo, hi, 0.0, w), domain))
     }
 
     /// An upper bound of `mu_P(D_x f)` over the box; `cap`, a rate known to hold there, spares
@@ -503,9 +527,10 @@ impl<'a> Stepper<'a> {
             Err(why) => {
                 // The same semantics as `rate = global` from here on: the constants hold on
                 // the domain, and the result is conditional on the process staying in it.
+                let lean = self.cert.may_lean(lo, hi, self.w);
                 let fallback = self.cert.global.as_ref().and_then(|(g, domain)| {
                     let domain = domain.as_ref()?;
-                    g.is_finite().then(|| {
+                    (lean && g.is_finite()).then(|| {
                         let region = domain.iter().map(|b| Interval::new(b.lo, b.hi)).collect();
                         (*g, region)
                     })
@@ -560,13 +585,7 @@ impl<'a> Stepper<'a> {
         // Absolute floor of the region's margin, so a zero-width tube still gets a region.
         let floor = 1e-9 * lo.iter().chain(hi).fold(1.0f64, |m, v| m.max(v.abs()));
         let mut tried = widen(lo, hi, floor, self.w);
-        // The rates may lean on the domain only where the deterministic set lies in it, with
-        // any rates up to the global ones (the deterministic radius grows with the rates).
-        let lean = self.cert.global.as_ref().is_some_and(|(g, domain)| {
-            domain
-                .as_ref()
-                .is_some_and(|d| g.is_finite() && within(&widen(lo, hi, det(*g), self.w), d))
-        });
+        let lean = self.cert.may_lean(lo, hi, self.w);
         let certify = |region: &[Interval]| {
             self.cert
                 .rates(region, time, lean)
