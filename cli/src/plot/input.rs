@@ -76,11 +76,34 @@ pub enum Shape {
 /// Where a result's rates come from.
 #[derive(Clone, Debug, Deserialize)]
 pub struct RateKind {
-    /// `"local"`, `"global"` or `"empirical"`.
-    pub kind: String,
+    /// Local, global or empirical.
+    pub kind: RateSource,
     /// Local rates: when the domain's global constants took over.
     #[serde(default)]
     pub global_from: Option<f64>,
+}
+
+/// The kind of a result's rates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RateSource {
+    /// Certified on regions holding the tube.
+    Local,
+    /// The compiler's constants.
+    Global,
+    /// Estimated from sample paths (not a guarantee).
+    Empirical,
+}
+
+impl RateSource {
+    /// The name used in specs and result files.
+    pub fn name(self) -> &'static str {
+        match self {
+            RateSource::Local => "local",
+            RateSource::Global => "global",
+            RateSource::Empirical => "empirical",
+        }
+    }
 }
 
 /// The constants of a result (only the metric is drawn).

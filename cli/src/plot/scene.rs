@@ -4,7 +4,7 @@
 //! pixels.
 
 use super::geometry::{Plane, Point, Projected};
-use super::input::{Guarantee, Method, ResultFile, Shape, Step};
+use super::input::{Guarantee, Method, RateSource, ResultFile, Shape, Step};
 use super::regions::Region;
 use reachc_runtime::model::{Analysis, ModelInfo};
 
@@ -83,7 +83,7 @@ pub struct RatesScene {
 
 /// The rates figure of a result with time-varying rates, `None` for one global rate.
 pub fn rates_scene(result: &ResultFile) -> Option<RatesScene> {
-    let rate = result.rate.as_ref().filter(|r| r.kind != "global")?;
+    let rate = result.rate.as_ref().filter(|r| r.kind != RateSource::Global)?;
     let steps = result.steps.get(1..).unwrap_or_default();
     let sigma = steps
         .iter()
@@ -95,13 +95,13 @@ pub fn rates_scene(result: &ResultFile) -> Option<RatesScene> {
     let mut notes = vec![format!(
         "{} rates: c_t is the largest contraction rate (mu_P of the Jacobian) over each report \
          interval",
-        rate.kind
+        rate.kind.name()
     )];
     if lo <= hi {
         notes.push(format!("noise level sigma_t in [{lo:.4}, {hi:.4}]"));
     }
-    match rate.kind.as_str() {
-        "local" => notes.push(
+    match rate.kind {
+        RateSource::Local => notes.push(
             "certified on boxes holding the tube over each internal step: where c_t > 0 the \
              tube grows"
                 .into(),
