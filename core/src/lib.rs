@@ -3,6 +3,7 @@
 //! delta-probabilistic reachable sets, with typed results. No dependencies (rayon with the
 //! `parallel` feature, for Monte Carlo).
 
+pub mod chi2;
 pub mod engine;
 pub mod func;
 pub mod interval;

@@ -49,6 +49,10 @@ pub struct ModelInfo {
     pub domain: Vec<Bounds>,
     /// Whether the spec gave a domain (results then hold while the state stays in it).
     pub has_domain: bool,
+    /// Whether `D_x f` and `G` are constant (no state, input or time in them): then
+    /// `X_t - x_t` is exactly Gaussian (method.md section 8.1) and engines size the stochastic
+    /// part from its covariance.
+    pub affine: bool,
     /// Unsafe sets.
     pub unsafe_sets: Vec<UnsafeSet>,
     /// The analyses, with their certified constants.

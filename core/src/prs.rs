@@ -143,6 +143,29 @@ pub struct RuleUsed {
     pub rule: RadiusRule,
     /// `eps` of Theorem 1 (the given one, or the minimiser), for the paper rules.
     pub eps: Option<f64>,
+    /// An affine system under the amgf rule: the radii come from the exact Gaussian
+    /// covariance instead (method.md section 8.1).
+    pub gaussian: Option<GaussianUsed>,
+}
+
+/// The exact Gaussian route of an affine system.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GaussianUsed {
+    /// The upper bound of `chi2_n^-1(1 - delta)` of the pointwise radii
+    /// `sqrt(q lambda_max(R Sigma_t R'))`.
+    pub quantile: f64,
+    /// Uniform guarantee: which time-uniform bound was tighter and is used.
+    pub uniform: Option<UniformBound>,
+}
+
+/// The time-uniform bound of a result: both are valid, the tighter (smaller sum of radii over
+/// the report times, fixed before the fact) is used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UniformBound {
+    /// The AMGF tube (method.md section 8.2).
+    AmgfTube,
+    /// The method-of-mixtures bound for Gaussian martingales (method.md section 8.1).
+    Mixture,
 }
 
 /// How `r1` was bounded.
@@ -433,6 +456,14 @@ pub enum Proved {
     },
     /// The time-uniform tube: Ville's inequality on `epochs` epochs at `delta / epochs` each.
     UniformTube {
+        /// The number of epochs.
+        epochs: usize,
+    },
+    /// The stochastic part of an affine system from its exact Gaussian covariance (enclosed in
+    /// interval arithmetic), with a rigorous chi-square quantile.
+    ExactGaussian,
+    /// The time-uniform Gaussian mixture bound on `epochs` epochs at `delta / epochs` each.
+    GaussianMixture {
         /// The number of epochs.
         epochs: usize,
     },

@@ -223,6 +223,7 @@ fn info(
         },
         domain: vec![Bounds::ENTIRE; n],
         has_domain: false,
+        affine: false,
         unsafe_sets: vec![],
         analyses: vec![],
     }

@@ -147,6 +147,7 @@ fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
         },
         domain: vec![Bounds::ENTIRE],
         has_domain: false,
+        affine: false,
         unsafe_sets,
         analyses: vec![],
     }
@@ -170,6 +171,7 @@ fn pendulum_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
         },
         domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
+        affine: false,
         unsafe_sets,
         analyses: vec![],
     }

@@ -88,6 +88,7 @@ fn info() -> ModelInfo {
         },
         domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
+        affine: false,
         unsafe_sets: vec![],
         analyses: vec![],
     };

@@ -80,6 +80,7 @@ fn model(analyses: Vec<Analysis>) -> ModelInfo {
         },
         domain: vec![Bounds::ENTIRE],
         has_domain: false,
+        affine: false,
         unsafe_sets: vec![],
         analyses,
     }

@@ -57,7 +57,13 @@ fn linear_constants_psi_and_radius_match_closed_forms_and_reference() {
                 s.t,
                 s.psi
             );
-            let r_t = (closed * reference).sqrt();
+            // amgf on an affine model: the exact Gaussian radius, whose chi-square quantile is
+            // -2 ln(delta) for n = 2 (method.md section 8.1); the paper rule keeps its kappa.
+            let factor = match analysis {
+                "amgf_rule" => -2.0 * r.delta.ln(),
+                _ => reference,
+            };
+            let r_t = (closed * factor).sqrt();
             assert!(
                 s.r_t >= r_t * (1.0 - 1e-12) && s.r_t <= r_t * (1.0 + 1e-9),
                 "t = {}",

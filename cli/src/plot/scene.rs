@@ -83,7 +83,10 @@ pub struct RatesScene {
 
 /// The rates figure of a result with time-varying rates, `None` for one global rate.
 pub fn rates_scene(result: &ResultFile) -> Option<RatesScene> {
-    let rate = result.rate.as_ref().filter(|r| r.kind != RateSource::Global)?;
+    let rate = result
+        .rate
+        .as_ref()
+        .filter(|r| r.kind != RateSource::Global)?;
     let steps = result.steps.get(1..).unwrap_or_default();
     let sigma = steps
         .iter()

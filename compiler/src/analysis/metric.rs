@@ -133,7 +133,7 @@ fn identity(n: usize) -> Vec<f64> {
 }
 
 /// `P / lambda_min(P)`, made exactly symmetric (upper triangle copied down).
-fn normalise(p: &DMatrix<f64>) -> Vec<f64> {
+pub(crate) fn normalise(p: &DMatrix<f64>) -> Vec<f64> {
     let n = p.nrows();
     let sym = (p + p.transpose()) * 0.5;
     let lmin = SymmetricEigen::new(sym.clone()).eigenvalues.min();

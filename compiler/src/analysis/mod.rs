@@ -6,6 +6,7 @@ mod bounds;
 mod contraction;
 mod derivatives;
 mod metric;
+mod objective;
 mod psd;
 #[cfg(feature = "sdp")]
 pub mod sdp;
@@ -18,4 +19,5 @@ pub use contraction::{
 };
 pub use derivatives::{Derivatives, GradEntry};
 pub use metric::{synthesize_metric, synthesize_metric_over, FULL_METRIC_MAX_DIM};
+pub use objective::metric_for_result;
 pub use transform::Frame;

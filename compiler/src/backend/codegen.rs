@@ -1702,6 +1702,7 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
     let initial = w.initial_set(&info.initial);
     let domain = list(info.domain.iter().map(|&r| range(r)));
     let has_domain = info.has_domain;
+    let affine = info.affine;
     let unsafe_sets: Vec<TokenStream> = info.unsafe_sets.iter().map(|u| w.unsafe_set(u)).collect();
     let unsafe_sets = list(unsafe_sets);
     let analyses: Vec<TokenStream> = info.analyses.iter().map(|a| w.analysis(a, info)).collect();
@@ -1736,6 +1737,7 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
                 initial: #initial,
                 domain: domain.clone(),
                 has_domain: #has_domain,
+                affine: #affine,
                 unsafe_sets: #unsafe_sets,
                 analyses: #analyses,
             }

@@ -4,14 +4,14 @@
 use reachc_core::model::{Analysis, ModelInfo};
 
 use crate::analysis::{
-    constants, constants_without_rate, synthesize_metric, synthesize_metric_over, time_range,
-    ConstantsError, Derivatives, Frame,
+    constants, constants_without_rate, metric_for_result, synthesize_metric,
+    synthesize_metric_over, time_range, ConstantsError, Derivatives, Frame,
 };
 use crate::diagnostics::Diagnostic;
 use crate::ir::Names;
 use crate::model::{self, MetricChoice, Model, Rate};
 use reachc_core::interval::Interval;
-use reachc_core::model::{Constants, MetricRegion, Provenance};
+use reachc_core::model::{AnalysisSpec, Constants, MetricRegion, Provenance};
 
 /// A model ready for code generation or interpretation.
 #[derive(Clone, Debug)]
@@ -43,7 +43,8 @@ pub fn prepare(model: &mut Model) -> Prepared {
         let metric = || match &a.spec.metric {
             MetricChoice::Identity => Ok(identity(n)),
             MetricChoice::Matrix(m) => Ok(m.clone()),
-            MetricChoice::Auto => synthesize_metric(model, &derivatives),
+            MetricChoice::Auto => synthesize_metric(model, &derivatives)
+                .map(|p| metric_for_result(model, &derivatives, &a.spec, p)),
         };
         // An empirical rate needs only sigma and rho from here; local rates need only a
         // metric (the global constants, where bounded, tighten them where they hold).
@@ -98,6 +99,7 @@ pub fn prepare(model: &mut Model) -> Prepared {
         initial: model.initial.clone(),
         domain: model.domain.clone(),
         has_domain: model.has_domain,
+        affine: is_affine(model, &derivatives),
         unsafe_sets: model.unsafe_sets.clone(),
         analyses,
     };
@@ -109,6 +111,13 @@ pub fn prepare(model: &mut Model) -> Prepared {
     }
 }
 
+/// Whether `D_x f` and `G` are constant expressions (no state, input, time or table in them):
+/// the model is affine in the state with additive noise (method.md section 8.1).
+fn is_affine(model: &Model, d: &Derivatives) -> bool {
+    let constant = |e: &crate::ir::ExprId| model.pool.vars_of(*e).is_empty();
+    d.jac_x.iter().flatten().all(constant) && model.diffusion.iter().flatten().all(constant)
+}
+
 /// The constants of a local-rate analysis: its metric (given; or synthesised over the domain
 /// when the compiler can bound the rate there, so that the local rates are never above the
 /// global ones; else over the initial set during the first report step), and the global
@@ -116,14 +125,16 @@ pub fn prepare(model: &mut Model) -> Prepared {
 fn local_constants(
     model: &Model,
     d: &Derivatives,
-    spec: &reachc_core::model::AnalysisSpec,
+    spec: &AnalysisSpec,
 ) -> Result<Constants, ConstantsError> {
     let n = model.states.len();
     let (metric, region) = match &spec.metric {
         MetricChoice::Identity => (identity(n), MetricRegion::Given),
         MetricChoice::Matrix(m) => (m.clone(), MetricRegion::Given),
         MetricChoice::Auto => {
-            let global = synthesize_metric(model, d).and_then(|p| constants(model, d, &p));
+            let global = synthesize_metric(model, d)
+                .map(|p| metric_for_result(model, d, spec, p))
+                .and_then(|p| constants(model, d, &p));
             match global {
                 Ok(c) if c.c.is_finite() => {
                     return Ok(Constants {
@@ -166,7 +177,8 @@ fn local_constants(
 }
 
 /// A metric synthesised for the Jacobian over the initial set's bounding box and
-/// `t in [0, step]` (the identity if that fails).
+/// `t in [0, step]` (the identity if that fails). Not chosen for the result: constants over
+/// the initial set predict the PRS at the horizon too poorly to compare metrics by.
 fn initial_metric(model: &Model, d: &Derivatives, step: f64) -> Vec<f64> {
     let n = model.states.len();
     let Ok(start) = model.initial.bounding_box() else {

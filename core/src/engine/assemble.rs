@@ -3,6 +3,7 @@
 //! each report time and over each report interval, the safety margins over those intervals,
 //! the verdicts.
 
+use super::gaussian;
 use super::local::Found;
 use super::radius::Stochastic;
 use super::safety::{Check, Context};
@@ -10,10 +11,10 @@ use super::transform::Frame;
 use super::uniform::{Scale, Tube};
 use super::Run;
 use crate::interval::Interval;
-use crate::model::{Guarantee, Inclusion, Method, Rate};
+use crate::model::{Guarantee, Inclusion, Method, RadiusRule, Rate};
 use crate::prs::{
-    ConstantsUsed, DetSet, Proved, Prs, R1Bound, RateUsed, RuleUsed, Span, Step, TransformUsed,
-    Unproved, UnsafeVerdict, Validation, Verdict,
+    ConstantsUsed, DetSet, GaussianUsed, Proved, Prs, R1Bound, RateUsed, RuleUsed, Span, Step,
+    TransformUsed, UniformBound, Unproved, UnsafeVerdict, Validation, Verdict,
 };
 
 /// One internal step `[t0, t1]` of the deterministic part.
@@ -67,8 +68,10 @@ struct Radii {
     /// Per report time after 0: `(radius at it, largest radius over its report interval)` of
     /// the guarantee.
     guaranteed: Vec<(f64, f64)>,
-    /// The tube's epochs (uniform guarantee).
-    epochs: Option<usize>,
+    /// The time-uniform bound used and its epochs (uniform guarantee).
+    uniform: Option<(UniformBound, usize)>,
+    /// The exact Gaussian route (affine systems under the amgf rule).
+    gaussian: Option<GaussianUsed>,
 }
 
 impl Radii {
@@ -84,45 +87,84 @@ impl Radii {
                 pointwise.push(r);
             }
         }
+        let times: Vec<f64> = det
+            .pieces
+            .iter()
+            .filter(|p| p.end.is_some())
+            .map(|p| p.t1)
+            .collect();
+        let gauss = match run.spec.radius {
+            RadiusRule::Amgf => gaussian::radii(run, &times),
+            _ => None,
+        };
+        if let Some(g) = &gauss {
+            // Both radii are valid for each time; the Gaussian one is never larger in exact
+            // arithmetic.
+            for (pw, &r) in pointwise.iter_mut().zip(&g.pointwise) {
+                pw.1 = pw.1.min(r);
+            }
+        }
+        let used = |uniform| {
+            gauss.as_ref().map(|g| GaussianUsed {
+                quantile: g.quantile,
+                uniform,
+            })
+        };
         match run.spec.guarantee {
-            // Psi is increasing, so an interval's largest radius is its end's.
+            // Psi and Sigma are increasing, so an interval's largest radius is its end's.
             Guarantee::Pointwise => Radii {
                 guaranteed: pointwise.iter().map(|&(_, r)| (r, r)).collect(),
                 pointwise,
-                epochs: None,
+                uniform: None,
+                gaussian: used(None),
             },
             Guarantee::Uniform => {
-                let mut t0 = 0.0;
-                let scale = Scale::new(det.pieces.iter().map(|p| {
-                    let h = Interval::point(p.t1) - Interval::point(t0);
-                    t0 = p.t1;
-                    (h, p.rates.0, p.rates.1)
-                }));
-                let tube = det.tube.clone().unwrap_or_else(|| {
-                    let first = det.pieces.iter().position(|p| p.end.is_some()).unwrap_or(0);
-                    Tube::for_scale(run.setup.n, run.spec.delta, &scale, first + 1)
-                });
-                // Per report interval: the radius over the hull of psi and S along it (the
-                // tube's bound holds for every time whose psi and S lie in the hulls).
-                let mut guaranteed = Vec::with_capacity(pointwise.len());
-                let (mut psi, mut s) = (scale.psi[0], scale.s[0]);
-                for (k, p) in det.pieces.iter().enumerate() {
-                    psi = psi.hull(scale.psi[k + 1]);
-                    s = s.hull(scale.s[k + 1]);
-                    if p.end.is_some() {
-                        let end = tube.radius(scale.psi[k + 1], scale.s[k + 1]);
-                        guaranteed.push((end, tube.radius(psi, s).max(end)));
-                        (psi, s) = (scale.psi[k + 1], scale.s[k + 1]);
-                    }
-                }
+                let (tube, epochs) = amgf_tube(run, det);
+                // Both bounds are valid; the one with the smaller radii (summed over the report
+                // times, a deterministic choice) is used.
+                let sum = |radii: &[(f64, f64)]| radii.iter().map(|r| r.0).sum::<f64>();
+                let (guaranteed, uniform) = match gauss.as_ref().and_then(|g| g.uniform.clone()) {
+                    Some((mix, k)) if sum(&mix) < sum(&tube) => (mix, (UniformBound::Mixture, k)),
+                    _ => (tube, (UniformBound::AmgfTube, epochs)),
+                };
                 Radii {
                     guaranteed,
                     pointwise,
-                    epochs: Some(tube.epochs()),
+                    uniform: Some(uniform),
+                    gaussian: used(Some(uniform.0)),
                 }
             }
         }
     }
+}
+
+/// The AMGF tube's radii per report time `(at it, largest over its report interval)`, and its
+/// number of epochs.
+fn amgf_tube(run: &Run, det: &Deterministic) -> (Vec<(f64, f64)>, usize) {
+    let mut t0 = 0.0;
+    let scale = Scale::new(det.pieces.iter().map(|p| {
+        let h = Interval::point(p.t1) - Interval::point(t0);
+        t0 = p.t1;
+        (h, p.rates.0, p.rates.1)
+    }));
+    let tube = det.tube.clone().unwrap_or_else(|| {
+        let first = det.pieces.iter().position(|p| p.end.is_some()).unwrap_or(0);
+        Tube::for_scale(run.setup.n, run.spec.delta, &scale, first + 1)
+    });
+    // Per report interval: the radius over the hull of psi and S along it (the tube's bound
+    // holds for every time whose psi and S lie in the hulls).
+    let mut guaranteed = Vec::new();
+    let (mut psi, mut s) = (scale.psi[0], scale.s[0]);
+    for (k, p) in det.pieces.iter().enumerate() {
+        psi = psi.hull(scale.psi[k + 1]);
+        s = s.hull(scale.s[k + 1]);
+        if p.end.is_some() {
+            let end = tube.radius(scale.psi[k + 1], scale.s[k + 1]);
+            guaranteed.push((end, tube.radius(psi, s).max(end)));
+            (psi, s) = (scale.psi[k + 1], scale.s[k + 1]);
+        }
+    }
+    (guaranteed, tube.epochs())
 }
 
 /// The result of a run: the radii along the internal steps, the PRS at each report time and
@@ -197,9 +239,18 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Opt
     }
     let (unsafe_sets, verdict) = verdicts(run, &setup.checks, &steps);
     let mut rigorous = header.rigorous;
-    if let Some(epochs) = radii.epochs {
-        rigorous.push(Proved::UniformTube { epochs });
+    if radii.gaussian.is_some() {
+        rigorous.push(Proved::ExactGaussian);
     }
+    match radii.uniform {
+        Some((UniformBound::AmgfTube, epochs)) => rigorous.push(Proved::UniformTube { epochs }),
+        Some((UniformBound::Mixture, epochs)) => rigorous.push(Proved::GaussianMixture { epochs }),
+        None => {}
+    }
+    let radius_rule = RuleUsed {
+        gaussian: radii.gaussian,
+        ..header.radius_rule
+    };
     Prs {
         model: run.info.name.clone(),
         analysis: run.spec.name.clone(),
@@ -215,7 +266,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Opt
         outputs: run.spec.outputs.clone(),
         rate: header.rate,
         constants: header.constants,
-        radius_rule: header.radius_rule,
+        radius_rule,
         kappa: header.kappa,
         r1: header.r1,
         r2: header.r2,

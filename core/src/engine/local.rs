@@ -17,7 +17,7 @@
 //! scaled by the input box's half-widths. Where the compiler's global constants hold on the
 //! region (no domain, or the region inside it), the smaller of the two is used.
 
-use super::linalg;
+use super::linalg::{self, lambda_max, product, symmetric_part};
 use super::uniform::{Scale, Tube};
 use super::{Run, RunError};
 use crate::interval::Interval;
@@ -407,57 +407,6 @@ impl<'a> Certifier<'a> {
             region.join(", ")
         ))
     }
-}
-
-/// `A B` for interval matrices `r x k` and `k x c`.
-fn product(a: &[Interval], b: &[Interval], r: usize, k: usize, c: usize) -> Vec<Interval> {
-    let mut out = vec![Interval::ZERO; r * c];
-    for i in 0..r {
-        for l in 0..k {
-            let ail = a[i * k + l];
-            if ail == Interval::ZERO {
-                continue;
-            }
-            for j in 0..c {
-                out[i * c + j] += ail * b[l * c + j];
-            }
-        }
-    }
-    out
-}
-
-/// `(B + B') / 2`.
-fn symmetric_part(b: &[Interval], n: usize) -> Vec<Interval> {
-    let mut s = vec![Interval::ZERO; n * n];
-    for i in 0..n {
-        for j in 0..n {
-            s[i * n + j] = (b[i * n + j] + b[j * n + i]) * Interval::point(0.5);
-        }
-    }
-    s
-}
-
-/// A rigorous upper bound of `lambda_max` over the symmetric matrices in `s`: the smaller of
-/// the interval-Cholesky route and `lambda_max(mid) + rho(rad)` (Collatz-Wielandt with the unit
-/// vector, i.e. the largest row sum of the radii), which stays tight for wide enclosures.
-fn lambda_max(s: &[Interval], n: usize) -> f64 {
-    let direct = linalg::lambda_max_upper(s, n);
-    let mid: Vec<Interval> = s.iter().map(|v| Interval::point(v.mid())).collect();
-    let mut spread = 0.0f64;
-    for i in 0..n {
-        let mut row = Interval::ZERO;
-        for j in 0..n {
-            let v = s[i * n + j];
-            // |v - mid| <= max(hi - mid, mid - lo), rounded up.
-            let m = mid[i * n + j];
-            row += (Interval::point(v.hi()) - m)
-                .abs()
-                .max((m - Interval::point(v.lo())).abs());
-        }
-        spread = spread.max(row.hi());
-    }
-    let split = (Interval::point(linalg::lambda_max_upper(&mid, n)) + Interval::point(spread)).hi();
-    direct.min(split)
 }
 
 /// The entry of largest magnitude (non-finite first).

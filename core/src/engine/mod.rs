@@ -21,6 +21,7 @@ mod assemble;
 mod contraction;
 mod defect;
 mod embedding;
+mod gaussian;
 mod hermite;
 pub(crate) mod interval;
 pub(crate) mod linalg;

@@ -270,6 +270,7 @@ pub(crate) fn stochastic_factor(n: usize, spec: &AnalysisSpec) -> (f64, RuleUsed
         RuleUsed {
             rule: spec.radius,
             eps,
+            gaussian: None,
         },
     )
 }

@@ -690,6 +690,7 @@ mod tests {
             },
             domain: vec![Bounds::ENTIRE; 2],
             has_domain: false,
+            affine: false,
             unsafe_sets: vec![],
             analyses: vec![],
         };

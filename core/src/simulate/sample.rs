@@ -250,6 +250,7 @@ mod tests {
             },
             domain: vec![Bounds::ENTIRE],
             has_domain: false,
+            affine: false,
             unsafe_sets: vec![],
             analyses: vec![],
         }

@@ -3,7 +3,7 @@
 use super::{csv_field, num, summary_indices};
 use reachc_core::model::{Guarantee, Method, Rate};
 use reachc_core::prs::{
-    DetSet, Proved, Prs, R1Method, Step, Unproved, UnsafeKind, UnsafeVerdict, Verdict,
+    DetSet, Proved, Prs, R1Method, Step, UniformBound, Unproved, UnsafeKind, UnsafeVerdict, Verdict,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -74,6 +74,15 @@ struct ConstantsJson<'a> {
 struct RuleJson {
     rule: &'static str,
     eps: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    gaussian: Option<GaussianJson>,
+}
+
+#[derive(Serialize)]
+struct GaussianJson {
+    chi2_quantile: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    uniform: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -188,6 +197,10 @@ impl<'a> Json<'a> {
             radius_rule: RuleJson {
                 rule: prs.radius_rule.rule.name(),
                 eps: prs.radius_rule.eps,
+                gaussian: prs.radius_rule.gaussian.map(|g| GaussianJson {
+                    chi2_quantile: g.quantile,
+                    uniform: g.uniform.map(uniform_name),
+                }),
             },
             kappa: prs.kappa,
             r1: prs.r1,
@@ -411,6 +424,24 @@ fn proved(p: &Proved) -> String {
              {epochs} epochs at delta / {epochs} each: one event, of probability at least \
              1 - delta, for all t in [0, horizon]"
         ),
+        Proved::ExactGaussian => "exact Gaussian: the system is affine with additive noise, so \
+             X_t - x_t ~ N(0, Sigma_t); Sigma_t enclosed in interval arithmetic (Taylor series \
+             with remainder), the chi-square quantile rounded up"
+            .to_string(),
+        Proved::GaussianMixture { epochs } => format!(
+            "time-uniform Gaussian bound: Ville's inequality on the method-of-mixtures \
+             martingale over {epochs} epochs at delta / {epochs} each (tighter here than the \
+             averaged-MGF tube): one event, of probability at least 1 - delta, for all t in \
+             [0, horizon]"
+        ),
+    }
+}
+
+/// The name of a time-uniform bound in result files.
+fn uniform_name(bound: UniformBound) -> &'static str {
+    match bound {
+        UniformBound::AmgfTube => "amgf_tube",
+        UniformBound::Mixture => "gaussian_mixture",
     }
 }
 
@@ -603,9 +634,18 @@ pub fn summary(prs: &Prs) -> String {
         rows.join(", "),
         k.metric_region
     );
-    let rule = match prs.radius_rule.eps {
-        Some(eps) => format!("{} (eps = {eps:.6})", prs.radius_rule.rule.name()),
-        None => prs.radius_rule.rule.name().to_string(),
+    let rule = match (prs.radius_rule.eps, prs.radius_rule.gaussian) {
+        (Some(eps), _) => format!("{} (eps = {eps:.6})", prs.radius_rule.rule.name()),
+        (None, Some(g)) => format!(
+            "exact Gaussian (affine system: chi2 quantile {:.6}{})",
+            g.quantile,
+            match g.uniform {
+                Some(UniformBound::Mixture) => ", time-uniform by the Gaussian mixture bound",
+                Some(UniformBound::AmgfTube) => ", time-uniform by the amgf tube (tighter here)",
+                None => "",
+            },
+        ),
+        (None, None) => prs.radius_rule.rule.name().to_string(),
     };
     let _ = writeln!(
         s,
