@@ -1,7 +1,23 @@
 //! Helpers for the workspace-level end-to-end tests: where the shipped specs and the bad-spec
 //! corpus live, and a renderer that names files relative to the workspace (stable snapshots).
 
+use reachc_compiler::backend::{interp::Interpreter, prepare};
+use reachc_compiler::driver::load;
+use reachc_runtime::model::ModelInfo;
 use std::path::{Path, PathBuf};
+
+/// The interpreter of a checked model, with its model data.
+pub fn interpreter_of(mut model: reachc_compiler::model::Model) -> (Interpreter, ModelInfo) {
+    let prepared = prepare(&mut model);
+    let info = prepared.info.clone();
+    (Interpreter::new(model, &prepared), info)
+}
+
+/// The interpreter of the shipped spec `specs/NAME`.
+pub fn shipped(name: &str) -> (Interpreter, ModelInfo) {
+    let model = load(&workspace().join("specs").join(name)).expect("a shipped spec loads");
+    interpreter_of(model.model)
+}
 
 /// The workspace root.
 pub fn workspace() -> PathBuf {

@@ -2,22 +2,12 @@
 //! are never below the true measure over their regions, sample paths never leave the regions, and
 //! a time-varying diffusion gets its own `sigma_t` per step.
 
-use reachc_compiler::backend::{interp::Interpreter, prepare};
+use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::driver::{check_source, load};
-use reachc_e2e::workspace;
+use reachc_e2e::{interpreter_of, shipped, workspace};
 use reachc_runtime::model::{ModelInfo, Rate};
 use reachc_runtime::simulate::{sample_paths, Options};
 use reachc_runtime::{Prs, Reach, System};
-
-fn interpreter_of(mut model: reachc_compiler::model::Model) -> (Interpreter, ModelInfo) {
-    let prepared = prepare(&mut model);
-    let info = prepared.info.clone();
-    (Interpreter::new(model, &prepared), info)
-}
-
-fn shipped(name: &str) -> (Interpreter, ModelInfo) {
-    interpreter_of(load(&workspace().join("specs").join(name)).unwrap().model)
-}
 
 /// `mu_P(J)` of a 2 x 2 `J`: the largest root of `det(S - lambda P) = 0`, `S = sym(P J)`.
 fn mu_p(p: &[f64], j: &[f64]) -> f64 {

@@ -2,25 +2,15 @@
 //! Gaussian mixture bound for time-uniform results, and `metric = auto` chosen for the PRS at
 //! the horizon rather than for the rate alone.
 
-use reachc_compiler::backend::{interp::Interpreter, prepare};
-use reachc_compiler::driver::{check_source, load};
-use reachc_e2e::workspace;
+use reachc_compiler::backend::interp::Interpreter;
+use reachc_compiler::driver::check_source;
+use reachc_e2e::{interpreter_of, shipped, workspace};
 use reachc_runtime::model::{MetricRegion, ModelInfo};
 use reachc_runtime::prs::{Proved, UniformBound};
 use reachc_runtime::simulate::{
     self, clopper_pearson_lower as lower_bound, clopper_pearson_upper as upper_bound, Options,
 };
 use reachc_runtime::{Prs, Reach};
-
-fn interpreter_of(mut model: reachc_compiler::model::Model) -> (Interpreter, ModelInfo) {
-    let prepared = prepare(&mut model);
-    let info = prepared.info.clone();
-    (Interpreter::new(model, &prepared), info)
-}
-
-fn shipped(name: &str) -> (Interpreter, ModelInfo) {
-    interpreter_of(load(&workspace().join("specs").join(name)).unwrap().model)
-}
 
 fn inline(source: &str) -> (Interpreter, ModelInfo) {
     let (model, diags) = check_source(source, &workspace().join("specs"));
