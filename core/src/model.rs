@@ -307,8 +307,12 @@ pub enum MetricChoice {
     Identity,
     /// A given symmetric positive definite matrix, `n x n` row-major.
     Matrix(Vec<f64>),
-    /// Synthesised by the compiler.
+    /// Synthesised by the compiler, for the PRS's volume at the horizon.
     Auto,
+    /// `auto(states = [..])`: one metric per named state (indices), each chosen for that
+    /// state's extent at the horizon; the PRS is the intersection of the sets of all of them,
+    /// each at `delta / K` (method.md section 8.6).
+    PerState(Vec<usize>),
 }
 
 /// A coordinate transform `y = T x` of an interval analysis.
@@ -409,6 +413,10 @@ pub struct Constants {
     pub provenance: Provenance,
     /// What the constants hold for.
     pub region: Region,
+    /// The analysis' further metrics (`metric = auto(states = [..])`), each with its own
+    /// certified constants: the PRS is the intersection of the sets of this metric and of every
+    /// one here, each computed at `delta / K` (`K = 1 + also.len()`).
+    pub also: Vec<Constants>,
 }
 
 impl Constants {
@@ -424,6 +432,7 @@ impl Constants {
             rho,
             provenance: Provenance::Given,
             region: info.region(f64::INFINITY),
+            also: Vec::new(),
         }
     }
 }

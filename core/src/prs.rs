@@ -80,6 +80,12 @@ pub struct Prs {
     /// With local rates, the region of each internal step and the rates certified on it (empty
     /// otherwise).
     pub regions: Vec<RateRegion>,
+    /// The results of the analysis' further metrics (`metric = auto(states = [..])`, method.md
+    /// section 8.6), on the same report times. With `K = 1 + also.len()` metrics, this result's
+    /// sets and theirs are each computed at `delta / K`, and the PRS is their intersection:
+    /// [`Prs::contains`], [`Prs::span_contains`], [`Prs::hull`], the margins and the verdicts
+    /// answer for the intersection ([`Prs::delta`] is the analysis' `delta`).
+    pub also: Vec<Prs>,
 }
 
 /// Where the contraction rate `c_t` came from.
@@ -526,6 +532,11 @@ impl Prs {
     /// Whether `x` lies in [`Step::span`] of report step `k`, the PRS of every time of the
     /// report interval ending there: `true` only if certainly (see [`Prs::contains`]).
     pub fn span_contains(&self, k: usize, x: &[f64]) -> bool {
+        self.own_span_contains(k, x) && self.also.iter().all(|m| m.own_span_contains(k, x))
+    }
+
+    /// [`Prs::span_contains`] for this result's own metric.
+    fn own_span_contains(&self, k: usize, x: &[f64]) -> bool {
         let span = &self.steps[k].span;
         assert_eq!(
             x.len(),
@@ -552,6 +563,11 @@ impl Prs {
     /// Whether `x` lies in the PRS at report step `k` (see [`Prs::contains`]). Panics if `k` is
     /// out of range or `x` has the wrong length.
     pub fn contains_at(&self, k: usize, x: &[f64]) -> bool {
+        self.own_contains_at(k, x) && self.also.iter().all(|m| m.own_contains_at(k, x))
+    }
+
+    /// [`Prs::contains_at`] for this result's own metric.
+    fn own_contains_at(&self, k: usize, x: &[f64]) -> bool {
         let st = &self.steps[k];
         let n = self.n();
         assert_eq!(x.len(), n, "contains: x has the wrong dimension");
@@ -593,6 +609,19 @@ impl Prs {
     /// hull), rounded outward; `None` if [`ConstantsUsed::spread`] is missing (a result built
     /// by hand). Panics if `k` is out of range.
     pub fn hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
+        let mut hull = self.own_hull_at(k)?;
+        for m in &self.also {
+            for (b, o) in hull.iter_mut().zip(m.own_hull_at(k)?) {
+                // Both hold the intersection, so theirs does; an empty one cannot happen for
+                // sets holding the same nominal state, but stays a valid (degenerate) box.
+                *b = Bounds::new(b.lo.max(o.lo), b.hi.min(o.hi).max(b.lo.max(o.lo)));
+            }
+        }
+        Some(hull)
+    }
+
+    /// [`Prs::hull_at`] for this result's own metric.
+    fn own_hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
         let st = &self.steps[k];
         let n = self.n();
         let w = &self.constants.spread;

@@ -28,6 +28,8 @@ pub struct Reach<'a> {
     info: &'a ModelInfo,
     spec: AnalysisSpec,
     setup: Setup<'a>,
+    /// The setups of the analysis' further metrics (`metric = auto(states = [..])`).
+    also: Vec<Setup<'a>>,
 }
 
 impl<'a> Reach<'a> {
@@ -89,11 +91,20 @@ impl<'a> Reach<'a> {
             },
         };
         let setup = Setup::new(sys, info, spec, &analysis.constants, needs)?;
+        let also = match &analysis.constants {
+            Ok(c) => c
+                .also
+                .iter()
+                .map(|k| Setup::with(sys, info, spec, k, needs))
+                .collect::<Result<_, _>>()?,
+            Err(_) => Vec::new(),
+        };
         Ok(Reach {
             sys,
             info,
             spec: spec.clone(),
             setup,
+            also,
         })
     }
 
@@ -167,15 +178,35 @@ impl<'a> Reach<'a> {
     fn run_from(&self, initial: &InitialSet, inputs: Inputs) -> Result<Prs, RunError> {
         // Local rates hold wherever the tube goes: the domain does not constrain them.
         check_initial(self.info, initial, self.spec.rate != Rate::Local)?;
-        let run = Run {
-            sys: self.sys,
-            info: self.info,
-            spec: &self.spec,
-            setup: &self.setup,
-            initial,
-            inputs,
+        // K metrics: each set at delta / K, the PRS their intersection (union bound).
+        let k = 1 + self.also.len();
+        let spec = AnalysisSpec {
+            // Rounded down, so that the K shares sum to at most delta.
+            delta: (self.spec.delta / k as f64).next_down(),
+            ..self.spec.clone()
         };
-        engine::run_engine(&run)
+        let run_with = |setup: &Setup| {
+            engine::run_engine(&Run {
+                sys: self.sys,
+                info: self.info,
+                spec: if k == 1 { &self.spec } else { &spec },
+                setup,
+                initial,
+                inputs,
+            })
+        };
+        let first = run_with(&self.setup)?;
+        if k == 1 {
+            return Ok(first);
+        }
+        let others = self.also.iter().map(run_with).collect::<Result<_, _>>()?;
+        Ok(engine::intersect(
+            self.info,
+            &self.setup.checks,
+            self.spec.delta,
+            first,
+            others,
+        ))
     }
 }
 

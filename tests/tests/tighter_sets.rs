@@ -140,7 +140,15 @@ fn metric_auto_is_never_worse_than_the_identity() {
         let path = workspace().join("specs").join(name);
         let source = std::fs::read_to_string(&path).unwrap();
         let (sys, info) = shipped(name);
-        let (id_sys, id_info) = inline(&source.replace("metric = auto", "metric = identity"));
+        // Every `metric = auto` or `metric = auto(states = [..])` line becomes the identity.
+        let identity: Vec<&str> = source
+            .lines()
+            .map(|l| match l.trim_start().starts_with("metric = auto") {
+                true => "    metric = identity",
+                false => l,
+            })
+            .collect();
+        let (id_sys, id_info) = inline(&identity.join("\n"));
         for analysis in &info.analyses {
             let Ok(consts) = &analysis.constants else {
                 continue;
@@ -165,4 +173,64 @@ fn metric_auto_is_never_worse_than_the_identity() {
         }
     }
     assert!(compared >= 6, "{compared}");
+}
+
+/// At `t = 0` the contraction method's PRS is the initial box itself, not the P-ball around it:
+/// an unsafe half-space 0.02 above the box is shown safe there (margin 0.02, the Euclidean
+/// distance), where the ball reached into it.
+#[test]
+fn the_initial_box_is_the_set_at_time_zero() {
+    let path = workspace().join("specs").join("vanderpol_feedback.sde");
+    let source = std::fs::read_to_string(path).unwrap();
+    let (sys, info) = inline(&source.replace("{ x >= 1.6 }", "{ x >= 1.12 }"));
+    let prs = Reach::new(&sys, &info, "contraction")
+        .unwrap()
+        .run()
+        .unwrap();
+    let start = &prs.steps[0];
+    assert!(
+        (start.margins[0] - 0.02).abs() <= 1e-12,
+        "{}",
+        start.margins[0]
+    );
+    // The ball around the box reaches past the half-space.
+    let w = prs.constants.spread[0];
+    assert!(1.05 + start.det.radius() * w > 1.12);
+    assert_eq!(prs.contains(&[1.1, 0.05], 0.0), Some(true));
+    assert_eq!(prs.contains(&[1.11, 0.0], 0.0), Some(false));
+}
+
+/// Several metrics at once (method.md section 8.6): on the pendulum, one metric for theta and
+/// one for omega, each at delta / 2, bring both half-widths at t = 4 below what one metric can
+/// (theta at most 0.12 while omega at most 0.60; one metric: 0.109 and 0.814, or 0.241 and
+/// 0.561). The PRS is the intersection: its box is the intersection of the members' boxes, and
+/// a point in the first metric's set but outside the second's is outside.
+#[test]
+fn several_metrics_intersect_their_sets() {
+    let (sys, info) = shipped("pendulum.sde");
+    let prs = Reach::new(&sys, &info, "per_state").unwrap().run().unwrap();
+    assert_eq!(prs.also.len(), 1);
+    assert_eq!(prs.delta, 1e-3);
+    assert_eq!(prs.also[0].delta, (1e-3f64 / 2.0).next_down());
+    let k = prs.steps.len() - 1;
+    let hull = prs.hull_at(k).unwrap();
+    let (theta, omega) = (
+        0.5 * (hull[0].hi - hull[0].lo),
+        0.5 * (hull[1].hi - hull[1].lo),
+    );
+    assert!(
+        theta <= 0.12 && omega <= 0.60,
+        "theta {theta}, omega {omega}"
+    );
+    let theirs = prs.also[0].hull_at(k).unwrap();
+    assert!(theirs[1].hi >= hull[1].hi && theirs[0].hi >= hull[0].hi);
+    // A point of the first metric's ball along omega, beyond the intersection's box.
+    let st = &prs.steps[k];
+    let c = st.det.center();
+    let p = &prs.constants.metric;
+    let omega_far = st.prs_radius / p[3].sqrt() * 0.999;
+    let x = [c[0], c[1] + omega_far];
+    assert!(omega_far > 0.6, "{omega_far}");
+    assert!(!prs.contains_at(k, &x));
+    assert!(prs.contains_at(k, c));
 }

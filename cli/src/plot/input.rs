@@ -38,6 +38,9 @@ pub struct ResultFile {
     pub rate: Option<RateKind>,
     /// One record per report time.
     pub steps: Vec<Step>,
+    /// The analysis' further metrics' results (the PRS is the intersection of all sets).
+    #[serde(default)]
+    pub also: Vec<ResultFile>,
 }
 
 /// The guarantee of a result (`"uniform"` or `"pointwise"`).

@@ -3,7 +3,7 @@
 //! the inputs here, drawn by [`super::figures`], so that the geometry can be tested without
 //! pixels.
 
-use super::geometry::{Plane, Point, Projected};
+use super::geometry::{clip, Plane, Point, Projected};
 use super::input::{Guarantee, Method, RateSource, ResultFile, Shape, Step};
 use super::regions::Region;
 use reachc_runtime::model::{Analysis, ModelInfo};
@@ -150,6 +150,32 @@ fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
     }
 }
 
+/// The projected PRS `poly` of report step `k` clipped by the projected PRS of each further
+/// metric of the result (its polygon contains the set, so the clipped polygon contains the
+/// projection of the intersection).
+fn intersected(result: &ResultFile, plane: &Plane, k: usize, poly: Vec<Point>) -> Vec<Point> {
+    result.also.iter().fold(poly, |poly, m| {
+        let (Some(mp), Some(step)) = (
+            Plane::new(plane.states, &m.constants.metric),
+            m.steps.get(k),
+        ) else {
+            return poly;
+        };
+        let other = det_set(m, &mp, step)
+            .plus_ellipse(mp.shape, step.r_t)
+            .polygon();
+        // Counter-clockwise vertices: the outward normal of edge (p, q) is (q - p) turned right.
+        let planes: Vec<(Point, f64)> = (0..other.len())
+            .map(|i| {
+                let (p, q) = (other[i], other[(i + 1) % other.len()]);
+                let n = [q[1] - p[1], p[0] - q[0]];
+                (n, n[0] * p[0] + n[1] * p[1])
+            })
+            .collect();
+        clip(&poly, &planes)
+    })
+}
+
 /// Projects each path (flat, `n` per report time) onto the plane.
 fn project_paths(plane: &Plane, n: usize, paths: &[Vec<f64>]) -> Vec<Vec<Point>> {
     paths
@@ -209,7 +235,7 @@ pub fn sets_scene(
                 } else {
                     det.polygon()
                 },
-                prs: prs.polygon(),
+                prs: intersected(result, plane, k, prs.polygon()),
                 samples: samples_at(&paths, k),
                 nominal: Some(plane.point(&step.nominal)),
             }
@@ -226,13 +252,20 @@ pub fn sets_scene(
         Guarantee::Uniform => "holds X_t for all t at once with probability ≥ 1 - δ",
         Guarantee::Pointwise => "holds X_t with probability ≥ 1 - δ at each t",
     };
-    let notes = vec![
+    let mut notes = vec![
         format!(
             "PRS (solid) = deterministic {shape} (dashed) + B_P(r_t): {holds}, δ = {}",
             result.delta
         ),
         "projections onto the plotted states: exact".into(),
     ];
+    if !result.also.is_empty() {
+        let k = 1 + result.also.len();
+        notes[1] = format!(
+            "PRS: the intersection of the sets of {k} metrics, each at δ / {k} (dashed: the \
+             first metric's deterministic set); drawn: the intersection of their projections"
+        );
+    }
     SetsScene {
         title: format!("{} / {}: δ-PRS", result.model, result.analysis),
         axes: [result.states[a].clone(), result.states[b].clone()],

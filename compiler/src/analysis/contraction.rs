@@ -745,6 +745,7 @@ fn noise_and_input(
             sigma: diffusion.bound(),
             rho: gain,
         },
+        also: Vec::new(),
         region: Region {
             domain: model.domain.clone(),
             input_box: model.input_box.clone(),

@@ -19,5 +19,5 @@ pub use contraction::{
 };
 pub use derivatives::{Derivatives, GradEntry};
 pub use metric::{synthesize_metric, synthesize_metric_over, FULL_METRIC_MAX_DIM};
-pub use objective::metric_for_result;
+pub use objective::{metric_for_result, Objective};
 pub use transform::Frame;

@@ -32,17 +32,34 @@ const SEARCH_EVALS: usize = 300;
 /// Up to this many initial-box coordinates `r1` is the maximum over the vertices.
 const VERTEX_MAX: usize = 12;
 
-/// The metric among `candidates` (and those derived from the rate-optimal `rate_metric`) whose
-/// certified constants predict the smallest PRS at the horizon of `spec`.
+/// What a metric is chosen for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Objective {
+    /// The volume of the PRS's P-ball at the horizon (`metric = auto`).
+    Volume,
+    /// The half-width of one state's extent at the horizon, for one of `metrics` metrics
+    /// sharing `delta` (`metric = auto(states = [..])`, each at `delta / metrics`).
+    Extent {
+        /// The state's index.
+        state: usize,
+        /// The number of metrics of the analysis.
+        metrics: usize,
+    },
+}
+
+/// The metric among the candidates derived from the rate-optimal `rate_metric` (and the
+/// identity) whose certified constants predict the smallest PRS at the horizon of `spec`, as
+/// measured by `objective`.
 pub fn metric_for_result(
     model: &Model,
     d: &Derivatives,
     spec: &AnalysisSpec,
     rate_metric: Vec<f64>,
+    objective: Objective,
 ) -> Vec<f64> {
     let n = model.states.len();
     let score = |p: &[f64]| -> f64 {
-        constants(model, d, p).map_or(f64::INFINITY, |k| predicted(model, spec, p, &k))
+        constants(model, d, p).map_or(f64::INFINITY, |k| predicted(model, spec, p, &k, objective))
     };
     let mut best = (score(&identity(n)), identity(n));
     let consider = |p: Vec<f64>, best: &mut (f64, Vec<f64>)| {
@@ -74,9 +91,16 @@ pub fn metric_for_result(
     normalise(&DMatrix::from_row_slice(n, n, &best.1))
 }
 
-/// The log-volume of the P-ball the certified constants predict at the horizon (see the module
-/// documentation); infinite when they are not finite.
-fn predicted(model: &Model, spec: &AnalysisSpec, p: &[f64], k: &Constants) -> f64 {
+/// The log-volume of the P-ball the certified constants predict at the horizon, or the log of
+/// its extent in one state (see the module documentation); infinite when the constants are not
+/// finite.
+fn predicted(
+    model: &Model,
+    spec: &AnalysisSpec,
+    p: &[f64],
+    k: &Constants,
+    objective: Objective,
+) -> f64 {
     let n = model.states.len();
     let (c, t) = (k.c, spec.horizon);
     if !(c.is_finite() && k.sigma.is_finite() && k.rho.is_finite()) {
@@ -84,18 +108,33 @@ fn predicted(model: &Model, spec: &AnalysisSpec, p: &[f64], k: &Constants) -> f6
     }
     // (e^(x) - 1) / x, continuous at 0.
     let growth = |x: f64| if x.abs() < 1e-12 { 1.0 } else { x.exp_m1() / x };
-    let kappa = reachc_core::kappa::kappa(n, spec.delta, spec.radius);
+    let delta = match objective {
+        Objective::Volume => spec.delta,
+        Objective::Extent { metrics, .. } => spec.delta / metrics as f64,
+    };
+    let kappa = reachc_core::kappa::kappa(n, delta, spec.radius);
     let psi = k.sigma * k.sigma * t * growth(2.0 * c * t);
     let r_t = (kappa * psi).sqrt();
     let det = match spec.method {
         Method::Contraction => (c * t).exp() * r1(model, p) + k.rho * t * growth(c * t),
         Method::Interval => 0.0,
     };
-    let chol = DMatrix::from_row_slice(n, n, p).cholesky();
-    let log_det = chol.map_or(f64::NAN, |l| {
-        2.0 * l.l().diagonal().iter().map(|v| v.ln()).sum::<f64>()
-    });
-    let v = n as f64 * (det + r_t).ln() - 0.5 * log_det;
+    let Some(chol) = DMatrix::from_row_slice(n, n, p).cholesky() else {
+        return f64::INFINITY;
+    };
+    let v = match objective {
+        Objective::Volume => {
+            let log_det = 2.0 * chol.l().diagonal().iter().map(|v| v.ln()).sum::<f64>();
+            n as f64 * (det + r_t).ln() - 0.5 * log_det
+        }
+        // The ball's half-width in state i is its radius times sqrt((P^-1)_ii).
+        Objective::Extent { state, .. } => {
+            let mut e = DMatrix::zeros(n, 1);
+            e[(state, 0)] = 1.0;
+            let col = chol.solve(&e);
+            (det + r_t).ln() + 0.5 * col[(state, 0)].ln()
+        }
+    };
     if v.is_nan() {
         f64::INFINITY
     } else {

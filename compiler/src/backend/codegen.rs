@@ -1484,6 +1484,8 @@ impl InfoWriter {
     }
 
     fn constants(&mut self, c: &Constants, info: &ModelInfo) -> TokenStream {
+        let also: Vec<TokenStream> = c.also.iter().map(|k| self.constants(k, info)).collect();
+        let also = list(also);
         let metric = self.floats(&c.metric);
         let (cc, sigma, rho) = (float(c.c), float(c.sigma), float(c.rho));
         let provenance = provenance(&c.provenance);
@@ -1514,6 +1516,7 @@ impl InfoWriter {
                 rho: #rho,
                 provenance: #provenance,
                 region: Region { domain: #domain, input_box: #input_box, time: #time },
+                also: #also,
             }
         }
     }
@@ -1533,6 +1536,10 @@ impl InfoWriter {
         let metric = match &a_spec.metric {
             MetricChoice::Identity => quote!(MetricChoice::Identity),
             MetricChoice::Auto => quote!(MetricChoice::Auto),
+            MetricChoice::PerState(states) => {
+                let states = states.iter().map(|&i| quote!(#i));
+                quote!(MetricChoice::PerState(vec![#(#states),*]))
+            }
             MetricChoice::Matrix(m) => {
                 let m = self.floats(m);
                 quote!(MetricChoice::Matrix(#m))

@@ -5,7 +5,7 @@ use reachc_core::model::{Analysis, ModelInfo};
 
 use crate::analysis::{
     constants, constants_without_rate, metric_for_result, synthesize_metric,
-    synthesize_metric_over, time_range, ConstantsError, Derivatives, Frame,
+    synthesize_metric_over, time_range, ConstantsError, Derivatives, Frame, Objective,
 };
 use crate::diagnostics::Diagnostic;
 use crate::ir::Names;
@@ -35,37 +35,11 @@ pub struct Prepared {
 /// an error, but the rest of the model is still usable.
 pub fn prepare(model: &mut Model) -> Prepared {
     let derivatives = Derivatives::of(model);
-    let n = model.states.len();
     let mut warnings = Vec::new();
     let mut analyses = Vec::new();
     let mut frames: Vec<Frame> = Vec::new();
     for a in model.analyses.clone() {
-        let metric = || match &a.spec.metric {
-            MetricChoice::Identity => Ok(identity(n)),
-            MetricChoice::Matrix(m) => Ok(m.clone()),
-            MetricChoice::Auto => synthesize_metric(model, &derivatives)
-                .map(|p| metric_for_result(model, &derivatives, &a.spec, p)),
-        };
-        // An empirical rate needs only sigma and rho from here; local rates need only a
-        // metric (the global constants, where bounded, tighten them where they hold).
-        let region = match a.spec.metric {
-            MetricChoice::Auto => MetricRegion::Domain,
-            _ => MetricRegion::Given,
-        };
-        let derived = match a.spec.rate {
-            Rate::Global => metric().and_then(|p| constants(model, &derivatives, &p)),
-            Rate::Empirical { .. } => {
-                metric().and_then(|p| constants_without_rate(model, &derivatives, &p))
-            }
-            Rate::Local => local_constants(model, &derivatives, &a.spec),
-        }
-        .map(|c| match a.spec.rate {
-            Rate::Local => c,
-            _ => Constants {
-                metric_region: region,
-                ..c
-            },
-        });
+        let derived = analysis_constants(model, &derivatives, &a.spec);
         let constants = derived.map_err(|e| {
             let (message, help) = explain(model, &derivatives, &e);
             warnings.push(
@@ -118,6 +92,59 @@ fn is_affine(model: &Model, d: &Derivatives) -> bool {
     d.jac_x.iter().flatten().all(constant) && model.diffusion.iter().flatten().all(constant)
 }
 
+/// The constants of an analysis: for its metric, or with `metric = auto(states = [..])` one
+/// metric per named state, each chosen for that state's extent at `delta / K`, the first's
+/// constants holding the others' in [`Constants::also`].
+fn analysis_constants(
+    model: &Model,
+    d: &Derivatives,
+    spec: &AnalysisSpec,
+) -> Result<Constants, ConstantsError> {
+    let MetricChoice::PerState(states) = &spec.metric else {
+        return one_metric(model, d, spec, Objective::Volume);
+    };
+    let metrics = states.len();
+    let mut all = states
+        .iter()
+        .map(|&state| one_metric(model, d, spec, Objective::Extent { state, metrics }))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut first = all.remove(0);
+    first.also = all;
+    Ok(first)
+}
+
+/// The constants of an analysis for one metric: given, or chosen by the compiler for
+/// `objective`. An empirical rate needs only sigma and rho from here; local rates need only a
+/// metric (the global constants, where bounded, tighten them where they hold).
+fn one_metric(
+    model: &Model,
+    d: &Derivatives,
+    spec: &AnalysisSpec,
+    objective: Objective,
+) -> Result<Constants, ConstantsError> {
+    let n = model.states.len();
+    let metric = || match &spec.metric {
+        MetricChoice::Identity => Ok(identity(n)),
+        MetricChoice::Matrix(m) => Ok(m.clone()),
+        MetricChoice::Auto | MetricChoice::PerState(_) => {
+            synthesize_metric(model, d).map(|p| metric_for_result(model, d, spec, p, objective))
+        }
+    };
+    let region = match spec.metric {
+        MetricChoice::Auto | MetricChoice::PerState(_) => MetricRegion::Domain,
+        _ => MetricRegion::Given,
+    };
+    let derived = match spec.rate {
+        Rate::Global => metric().and_then(|p| constants(model, d, &p)),
+        Rate::Empirical { .. } => metric().and_then(|p| constants_without_rate(model, d, &p)),
+        Rate::Local => return local_constants(model, d, spec, objective),
+    };
+    derived.map(|c| Constants {
+        metric_region: region,
+        ..c
+    })
+}
+
 /// The constants of a local-rate analysis: its metric (given; or synthesised over the domain
 /// when the compiler can bound the rate there, so that the local rates are never above the
 /// global ones; else over the initial set during the first report step), and the global
@@ -126,14 +153,15 @@ fn local_constants(
     model: &Model,
     d: &Derivatives,
     spec: &AnalysisSpec,
+    objective: Objective,
 ) -> Result<Constants, ConstantsError> {
     let n = model.states.len();
     let (metric, region) = match &spec.metric {
         MetricChoice::Identity => (identity(n), MetricRegion::Given),
         MetricChoice::Matrix(m) => (m.clone(), MetricRegion::Given),
-        MetricChoice::Auto => {
+        MetricChoice::Auto | MetricChoice::PerState(_) => {
             let global = synthesize_metric(model, d)
-                .map(|p| metric_for_result(model, d, spec, p))
+                .map(|p| metric_for_result(model, d, spec, p, objective))
                 .and_then(|p| constants(model, d, &p));
             match global {
                 Ok(c) if c.c.is_finite() => {
@@ -165,6 +193,7 @@ fn local_constants(
                 provenance: Provenance::Unbounded {
                     why: explain(model, d, &e).0,
                 },
+                also: Vec::new(),
                 region: reachc_core::model::Region {
                     domain: model.domain.clone(),
                     input_box: model.input_box.clone(),

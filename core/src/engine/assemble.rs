@@ -11,7 +11,7 @@ use super::transform::Frame;
 use super::uniform::{Scale, Tube};
 use super::Run;
 use crate::interval::Interval;
-use crate::model::{Guarantee, Inclusion, Method, RadiusRule, Rate};
+use crate::model::{Guarantee, Inclusion, Method, ModelInfo, RadiusRule, Rate};
 use crate::prs::{
     ConstantsUsed, DetSet, GaussianUsed, Proved, Prs, R1Bound, RateUsed, RuleUsed, Span, Step,
     TransformUsed, UniformBound, Unproved, UnsafeVerdict, Validation, Verdict,
@@ -237,7 +237,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Opt
             span,
         });
     }
-    let (unsafe_sets, verdict) = verdicts(run, &setup.checks, &steps);
+    let (unsafe_sets, verdict) = verdicts(run.info, &setup.checks, &steps);
     let mut rigorous = header.rigorous;
     if radii.gaussian.is_some() {
         rigorous.push(Proved::ExactGaussian);
@@ -291,6 +291,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Opt
                 && (run.spec.rate != Rate::Local || header.rate.global_from.is_some()),
         },
         regions: local.map(|found| found.regions).unwrap_or_default(),
+        also: Vec::new(),
     }
 }
 
@@ -367,11 +368,15 @@ impl Span {
 }
 
 /// Per-set verdicts and the overall verdict from the per-step margins.
-fn verdicts(run: &Run, checks: &[Check], steps: &[Step]) -> (Vec<UnsafeVerdict>, Verdict) {
+pub(super) fn verdicts(
+    info: &ModelInfo,
+    checks: &[Check],
+    steps: &[Step],
+) -> (Vec<UnsafeVerdict>, Verdict) {
     let mut verdicts = Vec::with_capacity(checks.len());
     // (step, set index) of the earliest failure; ties at the same step go to the first set.
     let mut first: Option<(usize, usize)> = None;
-    for (j, (set, check)) in run.info.unsafe_sets.iter().zip(checks).enumerate() {
+    for (j, (set, check)) in info.unsafe_sets.iter().zip(checks).enumerate() {
         let mut min_margin = f64::INFINITY;
         let mut min_t = 0.0;
         let mut first_bad: Option<usize> = None;

@@ -82,10 +82,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     };
     let internal = pieces.len();
     let det = Deterministic {
-        start: DetSet::Ball {
-            center: x0.clone(),
-            radius: r1,
-        },
+        start: initial_set(run, &x0, r1),
         pieces,
         frame: None,
         tube: local.as_ref().map(|found| found.tube.clone()),
@@ -260,4 +257,22 @@ fn noise_scale(run: &Run, x0: &[f64]) -> f64 {
         }
     }
     trace.max(0.0).sqrt()
+}
+
+/// `Rbar_0`: the initial set itself where it is a box (inside the ball `B_P(x0, r1)`, which
+/// is all the contraction method propagates), else that ball. Every over-approximation of the
+/// deterministic set is sound, so the smaller one is reported and checked at `t = 0`.
+fn initial_set(run: &Run, x0: &[f64], r1: f64) -> DetSet {
+    match run.initial.bounding_box() {
+        Ok(b) if run.initial.balls.is_empty() => DetSet::Box {
+            lo: b.iter().map(|x| x.lo).collect(),
+            hi: b.iter().map(|x| x.hi).collect(),
+            center: x0.to_vec(),
+            radius: r1,
+        },
+        _ => DetSet::Ball {
+            center: x0.to_vec(),
+            radius: r1,
+        },
+    }
 }

@@ -23,6 +23,7 @@ mod defect;
 mod embedding;
 mod gaussian;
 mod hermite;
+mod intersect;
 pub(crate) mod interval;
 pub(crate) mod linalg;
 mod local;
@@ -128,6 +129,17 @@ impl<'a> Setup<'a> {
                 used.join(", ")
             ))
         })?;
+        Setup::with(sys, info, spec, consts, needs)
+    }
+
+    /// [`Setup::new`] for constants known to exist (a further metric of the analysis).
+    pub(crate) fn with(
+        sys: &dyn System,
+        info: &ModelInfo,
+        spec: &AnalysisSpec,
+        consts: &'a Constants,
+        needs: Needs,
+    ) -> Result<Setup<'a>, RunError> {
         let (n, p) = (sys.n(), sys.p());
         validate(info, spec, n, p)?;
         covered(info, spec, consts)?;
@@ -221,6 +233,8 @@ impl Run<'_> {
 pub fn run(sys: &dyn System, info: &ModelInfo, analysis: &Analysis) -> Result<Prs, RunError> {
     crate::Reach::for_analysis(sys, info, analysis)?.run()
 }
+
+pub(crate) use intersect::intersect;
 
 /// Runs the engine of the analysis' method.
 pub(crate) fn run_engine(run: &Run) -> Result<Prs, RunError> {

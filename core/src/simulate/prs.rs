@@ -236,8 +236,23 @@ impl Shape {
     /// The shape of every step of `result` (the sets of one result all have one shape).
     fn of(result: &Prs) -> Shape {
         let n = result.states.len();
+        // An intersection of several metrics' sets: no shortcut of one metric's set decides.
+        if !result.also.is_empty() {
+            return Shape::Other;
+        }
         let all = |f: fn(&DetSet) -> bool| result.steps.iter().all(|s| f(&s.det));
-        if all(|d| matches!(d, DetSet::Ball { .. })) {
+        // The contraction method's set at t = 0 may be the initial box inside its P-ball: the
+        // ball's shortcuts then hold for "outside" only (see `Membership::ball`).
+        let ball_after_start = result
+            .steps
+            .iter()
+            .skip(1)
+            .all(|s| matches!(s.det, DetSet::Ball { .. }))
+            && matches!(
+                result.steps.first().map(|s| &s.det),
+                Some(DetSet::Ball { .. } | DetSet::Box { .. })
+            );
+        if ball_after_start {
             return Shape::PBall;
         }
         // Every step's box, flat (`n` per step).
@@ -278,6 +293,9 @@ pub(crate) struct Membership<'a> {
     q_in: Vec<f64>,
     nonneg: bool,
     n: usize,
+    /// Per step, whether the set is the whole P-ball of the PRS radius (for [`Shape::PBall`]:
+    /// else, the initial box at `t = 0`, only "clearly outside" is decided by the ball).
+    ball: Vec<bool>,
 }
 
 impl<'a> Membership<'a> {
@@ -301,6 +319,11 @@ impl<'a> Membership<'a> {
             .iter()
             .map(|r| r * (1.0 - eps16) / (1.0 + metric.gamma))
             .collect();
+        let ball = result
+            .steps
+            .iter()
+            .map(|s| matches!(s.det, DetSet::Ball { .. }))
+            .collect();
         Membership {
             result,
             shape,
@@ -309,6 +332,7 @@ impl<'a> Membership<'a> {
             q_in,
             nonneg: metric.nonneg,
             n,
+            ball,
         }
     }
 
@@ -318,7 +342,8 @@ impl<'a> Membership<'a> {
     /// terms: see [`inside_by_shortcut`](Self::inside_by_shortcut)).
     pub(crate) fn inside_below(&self, k: usize) -> Option<f64> {
         match self.shape {
-            Shape::PBall if self.nonneg => Some(self.q_in[k]),
+            Shape::PBall if self.nonneg && self.ball[k] => Some(self.q_in[k]),
+            Shape::PBall if self.nonneg => Some(f64::NEG_INFINITY),
             _ => None,
         }
     }
@@ -331,7 +356,7 @@ impl<'a> Membership<'a> {
     /// `(clearly outside, clearly inside)` the P-ball of step `k` (see the module's notes).
     #[inline(always)]
     fn clearly(&self, metric: &Metric, k: usize, q: f64, a: f64) -> (bool, bool) {
-        if self.nonneg {
+        let (out, inside) = if self.nonneg {
             (q > self.q_out[k], q < self.q_in[k])
         } else {
             let (r2, err) = (
@@ -339,7 +364,10 @@ impl<'a> Membership<'a> {
                 metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k],
             );
             (q - err > r2, q + err < r2)
-        }
+        };
+        // Inside the P-ball is inside the set only where the set is that ball.
+        let ball = !matches!(self.shape, Shape::PBall) || self.ball[k];
+        (out, inside && ball)
     }
 
     /// Whether `x` is, by one of the shortcuts alone, in the PRS of step `k` (then
@@ -467,6 +495,9 @@ pub(crate) struct Tube<'a> {
     centre: Vec<f64>,
     outer2: Vec<f64>,
     nonneg: bool,
+    /// The result is one metric's set (no intersection with others): a point of its span is
+    /// in the PRS, so the "inside" shortcuts decide.
+    alone: bool,
 }
 
 impl<'a> Tube<'a> {
@@ -486,6 +517,7 @@ impl<'a> Tube<'a> {
             centre: Vec::with_capacity(n * steps),
             outer2: Vec::with_capacity(steps),
             nonneg: metric.nonneg,
+            alone: result.also.is_empty(),
         };
         let eps16 = 16.0 * f64::EPSILON;
         for (k, st) in result.steps.iter().enumerate() {
@@ -509,7 +541,11 @@ impl<'a> Tube<'a> {
             // As in `Membership::new`: the error bound solved for q once per step.
             let r2 = s.radius * s.radius;
             tube.r2.push(r2);
-            tube.q_in.push(r2 * (1.0 - eps16) / (1.0 + metric.gamma));
+            tube.q_in.push(if tube.alone {
+                r2 * (1.0 - eps16) / (1.0 + metric.gamma)
+            } else {
+                f64::NEG_INFINITY
+            });
             tube.q_out.push(r2 * (1.0 + eps16) / (1.0 - metric.gamma));
             // A ball around the box's centre holding the span: radius + b, with
             // b^2 <= sum_ij |P_ij| h_i h_j and h_i >= |y_i - c_i| over the box, all rounded up.
@@ -568,7 +604,7 @@ impl<'a> Tube<'a> {
         if self.nonneg {
             q < self.q_in[k]
         } else {
-            q + (metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k]) < self.r2[k]
+            self.alone && q + (metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k]) < self.r2[k]
         }
     }
 
@@ -589,7 +625,7 @@ impl<'a> Tube<'a> {
         // In the box (which the span holds): the states at t = 0 of an interval analysis,
         // whose span there is the initial box with radius 0.
         let (lo, hi, _) = self.diag_bounds(k);
-        if (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
+        if self.alone && (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
             return true;
         }
         let clearly_out = if self.nonneg {

@@ -46,6 +46,10 @@ struct Json<'a> {
     unsafe_sets: Vec<UnsafeJson<'a>>,
     verdict: VerdictJson<'a>,
     validated: ValidationJson,
+    /// The analysis' further metrics' results, each at `delta / K` (the PRS is the
+    /// intersection: `steps[..].prs_hull_lo/hi` and the verdicts are the intersection's).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    also: Vec<Json<'a>>,
 }
 
 #[derive(Serialize)]
@@ -229,6 +233,7 @@ impl<'a> Json<'a> {
                 not_validated: prs.validation.not_validated.iter().map(unproved).collect(),
                 conditional_on_domain: prs.validation.conditional_on_domain,
             },
+            also: prs.also.iter().map(Json::of).collect(),
         }
     }
 }
@@ -647,13 +652,16 @@ pub fn summary(prs: &Prs) -> String {
         ),
         (None, None) => prs.radius_rule.rule.name().to_string(),
     };
+    // With several metrics each set is at delta / K.
+    let delta_each = prs.delta / (1 + prs.also.len()) as f64;
     let _ = writeln!(
         s,
         "  radius rule: {rule}, kappa(n = {}, delta = {}) = {:.6}",
         prs.states.len(),
-        prs.delta,
+        delta_each,
         prs.kappa
     );
+    summary_metrics(prs, &mut s);
     if prs.method == Method::Interval {
         summary_boxes(prs, &mut s);
     } else {
@@ -763,6 +771,56 @@ fn guarantee_sentence(prs: &Prs) -> String {
 
 /// The table of the summary for box sets: per column of [`box_columns`] the range `[lo, hi]`,
 /// and `r_t`.
+/// The further metrics of an intersection result, and its bounding boxes.
+fn summary_metrics(prs: &Prs, s: &mut String) {
+    if prs.also.is_empty() {
+        return;
+    }
+    let k = 1 + prs.also.len();
+    let _ = writeln!(
+        s,
+        "  several metrics: the PRS is the intersection of the sets of {k} metrics, each at \
+         delta / {k} = {:e} (the tables below the first metric's; the boxes, margins and \
+         verdicts the intersection's)",
+        prs.delta / k as f64
+    );
+    for (j, m) in prs.also.iter().enumerate() {
+        let n = m.n().max(1);
+        let rows: Vec<String> = m
+            .constants
+            .metric
+            .chunks(n)
+            .map(|r| {
+                let cells: Vec<String> = r.iter().map(|v| format!("{v:.6}")).collect();
+                format!("[{}]", cells.join(", "))
+            })
+            .collect();
+        let last = m.steps.last().map_or(f64::NAN, |st| st.prs_radius);
+        let _ = writeln!(
+            s,
+            "  metric {}: P = [{}], c = {:.6}, sigma = {:.6}; PRS radius at the horizon {}",
+            j + 2,
+            rows.join(", "),
+            m.constants.c,
+            m.constants.sigma,
+            num(last)
+        );
+    }
+    let names: Vec<String> = prs.states.iter().map(|x| format!("{x} [lo, hi]")).collect();
+    let header: Vec<String> = names.iter().map(|x| format!("{x:>28}")).collect();
+    let _ = writeln!(s, "  {:>10}  {}", "t", header.join("  "));
+    for i in summary_indices(prs.steps.len()) {
+        let Some(hull) = prs.hull_at(i) else {
+            continue;
+        };
+        let cells: Vec<String> = hull
+            .iter()
+            .map(|b| format!("[{:>12}, {:>12}]", num(b.lo), num(b.hi)))
+            .collect();
+        let _ = writeln!(s, "  {:>10.4}  {}", prs.steps[i].t, cells.join("  "));
+    }
+}
+
 fn summary_boxes(prs: &Prs, s: &mut String) {
     let inclusion = prs.inclusion.map_or("?", |i| i.name());
     match &prs.transform {

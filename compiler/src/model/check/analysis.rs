@@ -9,10 +9,13 @@ use crate::model::{
     Analysis, AnalysisSpec, Guarantee, Inclusion, Integrator, Method, MetricChoice as Metric,
     RadiusRule, Rate, Transform,
 };
-use crate::syntax::ast::{Block, Expr, ExprKind, Ident};
+use crate::syntax::ast::{Arg, Block, Expr, ExprKind, Ident};
 
 /// Most sample paths of an empirical rate estimate (they are all kept in memory).
 const MAX_EMPIRICAL_PATHS: f64 = 20_000.0;
+
+/// Most metrics of `metric = auto(states = [..])` (each costs a run; delta is shared).
+const MAX_METRICS: usize = 8;
 
 const KEYS: &[&str] = &[
     "method",
@@ -111,13 +114,14 @@ impl Checker<'_> {
             Some((e, _)) => match &e.kind {
                 ExprKind::Name(id) if id.name == "identity" => Some(Metric::Identity),
                 ExprKind::Name(id) if id.name == "auto" => Some(Metric::Auto),
+                ExprKind::Call { func, args } if func.name == "auto" => self.per_state(e, args),
                 ExprKind::List(_) => self
                     .square(e, n, "metric", true)
                     .map(|m| Metric::Matrix(m.concat())),
                 _ => self.fail(Diagnostic::error(
                     "unknown metric",
                     e.span.clone(),
-                    "expected `identity`, `auto` or a matrix",
+                    "expected `identity`, `auto`, `auto(states = [..])` or a matrix",
                 )),
             },
         };
@@ -181,7 +185,7 @@ impl Checker<'_> {
                     "needs `method = contraction`",
                     "the interval method uses a certified rate (`local` or `global`)",
                 ))
-            } else if metric == Metric::Auto {
+            } else if matches!(metric, Metric::Auto | Metric::PerState(_)) {
                 Some((
                     "cannot be combined with `metric = auto`",
                     "the metric is synthesised from the certified (global) rate; give \
@@ -358,6 +362,44 @@ impl Checker<'_> {
                 )
             }
         }
+    }
+
+    /// `auto(states = [a, b, ..])`: one metric per named state (at most
+    /// [`MAX_METRICS`]).
+    fn per_state(&mut self, e: &Expr, args: &[Arg]) -> Option<Metric> {
+        let help = "write e.g. `auto(states = [theta, omega])`: one metric per named state";
+        let [a] = args else {
+            return self.fail(
+                Diagnostic::error(
+                    "`auto` takes one argument, `states = [..]`",
+                    e.span.clone(),
+                    "here",
+                )
+                .with_help(help),
+            );
+        };
+        if a.name.as_ref().is_none_or(|n| n.name != "states") {
+            let span = a
+                .name
+                .as_ref()
+                .map_or(a.value.span.clone(), |n| n.span.clone());
+            return self.fail(
+                Diagnostic::error("`auto` takes `states = [..]`", span, "expected `states`")
+                    .with_help(help),
+            );
+        }
+        let states = self.state_list(&a.value)?;
+        if states.is_empty() || states.len() > MAX_METRICS {
+            return self.fail(
+                Diagnostic::error(
+                    format!("`auto(states = ..)` names 1 to {MAX_METRICS} states"),
+                    a.value.span.clone(),
+                    format!("{} states", states.len()),
+                )
+                .with_help(help),
+            );
+        }
+        Some(Metric::PerState(states))
     }
 
     /// `local`, `global` or `empirical(paths = N)`.

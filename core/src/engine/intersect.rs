@@ -1,0 +1,48 @@
+//! Several metrics at once (method.md section 8.6): the results of one analysis under `K`
+//! metrics, each at `delta / K`, hold at once with probability `1 - delta` (union bound), so
+//! the PRS is the intersection of their sets.
+
+use super::assemble::verdicts;
+use super::safety::Check;
+use crate::model::ModelInfo;
+use crate::prs::Prs;
+
+/// The intersection of `first` and `others` (results of the same analysis and run, on the same
+/// report times, each at `delta / K`) as one result at `delta`: a margin of the intersection is
+/// at least the largest of the members' (the intersection lies in each), and the verdicts
+/// follow from those margins. `checks` are `first`'s.
+pub(crate) fn intersect(
+    info: &ModelInfo,
+    checks: &[Check],
+    delta: f64,
+    mut first: Prs,
+    others: Vec<Prs>,
+) -> Prs {
+    for (k, step) in first.steps.iter_mut().enumerate() {
+        for other in &others {
+            let theirs = &other.steps[k];
+            debug_assert_eq!(theirs.t, step.t, "members share the report times");
+            for (m, &o) in step.margins.iter_mut().zip(&theirs.margins) {
+                // NaN never counts as safe: keep it only if no member shows more.
+                if o > *m || m.is_nan() {
+                    *m = o;
+                }
+            }
+        }
+    }
+    for other in &others {
+        let v = &other.validation;
+        first.validation.conditional_on_domain |= v.conditional_on_domain;
+        for item in &v.not_validated {
+            if !first.validation.not_validated.contains(item) {
+                first.validation.not_validated.push(item.clone());
+            }
+        }
+    }
+    let (unsafe_sets, verdict) = verdicts(info, checks, &first.steps);
+    first.unsafe_sets = unsafe_sets;
+    first.verdict = verdict;
+    first.delta = delta;
+    first.also = others;
+    first
+}
