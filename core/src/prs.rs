@@ -8,7 +8,7 @@ use crate::engine::interval;
 use crate::interval::Interval;
 use crate::model::{
     Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricRegion, Provenance,
-    RadiusRule, Rate, UnsafeShape,
+    RadiusRule, Rate, TransformSource, UnsafeShape,
 };
 use crate::reach::InputPlan;
 
@@ -178,6 +178,8 @@ pub struct TransformUsed {
     pub inverse: Vec<f64>,
     /// A rigorous bound of `|(T^-1)_ij - inverse_ij|` over all entries (0 when exact).
     pub inverse_error: f64,
+    /// Written in the spec or chosen by the compiler.
+    pub source: TransformSource,
 }
 
 /// The sets at one report time.

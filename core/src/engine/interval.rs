@@ -383,6 +383,7 @@ pub(crate) fn parallelotope_contains(
         matrix: tr.matrix.clone(),
         inverse: tr.inverse.clone(),
         frame: 0,
+        source: tr.source,
     };
     let Ok(f) = Frame::new(&transform, n) else {
         return false;

@@ -1,9 +1,10 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
 use super::{csv_field, num, summary_indices};
-use reachc_core::model::{Guarantee, Method, Rate};
+use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
 use reachc_core::prs::{
-    DetSet, Proved, Prs, R1Method, Step, Unproved, UnsafeKind, UnsafeVerdict, Verdict,
+    DetSet, Proved, Prs, R1Method, Step, TransformUsed, Unproved, UnsafeKind, UnsafeVerdict,
+    Verdict,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -81,6 +82,15 @@ struct TransformJson<'a> {
     matrix: Vec<&'a [f64]>,
     inverse: Vec<&'a [f64]>,
     inverse_error: f64,
+    source: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    log_norm_inf: Option<LogNormJson>,
+}
+
+#[derive(Serialize)]
+struct LogNormJson {
+    chosen: f64,
+    identity: f64,
 }
 
 #[derive(Serialize)]
@@ -197,6 +207,18 @@ impl<'a> Json<'a> {
                 matrix: rows(&tr.matrix),
                 inverse: rows(&tr.inverse),
                 inverse_error: tr.inverse_error,
+                source: match tr.source {
+                    TransformSource::Given => "given",
+                    TransformSource::Auto(_) => "auto",
+                },
+                log_norm_inf: match tr.source {
+                    TransformSource::Auto(AutoFit::LogNorm { chosen, identity }) => {
+                        Some(LogNormJson { chosen, identity })
+                    }
+                    TransformSource::Given | TransformSource::Auto(AutoFit::NonFiniteJacobian) => {
+                        None
+                    }
+                },
             }),
             initial_center: &prs.initial_center,
             input_center: &prs.input_center,
@@ -704,6 +726,28 @@ pub fn summary(prs: &Prs) -> String {
     s
 }
 
+/// Where a transform comes from, as a parenthesis after it (nothing for a given one).
+fn transform_source(tr: &TransformUsed) -> String {
+    let fit = match tr.source {
+        TransformSource::Given => return String::new(),
+        TransformSource::Auto(fit) => fit,
+    };
+    let how = match fit {
+        AutoFit::LogNorm { chosen, identity } if chosen < identity => format!(
+            "mu_inf(T A T^-1) = {} against mu_inf(A) = {} for the identity",
+            num(chosen),
+            num(identity)
+        ),
+        AutoFit::LogNorm { identity, .. } => {
+            format!("nothing beats the identity: mu_inf(A) = {}", num(identity))
+        }
+        AutoFit::NonFiniteJacobian => "A is not finite: the identity".to_string(),
+    };
+    format!(
+        " (chosen automatically from A, the drift's Jacobian at the initial set's centre: {how})"
+    )
+}
+
 /// What the probability level is about, in words.
 fn guarantee_sentence(prs: &Prs) -> String {
     match prs.guarantee {
@@ -738,10 +782,11 @@ fn summary_boxes(prs: &Prs, s: &mut String) {
             let rows: Vec<String> = tr.matrix.chunks(n).map(|r| format!("{r:?}")).collect();
             let _ = writeln!(
                 s,
-                "  deterministic sets: parallelotopes {{x : T x in box}}, T = [{}], box of the \
+                "  deterministic sets: parallelotopes {{x : T x in box}}, T = [{}]{}, box of the \
                  embedding system in y = T x ({inclusion} inclusion); PRS = parallelotope (+) \
                  B_P(r_t); columns: the box in y, then the parallelotope's hull in x",
-                rows.join(", ")
+                rows.join(", "),
+                transform_source(tr)
             );
         }
     }

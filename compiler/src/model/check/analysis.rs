@@ -10,6 +10,7 @@ use crate::model::{
     RadiusRule, Rate, Transform,
 };
 use crate::syntax::ast::{Block, Expr, ExprKind, Ident};
+use reachc_core::model::TransformSource;
 
 /// Most sample paths of an empirical rate estimate (they are all kept in memory).
 const MAX_EMPIRICAL_PATHS: f64 = 20_000.0;
@@ -329,6 +330,7 @@ impl Checker<'_> {
             matrix,
             inverse,
             frame,
+            source: TransformSource::Given,
         })
     }
 
