@@ -80,6 +80,8 @@ pub struct Prs {
     /// With local rates, the region of each internal step and the rates certified on it (empty
     /// otherwise).
     pub regions: Vec<RateRegion>,
+    /// Advice on the result (interval method: a wrapping box, a box leaving the domain).
+    pub hints: Vec<Hint>,
 }
 
 /// Where the contraction rate `c_t` came from.
@@ -180,6 +182,40 @@ pub struct TransformUsed {
     pub inverse_error: f64,
     /// Written in the spec or chosen by the compiler.
     pub source: TransformSource,
+}
+
+/// Advice on an interval result, read off its own numbers (advisory: plain floating point, no
+/// guarantee rests on it).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Hint {
+    /// The box wraps: at time `t` the PRS's bounding box in `state` is more than
+    /// [`WRAPPING_FACTOR`](crate::engine::WRAPPING_FACTOR) times wider than that of the P-ball
+    /// the result's own constants give from the initial set (`R_t = e^(ct) r1 + rho r2
+    /// (e^(ct) - 1) / c` plus the same `r_t`, the contraction method's set), the largest such
+    /// ratio over the report times and states.
+    Wrapping {
+        /// The report time.
+        t: f64,
+        /// The state (index into [`Prs::states`]).
+        state: usize,
+        /// Half-width of the PRS's bounding box in `state` (the box's hull plus `r_t`).
+        half_width: f64,
+        /// Half-width of the P-ball's bounding box in `state`.
+        ball_half_width: f64,
+        /// The contraction rate `c` of the result's constants.
+        c: f64,
+    },
+    /// The deterministic box leaves the spec's domain (first report time and state).
+    LeavesDomain {
+        /// The report time.
+        t: f64,
+        /// The state (index into [`Prs::states`]).
+        state: usize,
+        /// The box's hull in `state`.
+        range: Bounds,
+        /// The domain in `state`.
+        domain: Bounds,
+    },
 }
 
 /// The sets at one report time.

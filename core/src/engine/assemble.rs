@@ -240,6 +240,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Opt
                 && (run.spec.rate != Rate::Local || header.rate.global_from.is_some()),
         },
         regions: local.map(|found| found.regions).unwrap_or_default(),
+        hints: Vec::new(),
     }
 }
 

@@ -3,7 +3,7 @@
 use super::{csv_field, num, summary_indices};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
 use reachc_core::prs::{
-    DetSet, Proved, Prs, R1Method, Step, TransformUsed, Unproved, UnsafeKind, UnsafeVerdict,
+    DetSet, Hint, Proved, Prs, R1Method, Step, TransformUsed, Unproved, UnsafeKind, UnsafeVerdict,
     Verdict,
 };
 use serde::Serialize;
@@ -47,6 +47,7 @@ struct Json<'a> {
     unsafe_sets: Vec<UnsafeJson<'a>>,
     verdict: VerdictJson<'a>,
     validated: ValidationJson,
+    hints: Vec<HintJson<'a>>,
 }
 
 #[derive(Serialize)]
@@ -91,6 +92,24 @@ struct TransformJson<'a> {
 struct LogNormJson {
     chosen: f64,
     identity: f64,
+}
+
+#[derive(Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+enum HintJson<'a> {
+    Wrapping {
+        t: f64,
+        state: &'a str,
+        half_width: f64,
+        ball_half_width: f64,
+        c: f64,
+    },
+    LeavesDomain {
+        t: f64,
+        state: &'a str,
+        range: [f64; 2],
+        domain: [f64; 2],
+    },
 }
 
 #[derive(Serialize)]
@@ -237,6 +256,38 @@ impl<'a> Json<'a> {
                 rigorous: prs.validation.rigorous.iter().map(proved).collect(),
                 not_validated: prs.validation.not_validated.iter().map(unproved).collect(),
                 conditional_on_domain: prs.validation.conditional_on_domain,
+            },
+            hints: prs.hints.iter().map(|h| HintJson::of(prs, h)).collect(),
+        }
+    }
+}
+
+impl<'a> HintJson<'a> {
+    fn of(prs: &'a Prs, hint: &Hint) -> HintJson<'a> {
+        match *hint {
+            Hint::Wrapping {
+                t,
+                state,
+                half_width,
+                ball_half_width,
+                c,
+            } => HintJson::Wrapping {
+                t,
+                state: &prs.states[state],
+                half_width,
+                ball_half_width,
+                c,
+            },
+            Hint::LeavesDomain {
+                t,
+                state,
+                range,
+                domain,
+            } => HintJson::LeavesDomain {
+                t,
+                state: &prs.states[state],
+                range: [range.lo, range.hi],
+                domain: [domain.lo, domain.hi],
             },
         }
     }
@@ -723,6 +774,9 @@ pub fn summary(prs: &Prs) -> String {
         not_validated.join("; ")
     };
     let _ = writeln!(s, "  not validated: {not_validated}");
+    for hint in &prs.hints {
+        let _ = writeln!(s, "  hint: {}", hint_sentence(prs, hint));
+    }
     s
 }
 
@@ -746,6 +800,53 @@ fn transform_source(tr: &TransformUsed) -> String {
     format!(
         " (chosen automatically from A, the drift's Jacobian at the initial set's centre: {how})"
     )
+}
+
+/// A hint, in words, with what to try.
+fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
+    let already_auto = prs
+        .transform
+        .as_ref()
+        .is_some_and(|tr| matches!(tr.source, TransformSource::Auto(_)));
+    let try_this = if already_auto {
+        "try `method = contraction`"
+    } else {
+        "try `transform = auto` (or `method = contraction`)"
+    };
+    match *hint {
+        Hint::Wrapping {
+            t,
+            state,
+            half_width,
+            ball_half_width,
+            c,
+        } => {
+            let ball = if c < 0.0 { "shrinks" } else { "bounds" };
+            format!(
+                "the box grows (wrapping): the PRS's half-width in `{}` is {} by t = {t:.4} while \
+                 the contraction rate c = {} {ball} P-balls (half-width {} from the same initial \
+                 set and r_t): {try_this}",
+                prs.states[state],
+                num(half_width),
+                num(c),
+                num(ball_half_width)
+            )
+        }
+        Hint::LeavesDomain {
+            t,
+            state,
+            range,
+            domain,
+        } => format!(
+            "the box leaves the domain in `{}` at t = {t:.4} ([{}, {}] is not in [{}, {}]; the \
+             constants hold only in the domain): {try_this}",
+            prs.states[state],
+            num(range.lo),
+            num(range.hi),
+            num(domain.lo),
+            num(domain.hi)
+        ),
+    }
 }
 
 /// What the probability level is about, in words.
