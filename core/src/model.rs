@@ -326,6 +326,34 @@ pub struct Transform {
     /// Which [`System::frame`](crate::System::frame) holds the transformed system (analyses
     /// with the same `T` share one).
     pub frame: usize,
+    /// Written in the spec or chosen by the compiler.
+    pub source: TransformSource,
+}
+
+/// Where a coordinate transform comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TransformSource {
+    /// Written in the spec (`transform = [[...]]`).
+    Given,
+    /// Chosen by the compiler (`transform = auto`) from the Jacobian `A` of the drift at the
+    /// centre of the initial set (inputs at the input box's centre, `t = 0`).
+    Auto(AutoFit),
+}
+
+/// How the compiler chose an automatic transform.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AutoFit {
+    /// `T` (locally) minimises the logarithmic infinity norm
+    /// `mu_inf(B) = max_i (B_ii + sum_(j != i) |B_ij|)` of `B = T A T^-1`, which bounds how fast
+    /// the embedding's box grows; the identity when nothing beats it.
+    LogNorm {
+        /// `mu_inf(T A T^-1)`.
+        chosen: f64,
+        /// `mu_inf(A)`, the identity's.
+        identity: f64,
+    },
+    /// The Jacobian at the centre is not finite: `T` is the identity.
+    NonFiniteJacobian,
 }
 
 /// An `analysis NAME { ... }` block as written, with the defaults filled in.

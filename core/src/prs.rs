@@ -8,7 +8,7 @@ use crate::engine::interval;
 use crate::interval::Interval;
 use crate::model::{
     Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricRegion, Provenance,
-    RadiusRule, Rate, UnsafeShape,
+    RadiusRule, Rate, TransformSource, UnsafeShape,
 };
 use crate::reach::InputPlan;
 
@@ -86,6 +86,8 @@ pub struct Prs {
     /// [`Prs::contains`], [`Prs::span_contains`], [`Prs::hull`], the margins and the verdicts
     /// answer for the intersection ([`Prs::delta`] is the analysis' `delta`).
     pub also: Vec<Prs>,
+    /// Advice on the result (interval method: a wrapping box, a box leaving the domain).
+    pub hints: Vec<Hint>,
 }
 
 /// Where the contraction rate `c_t` came from.
@@ -207,6 +209,42 @@ pub struct TransformUsed {
     pub inverse: Vec<f64>,
     /// A rigorous bound of `|(T^-1)_ij - inverse_ij|` over all entries (0 when exact).
     pub inverse_error: f64,
+    /// Written in the spec or chosen by the compiler.
+    pub source: TransformSource,
+}
+
+/// Advice on an interval result, read off its own numbers (advisory: plain floating point, no
+/// guarantee rests on it).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Hint {
+    /// The box wraps: at time `t` the PRS's bounding box in `state` is more than
+    /// [`WRAPPING_FACTOR`](crate::engine::WRAPPING_FACTOR) times wider than that of the P-ball
+    /// the result's own constants give from the initial set (`R_t = e^(ct) r1 + rho r2
+    /// (e^(ct) - 1) / c` plus the same `r_t`, the contraction method's set), the largest such
+    /// ratio over the report times and states.
+    Wrapping {
+        /// The report time.
+        t: f64,
+        /// The state (index into [`Prs::states`]).
+        state: usize,
+        /// Half-width of the PRS's bounding box in `state` (the box's hull plus `r_t`).
+        half_width: f64,
+        /// Half-width of the P-ball's bounding box in `state`.
+        ball_half_width: f64,
+        /// The contraction rate `c` of the result's constants.
+        c: f64,
+    },
+    /// The deterministic box leaves the spec's domain (first report time and state).
+    LeavesDomain {
+        /// The report time.
+        t: f64,
+        /// The state (index into [`Prs::states`]).
+        state: usize,
+        /// The box's hull in `state`.
+        range: Bounds,
+        /// The domain in `state`.
+        domain: Bounds,
+    },
 }
 
 /// The sets at one report time.

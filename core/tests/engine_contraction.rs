@@ -6,7 +6,7 @@ use reachc_core::interval::Interval;
 use reachc_core::kappa::kappa;
 use reachc_core::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
-    ModelInfo, RadiusRule, Rate, Transform, UnsafeSet, UnsafeShape,
+    ModelInfo, RadiusRule, Rate, Transform, TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_core::prs::{Prs, Unproved, UnsafeKind, Verdict};
 use reachc_core::{InputPlan, Reach, System};
@@ -692,6 +692,7 @@ fn errors() {
         matrix: identity(sys.n),
         inverse: identity(sys.n),
         frame: 0,
+        source: TransformSource::Given,
     });
     assert!(matches!(
         engine::run(&sys, &inf, &an),

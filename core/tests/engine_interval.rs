@@ -6,7 +6,7 @@ use reachc_core::engine::{self, RunError};
 use reachc_core::interval::Interval;
 use reachc_core::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Inclusion, InitialSet, Integrator, Method,
-    ModelInfo, Transform, UnsafeSet, UnsafeShape,
+    ModelInfo, Transform, TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_core::prs::{DetSet, Prs, Unproved, Verdict};
 use reachc_core::{Reach, System};
@@ -306,6 +306,7 @@ fn refuses_transform_and_missing_constants() {
         matrix: vec![1.0],
         inverse: vec![1.0],
         frame: 0,
+        source: TransformSource::Given,
     });
     assert!(matches!(
         engine::run(&Lin, &lin_info(vec![]), &a),

@@ -4,6 +4,7 @@ use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::model::{
     Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, Transform,
+    TransformSource,
 };
 use reachc_runtime::{report, Reach, System};
 
@@ -114,6 +115,7 @@ fn runs_writes_and_skips_interval() {
                 matrix: vec![1.0],
                 inverse: vec![1.0],
                 frame: 0,
+                source: TransformSource::Given,
             });
             a
         },

@@ -693,6 +693,7 @@ fn generated_code_agrees_with_the_interpreter() {
         "linear",
         "linear_n",
         "lorenz",
+        "msd",
         "pendulum",
         "unicycle",
         "unicycle_lookahead",

@@ -1,15 +1,20 @@
 //! Interval-based delta-PRS end to end through the interpreter backend: the boxes of every
 //! shipped spec (each inclusion function, with and without the spec's transforms) against
-//! sampled deterministic trajectories, and the paper's pendulum in `y = T x`.
+//! sampled deterministic trajectories, the paper's pendulum in `y = T x`, and `transform = auto`
+//! with the wrapping hint on the mass-spring-damper.
 
+use nalgebra::DMatrix;
+use reachc_compiler::analysis::{choose_transform, jacobian_at};
 use reachc_compiler::backend::{interp::Interpreter, prepare};
 use reachc_compiler::driver::load;
+use reachc_compiler::model::Model;
 use reachc_e2e::{euler_maruyama, shipped_specs, workspace, Rng};
-use reachc_runtime::engine::{self, RunError};
+use reachc_runtime::engine::{self, RunError, WRAPPING_FACTOR};
 use reachc_runtime::model::{
-    Analysis, Bounds, Constants, Inclusion, Integrator, Method, ModelInfo, Rate,
+    Analysis, AutoFit, Bounds, Constants, Inclusion, Integrator, Method, ModelInfo, Rate,
+    TransformSource,
 };
-use reachc_runtime::prs::DetSet;
+use reachc_runtime::prs::{DetSet, Hint};
 use reachc_runtime::{Prs, Reach, System};
 
 /// The shipped spec's model with the interpreter and its info.
@@ -325,4 +330,157 @@ fn transformed_pendulum_prs_covers_monte_carlo_paths() {
     let far = [st.det.box_hull().unwrap().1[0] + 2.0 * st.r_t, 0.0];
     assert!(!r.contains_at(k, &far));
     assert!(r.contains_at(k, &[0.0, 0.0]));
+}
+
+/// The PRS's bounding-box half-widths at the final report time.
+fn final_half_widths(r: &Prs) -> Vec<f64> {
+    let hull = r.hull_at(r.steps.len() - 1).unwrap();
+    hull.iter().map(|b| (b.hi - b.lo) / 2.0).collect()
+}
+
+/// The mass-spring-damper (specs/msd.sde): in x and v the box wraps, grows far beyond the
+/// contraction PRS and says so; with `transform = auto` its PRS stays within 2x of the
+/// contraction PRS at the horizon, and no hint.
+#[test]
+fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
+    let (sys, info) = interpreter(&workspace().join("specs/msd.sde"));
+    let run = |name: &str| Reach::new(&sys, &info, name).unwrap().run().unwrap();
+    let (contraction, plain, auto) = (run("contraction"), run("interval"), run("interval_auto"));
+    let (hc, hp, ha) = (
+        final_half_widths(&contraction),
+        final_half_widths(&plain),
+        final_half_widths(&auto),
+    );
+    eprintln!("half-widths at t = 5: contraction {hc:?}, interval {hp:?}, interval_auto {ha:?}");
+    assert!(
+        contraction.constants.c < -0.98,
+        "c = {}",
+        contraction.constants.c
+    );
+    for i in 0..2 {
+        assert!(
+            ha[i] <= 2.0 * hc[i],
+            "state {i}: auto {ha:?} vs contraction {hc:?}"
+        );
+        assert!(
+            hp[i] >= 5.0 * hc[i],
+            "state {i}: plain {hp:?} vs contraction {hc:?}"
+        );
+    }
+    // The hint names the horizon, x and both widths (the wrapping box against a P-ball of the
+    // same constants).
+    match plain.hints.as_slice() {
+        [Hint::Wrapping {
+            t,
+            state,
+            half_width,
+            ball_half_width,
+            c,
+        }] => {
+            assert_eq!((*t, *state), (5.0, 0));
+            // The hint's float sum against the PRS hull's outward-rounded one.
+            assert!((half_width - hp[0]).abs() <= 1e-12 * hp[0], "{half_width}");
+            assert!(*half_width > WRAPPING_FACTOR * ball_half_width);
+            assert!(
+                (ball_half_width - hc[0]).abs() <= 0.01 * hc[0],
+                "{ball_half_width}"
+            );
+            assert_eq!(*c, plain.constants.c);
+        }
+        other => panic!("expected one wrapping hint, got {other:?}"),
+    }
+    assert!(auto.hints.is_empty(), "{:?}", auto.hints);
+    assert!(contraction.hints.is_empty());
+    let summary = reachc_runtime::report::summary(&plain);
+    assert!(
+        summary.contains("hint: the box grows") && summary.contains("try `transform = auto`"),
+        "{summary}"
+    );
+    // Every output says the transform was chosen automatically.
+    let tr = auto.transform.as_ref().unwrap();
+    assert!(matches!(
+        tr.source,
+        TransformSource::Auto(AutoFit::LogNorm { chosen, identity }) if chosen < -0.98 && identity == 1.0
+    ));
+    assert!(reachc_runtime::report::summary(&auto).contains("chosen automatically"));
+    let json: serde_json::Value =
+        serde_json::from_str(&reachc_runtime::report::to_json(&auto)).unwrap();
+    assert_eq!(json["transform"]["source"], "auto");
+    assert_eq!(json["transform"]["log_norm_inf"]["identity"], 1.0);
+    let json: serde_json::Value =
+        serde_json::from_str(&reachc_runtime::report::to_json(&plain)).unwrap();
+    assert_eq!(json["hints"][0]["kind"], "wrapping");
+    assert_eq!(json["hints"][0]["state"], "x");
+}
+
+/// `mu_inf(B) = max_i (B_ii + sum_(j != i) |B_ij|)` of `B = T A T^-1`, all `n x n` row-major.
+fn log_norm_of_similar(t: &[f64], t_inv: &[f64], a: &[f64], n: usize) -> f64 {
+    let mul = |x: &[f64], y: &[f64]| -> Vec<f64> {
+        (0..n * n)
+            .map(|k| (0..n).map(|l| x[k / n * n + l] * y[l * n + k % n]).sum())
+            .collect()
+    };
+    let b = mul(&mul(t, a), t_inv);
+    (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|j| {
+                    if i == j {
+                        b[i * n + i]
+                    } else {
+                        b[i * n + j].abs()
+                    }
+                })
+                .sum::<f64>()
+        })
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// The drift's Jacobian of a shipped spec at `x` (no inputs, `t = 0`).
+fn jacobian(spec: &str, x: &[f64]) -> (Model, DMatrix<f64>) {
+    let mut model = load(&workspace().join("specs").join(spec)).unwrap().model;
+    let a = jacobian_at(&mut model.pool, &model.drift, &model.tables, (x, &[], 0.0));
+    (model, a)
+}
+
+/// A matrix by rows.
+fn row_major(m: &DMatrix<f64>) -> Vec<f64> {
+    m.transpose().iter().copied().collect()
+}
+
+/// The chosen `T` beats the identity by `mu_inf`, recomputed here from the matrices: on the
+/// mass-spring-damper (the `T` the engine runs, with its inverse) and on the pendulum at 0.
+#[test]
+fn automatic_transform_lowers_the_log_norm() {
+    let (model, a) = jacobian("msd.sde", &[1.0, 0.0]);
+    let a = row_major(&a);
+    assert_eq!(a, [0.0, 1.0, -4.0, -5.0]);
+    let tr = model
+        .analyses
+        .iter()
+        .find(|x| x.spec.name == "interval_auto")
+        .and_then(|x| x.spec.transform.clone())
+        .unwrap();
+    let identity = log_norm_of_similar(&[1.0, 0.0, 0.0, 1.0], &[1.0, 0.0, 0.0, 1.0], &a, 2);
+    let mu = log_norm_of_similar(&tr.matrix, &tr.inverse, &a, 2);
+    eprintln!(
+        "msd: T = {:?}, mu_inf = {mu} (identity {identity})",
+        tr.matrix
+    );
+    assert_eq!(identity, 1.0);
+    // The eigenvalues are -1 and -4: -1 is the best any T does; 1% of it buys conditioning.
+    assert!((-1.0..=-0.985).contains(&mu), "mu_inf = {mu}");
+
+    // The pendulum at 0: A = [[0, 1], [-10, -20]], eigenvalues -10 +- sqrt(90).
+    let (_, jac) = jacobian("pendulum.sde", &[0.0, 0.0]);
+    let a = row_major(&jac);
+    assert_eq!(a, [0.0, 1.0, -10.0, -20.0]);
+    let chosen = choose_transform(&jac);
+    let t = row_major(&chosen.matrix);
+    let t_inv = row_major(&chosen.matrix.clone().try_inverse().unwrap());
+    let mu = log_norm_of_similar(&t, &t_inv, &a, 2);
+    let lambda = -10.0 + 90f64.sqrt();
+    eprintln!("pendulum: T = {t:?}, mu_inf = {mu} (identity 1, lambda_max {lambda})");
+    assert!((mu - chosen.log_norm).abs() <= 1e-12);
+    assert!(mu < 0.99 * lambda, "mu_inf = {mu}");
 }

@@ -40,9 +40,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
 use reachc_core::model::{
-    Analysis, Ball, Bounds, Constants, Guarantee, Inclusion, InitialSet, InputGain, Integrator,
-    MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Provenance, RadiusRule, Rate,
-    UnsafeSet, UnsafeShape,
+    Analysis, AutoFit, Ball, Bounds, Constants, Guarantee, Inclusion, InitialSet, InputGain,
+    Integrator, MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Provenance, RadiusRule,
+    Rate, TransformSource, UnsafeSet, UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -1579,7 +1579,25 @@ impl InfoWriter {
                 self.floats(&t.inverse),
                 int(t.frame),
             );
-            quote!(Transform { matrix: #matrix, inverse: #inverse, frame: #frame })
+            let source = match t.source {
+                TransformSource::Given => quote!(TransformSource::Given),
+                TransformSource::Auto(AutoFit::LogNorm { chosen, identity }) => {
+                    let (chosen, identity) = (float(chosen), float(identity));
+                    quote!(TransformSource::Auto(AutoFit::LogNorm {
+                        chosen: #chosen,
+                        identity: #identity,
+                    }))
+                }
+                TransformSource::Auto(AutoFit::NonFiniteJacobian) => {
+                    quote!(TransformSource::Auto(AutoFit::NonFiniteJacobian))
+                }
+            };
+            quote!(Transform {
+                matrix: #matrix,
+                inverse: #inverse,
+                frame: #frame,
+                source: #source,
+            })
         });
         let constants = match &a.constants {
             Ok(c) => {

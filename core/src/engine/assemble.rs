@@ -292,6 +292,7 @@ pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Opt
         },
         regions: local.map(|found| found.regions).unwrap_or_default(),
         also: Vec::new(),
+        hints: Vec::new(),
     }
 }
 

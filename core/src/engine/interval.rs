@@ -29,7 +29,7 @@
 use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::embedding::{BoxStep, Embedding};
 use super::transform::{self, Frame};
-use super::{local, nominal, radius, validate, Run, RunError};
+use super::{hints, local, nominal, radius, validate, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
 use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, Span, TransformUsed, Unproved};
@@ -195,7 +195,9 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         rigorous,
         not_validated,
     };
-    Ok(assemble(run, det, header, local))
+    let mut prs = assemble(run, det, header, local);
+    prs.hints = hints::interval(run, &prs);
+    Ok(prs)
 }
 
 /// The input box of each report step: the model's box, or the plan's point.
@@ -383,6 +385,7 @@ pub(crate) fn parallelotope_contains(
         matrix: tr.matrix.clone(),
         inverse: tr.inverse.clone(),
         frame: 0,
+        source: tr.source,
     };
     let Ok(f) = Frame::new(&transform, n) else {
         return false;

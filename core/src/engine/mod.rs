@@ -23,6 +23,7 @@ mod defect;
 mod embedding;
 mod gaussian;
 mod hermite;
+mod hints;
 mod intersect;
 pub(crate) mod interval;
 pub(crate) mod linalg;
@@ -34,6 +35,7 @@ mod safety;
 pub(crate) mod transform;
 mod uniform;
 
+pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
 pub use radius::MAX_VERTEX_COORDS;
 
@@ -218,11 +220,21 @@ impl Run<'_> {
                     .iter()
                     .map(|b| Interval::new(b.lo, b.hi).mid())
                     .collect();
-                // The input box is the U-ball of radius 1 around its centre (Constants::rho).
-                let r2 = if self.setup.p == 0 { 0.0 } else { 1.0 };
-                (vec![centre; grid.len()], r2)
+                (vec![centre; grid.len()], self.input_radius())
             }
-            Inputs::Plan(plan) => (grid.iter().map(|&t| plan.at(t).to_vec()).collect(), 0.0),
+            Inputs::Plan(plan) => (
+                grid.iter().map(|&t| plan.at(t).to_vec()).collect(),
+                self.input_radius(),
+            ),
+        }
+    }
+
+    /// `r2`, the input uncertainty in the input norm: the input box is the U-ball of radius 1
+    /// around its centre ([`Constants::rho`]); a known plan has none.
+    pub(crate) fn input_radius(&self) -> f64 {
+        match self.inputs {
+            Inputs::Box if self.setup.p > 0 => 1.0,
+            Inputs::Box | Inputs::Plan(_) => 0.0,
         }
     }
 }

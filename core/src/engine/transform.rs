@@ -8,7 +8,7 @@
 
 use super::RunError;
 use crate::interval::Interval;
-use crate::model::Transform;
+use crate::model::{Transform, TransformSource};
 use crate::prs::TransformUsed;
 
 /// A transform ready for the engine: `T` and an enclosure of `T^-1`, both n x n row-major.
@@ -21,6 +21,8 @@ pub(crate) struct Frame {
     t_inv: Vec<Interval>,
     /// The entry bound `e`.
     e: f64,
+    /// Where `T` comes from (carried to the result).
+    source: TransformSource,
 }
 
 /// `sum_j a_j v_j` in interval arithmetic.
@@ -96,6 +98,7 @@ impl Frame {
                 .collect(),
             s: tr.inverse.clone(),
             e,
+            source: tr.source,
         })
     }
 
@@ -182,6 +185,7 @@ impl Frame {
             matrix: self.t.clone(),
             inverse: self.s.clone(),
             inverse_error: self.e,
+            source: self.source,
         }
     }
 }
@@ -219,6 +223,7 @@ mod tests {
                 matrix: vec![1.0, 0.2, 1.0, 0.0],
                 inverse: vec![0.0, 1.0, 5.0, -5.0],
                 frame: 0,
+                source: TransformSource::Given,
             },
             2,
         )
@@ -240,6 +245,7 @@ mod tests {
                 matrix: vec![0.0, 1.0, 1.0, 0.0],
                 inverse: vec![0.0, 1.0, 1.0, 0.0],
                 frame: 0,
+                source: TransformSource::Given,
             },
             2,
         )

@@ -754,6 +754,7 @@ mod tests {
             matrix: t.concat(),
             inverse: vec![0.0, 1.0, 5.0, -5.0],
             inverse_error: 1e-15,
+            source: TransformSource::Given,
         });
         for st in &mut r.steps {
             let DetSet::Box {

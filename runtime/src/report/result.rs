@@ -1,9 +1,10 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
 use super::{csv_field, num, summary_indices};
-use reachc_core::model::{Guarantee, Method, Rate};
+use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
 use reachc_core::prs::{
-    DetSet, Proved, Prs, R1Method, Step, UniformBound, Unproved, UnsafeKind, UnsafeVerdict, Verdict,
+    DetSet, Hint, Proved, Prs, R1Method, Step, TransformUsed, UniformBound, Unproved, UnsafeKind,
+    UnsafeVerdict, Verdict,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -46,6 +47,7 @@ struct Json<'a> {
     unsafe_sets: Vec<UnsafeJson<'a>>,
     verdict: VerdictJson<'a>,
     validated: ValidationJson,
+    hints: Vec<HintJson<'a>>,
     /// The analysis' further metrics' results, each at `delta / K` (the PRS is the
     /// intersection: `steps[..].prs_hull_lo/hi` and the verdicts are the intersection's).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -94,6 +96,33 @@ struct TransformJson<'a> {
     matrix: Vec<&'a [f64]>,
     inverse: Vec<&'a [f64]>,
     inverse_error: f64,
+    source: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    log_norm_inf: Option<LogNormJson>,
+}
+
+#[derive(Serialize)]
+struct LogNormJson {
+    chosen: f64,
+    identity: f64,
+}
+
+#[derive(Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+enum HintJson<'a> {
+    Wrapping {
+        t: f64,
+        state: &'a str,
+        half_width: f64,
+        ball_half_width: f64,
+        c: f64,
+    },
+    LeavesDomain {
+        t: f64,
+        state: &'a str,
+        range: [f64; 2],
+        domain: [f64; 2],
+    },
 }
 
 #[derive(Serialize)]
@@ -214,6 +243,18 @@ impl<'a> Json<'a> {
                 matrix: rows(&tr.matrix),
                 inverse: rows(&tr.inverse),
                 inverse_error: tr.inverse_error,
+                source: match tr.source {
+                    TransformSource::Given => "given",
+                    TransformSource::Auto(_) => "auto",
+                },
+                log_norm_inf: match tr.source {
+                    TransformSource::Auto(AutoFit::LogNorm { chosen, identity }) => {
+                        Some(LogNormJson { chosen, identity })
+                    }
+                    TransformSource::Given | TransformSource::Auto(AutoFit::NonFiniteJacobian) => {
+                        None
+                    }
+                },
             }),
             initial_center: &prs.initial_center,
             input_center: &prs.input_center,
@@ -233,7 +274,39 @@ impl<'a> Json<'a> {
                 not_validated: prs.validation.not_validated.iter().map(unproved).collect(),
                 conditional_on_domain: prs.validation.conditional_on_domain,
             },
+            hints: prs.hints.iter().map(|h| HintJson::of(prs, h)).collect(),
             also: prs.also.iter().map(Json::of).collect(),
+        }
+    }
+}
+
+impl<'a> HintJson<'a> {
+    fn of(prs: &'a Prs, hint: &Hint) -> HintJson<'a> {
+        match *hint {
+            Hint::Wrapping {
+                t,
+                state,
+                half_width,
+                ball_half_width,
+                c,
+            } => HintJson::Wrapping {
+                t,
+                state: &prs.states[state],
+                half_width,
+                ball_half_width,
+                c,
+            },
+            Hint::LeavesDomain {
+                t,
+                state,
+                range,
+                domain,
+            } => HintJson::LeavesDomain {
+                t,
+                state: &prs.states[state],
+                range: [range.lo, range.hi],
+                domain: [domain.lo, domain.hi],
+            },
         }
     }
 }
@@ -749,7 +822,79 @@ pub fn summary(prs: &Prs) -> String {
         not_validated.join("; ")
     };
     let _ = writeln!(s, "  not validated: {not_validated}");
+    for hint in &prs.hints {
+        let _ = writeln!(s, "  hint: {}", hint_sentence(prs, hint));
+    }
     s
+}
+
+/// Where a transform comes from, as a parenthesis after it (nothing for a given one).
+fn transform_source(tr: &TransformUsed) -> String {
+    let fit = match tr.source {
+        TransformSource::Given => return String::new(),
+        TransformSource::Auto(fit) => fit,
+    };
+    let how = match fit {
+        AutoFit::LogNorm { chosen, identity } if chosen < identity => format!(
+            "mu_inf(T A T^-1) = {} against mu_inf(A) = {} for the identity",
+            num(chosen),
+            num(identity)
+        ),
+        AutoFit::LogNorm { identity, .. } => {
+            format!("nothing beats the identity: mu_inf(A) = {}", num(identity))
+        }
+        AutoFit::NonFiniteJacobian => "A is not finite: the identity".to_string(),
+    };
+    format!(
+        " (chosen automatically from A, the drift's Jacobian at the initial set's centre: {how})"
+    )
+}
+
+/// A hint, in words, with what to try.
+fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
+    let already_auto = prs
+        .transform
+        .as_ref()
+        .is_some_and(|tr| matches!(tr.source, TransformSource::Auto(_)));
+    let try_this = if already_auto {
+        "try `method = contraction`"
+    } else {
+        "try `transform = auto` (or `method = contraction`)"
+    };
+    match *hint {
+        Hint::Wrapping {
+            t,
+            state,
+            half_width,
+            ball_half_width,
+            c,
+        } => {
+            let ball = if c < 0.0 { "shrinks" } else { "bounds" };
+            format!(
+                "the box grows (wrapping): the PRS's half-width in `{}` is {} by t = {t:.4} while \
+                 the contraction rate c = {} {ball} P-balls (half-width {} from the same initial \
+                 set and r_t): {try_this}",
+                prs.states[state],
+                num(half_width),
+                num(c),
+                num(ball_half_width)
+            )
+        }
+        Hint::LeavesDomain {
+            t,
+            state,
+            range,
+            domain,
+        } => format!(
+            "the box leaves the domain in `{}` at t = {t:.4} ([{}, {}] is not in [{}, {}]; the \
+             constants hold only in the domain): {try_this}",
+            prs.states[state],
+            num(range.lo),
+            num(range.hi),
+            num(domain.lo),
+            num(domain.hi)
+        ),
+    }
 }
 
 /// What the probability level is about, in words.
@@ -836,10 +981,11 @@ fn summary_boxes(prs: &Prs, s: &mut String) {
             let rows: Vec<String> = tr.matrix.chunks(n).map(|r| format!("{r:?}")).collect();
             let _ = writeln!(
                 s,
-                "  deterministic sets: parallelotopes {{x : T x in box}}, T = [{}], box of the \
+                "  deterministic sets: parallelotopes {{x : T x in box}}, T = [{}]{}, box of the \
                  embedding system in y = T x ({inclusion} inclusion); PRS = parallelotope (+) \
                  B_P(r_t); columns: the box in y, then the parallelotope's hull in x",
-                rows.join(", ")
+                rows.join(", "),
+                transform_source(tr)
             );
         }
     }

@@ -4,18 +4,34 @@ use super::matrix;
 use super::scope::did_you_mean;
 use super::sets::Fields;
 use super::Checker;
+use crate::analysis::{choose_transform, jacobian_at, MAX_AUTO_STATES};
 use crate::diagnostics::{Diagnostic, Span};
+use crate::ir::ExprId;
 use crate::model::{
-    Analysis, AnalysisSpec, Guarantee, Inclusion, Integrator, Method, MetricChoice as Metric,
-    RadiusRule, Rate, Transform,
+    Analysis, AnalysisSpec, Bounds, Guarantee, Inclusion, Integrator, Method,
+    MetricChoice as Metric, RadiusRule, Rate, Transform,
 };
 use crate::syntax::ast::{Arg, Block, Expr, ExprKind, Ident};
+use reachc_core::model::{AutoFit, InitialSet, TransformSource};
+use reachc_core::Interval;
 
 /// Most sample paths of an empirical rate estimate (they are all kept in memory).
 const MAX_EMPIRICAL_PATHS: f64 = 20_000.0;
 
 /// Most metrics of `metric = auto(states = [..])` (each costs a run; delta is shared).
 const MAX_METRICS: usize = 8;
+/// What `transform = ...` says: `auto` is resolved once the whole drift is known.
+enum TransformKey {
+    Given(Transform),
+    Auto,
+}
+
+/// The `n x n` identity by rows.
+fn identity_rows(n: usize) -> Vec<Vec<f64>> {
+    (0..n)
+        .map(|i| (0..n).map(|j| f64::from(u8::from(i == j))).collect())
+        .collect()
+}
 
 const KEYS: &[&str] = &[
     "method",
@@ -223,7 +239,7 @@ impl Checker<'_> {
             );
             return;
         }
-        if let (Some(_), Some((e, _))) = (&transform, f.get("transform")) {
+        if let (Some(written), Some((e, _))) = (&transform, f.get("transform")) {
             if method != Method::Interval {
                 self.fail::<()>(
                     Diagnostic::error(
@@ -238,7 +254,16 @@ impl Checker<'_> {
                 );
                 return;
             }
+            if let TransformKey::Auto = written {
+                // Chosen once the whole drift is known (`auto_transforms`).
+                self.auto_transforms
+                    .push((self.analyses.len(), e.span.clone()));
+            }
         }
+        let transform = match transform {
+            Some(TransformKey::Given(t)) => Some(t),
+            Some(TransformKey::Auto) | None => None,
+        };
         self.analyses.push(Analysis {
             spec: AnalysisSpec {
                 name: name.name.clone(),
@@ -314,26 +339,165 @@ impl Checker<'_> {
         }
     }
 
-    /// A coordinate transform: an invertible n x n matrix, with its inverse. Analyses with the
-    /// same `T` share one frame (the transformed system backends generate once).
-    fn transform(&mut self, e: &Expr, n: usize) -> Option<Transform> {
-        let matrix = self.square(e, n, "transform", false)?;
-        // `square` checked invertibility by the same elimination, so this succeeds.
-        let inverse = matrix::inverse(&matrix).ok()?.concat();
-        let matrix = matrix.concat();
-        let frames = self
-            .analyses
-            .iter()
-            .filter_map(|a| a.spec.transform.as_ref());
-        let frame = match frames.clone().find(|t| t.matrix == matrix) {
-            Some(t) => t.frame,
-            None => frames.map(|t| t.frame + 1).max().unwrap_or(0),
+    /// A coordinate transform: `auto`, or an invertible n x n matrix (with its inverse; its
+    /// frame is numbered by `number_frames`).
+    fn transform(&mut self, e: &Expr, n: usize) -> Option<TransformKey> {
+        match &e.kind {
+            ExprKind::Name(id) if id.name == "auto" => {
+                if n > MAX_AUTO_STATES {
+                    return self.fail(
+                        Diagnostic::error(
+                            format!(
+                                "`transform = auto` handles at most {MAX_AUTO_STATES} states, \
+                                 this model has {n}"
+                            ),
+                            e.span.clone(),
+                            "too many states",
+                        )
+                        .with_help(
+                            "give the transform as a matrix, or remove it (the transformed \
+                             drift of a chosen T is dense: n^2 terms)",
+                        ),
+                    );
+                }
+                Some(TransformKey::Auto)
+            }
+            ExprKind::List(_) => {
+                let matrix = self.square(e, n, "transform", false)?;
+                // `square` checked invertibility by the same elimination, so this succeeds.
+                let inverse = matrix::inverse(&matrix).ok()?.concat();
+                Some(TransformKey::Given(Transform {
+                    matrix: matrix.concat(),
+                    inverse,
+                    frame: 0,
+                    source: TransformSource::Given,
+                }))
+            }
+            _ => self.fail(Diagnostic::error(
+                "unknown transform",
+                e.span.clone(),
+                "expected `auto` or a matrix",
+            )),
+        }
+    }
+
+    /// Chooses the transform of every `transform = auto` analysis: one `T` for all of them,
+    /// from the drift's Jacobian at the initial set's centre (inputs at the input box's
+    /// centre, `t = 0`). Runs after the checks, on a model without errors.
+    pub(super) fn auto_transforms(&mut self) {
+        let pending = std::mem::take(&mut self.auto_transforms);
+        if pending.is_empty() {
+            return;
+        }
+        let n = self.states.len();
+        let (matrix, fit) = match self.centre_jacobian() {
+            Ok(a) => {
+                let chosen = choose_transform(&a);
+                let rows: Vec<Vec<f64>> = chosen
+                    .matrix
+                    .row_iter()
+                    .map(|r| r.iter().copied().collect())
+                    .collect();
+                let fit = AutoFit::LogNorm {
+                    chosen: chosen.log_norm,
+                    identity: chosen.identity_log_norm,
+                };
+                (rows, fit)
+            }
+            Err(why) => {
+                for (_, span) in &pending {
+                    self.diags.push(
+                        Diagnostic::warning(
+                            "`transform = auto` falls back to the identity",
+                            span.clone(),
+                            "no Jacobian to choose T from",
+                        )
+                        .with_note(why.clone()),
+                    );
+                }
+                (identity_rows(n), AutoFit::NonFiniteJacobian)
+            }
         };
-        Some(Transform {
-            matrix,
-            inverse,
-            frame,
-        })
+        // The chooser caps cond(T) far below the checker's singularity threshold; should the
+        // elimination still refuse T, the identity is what nothing beating it gives.
+        let (matrix, inverse, fit) = match matrix::inverse(&matrix) {
+            Ok(inverse) => (matrix, inverse, fit),
+            Err(_) => {
+                let fit = match fit {
+                    AutoFit::LogNorm { identity, .. } => AutoFit::LogNorm {
+                        chosen: identity,
+                        identity,
+                    },
+                    AutoFit::NonFiniteJacobian => AutoFit::NonFiniteJacobian,
+                };
+                (identity_rows(n), identity_rows(n), fit)
+            }
+        };
+        let transform = Transform {
+            matrix: matrix.concat(),
+            inverse: inverse.concat(),
+            frame: 0,
+            source: TransformSource::Auto(fit),
+        };
+        for (index, _) in pending {
+            if let Some(a) = self.analyses.get_mut(index) {
+                a.spec.transform = Some(transform.clone());
+            }
+        }
+    }
+
+    /// `D_x f` at the initial set's centre, the inputs' centre and `t = 0`, or why not.
+    fn centre_jacobian(&mut self) -> Result<nalgebra::DMatrix<f64>, String> {
+        let initial = InitialSet {
+            boxes: self.boxes.clone(),
+            balls: self.balls.iter().map(|(b, _)| b.clone()).collect(),
+        };
+        let centre = |b: &Bounds| Interval::new(b.lo, b.hi).mid();
+        let x: Vec<f64> = initial.bounding_box()?.iter().map(centre).collect();
+        let u: Vec<f64> = self
+            .input_box
+            .iter()
+            .map(|b| b.as_ref().map_or(0.0, centre))
+            .collect();
+        let zero = self.pool.num(0.0);
+        let drift: Vec<ExprId> = self
+            .drift
+            .iter()
+            .map(|d| d.as_ref().map_or(zero, |(e, _)| *e))
+            .collect();
+        let a = jacobian_at(&mut self.pool, &drift, &self.tables, (&x, &u, 0.0));
+        match a.iter().position(|v| !v.is_finite()) {
+            None => Ok(a),
+            Some(k) => {
+                let (i, j) = (k % x.len(), k / x.len());
+                Err(format!(
+                    "d {}' / d {} = {} at the centre of the initial set {x:?} (inputs {u:?}, \
+                     t = 0)",
+                    self.states[i].name,
+                    self.states[j].name,
+                    a[(i, j)]
+                ))
+            }
+        }
+    }
+
+    /// Numbers the frames of the coordinate transforms: analyses with the same `T` share one
+    /// (the transformed system backends generate once), in order of first use.
+    pub(super) fn number_frames(&mut self) {
+        let mut frames: Vec<Vec<f64>> = Vec::new();
+        for t in self
+            .analyses
+            .iter_mut()
+            .filter_map(|a| a.spec.transform.as_mut())
+        {
+            t.frame = match frames.iter().position(|m| *m == t.matrix) {
+                Some(k) => k,
+                None => {
+                    frames.push(t.matrix.clone());
+                    frames.len() - 1
+                }
+            };
+        }
     }
 
     /// An n x n matrix, symmetric positive definite (`spd`) or non-singular.
@@ -493,5 +657,64 @@ impl Checker<'_> {
                 .with_help(help),
             ),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::diagnostics::Severity;
+    use crate::driver::check_source;
+    use crate::model::Model;
+    use reachc_core::model::{AutoFit, TransformSource};
+
+    fn check(analyses: &str, drift: &str) -> (Model, Vec<crate::diagnostics::Diagnostic>) {
+        let src = format!(
+            "model m\nstate x in [0, 2]\nstate y in [-1, 1]\ndrift {{ {drift} }}\n{analyses}"
+        );
+        let (model, diags) = check_source(&src, std::path::Path::new("."));
+        (model.expect("the spec checks"), diags)
+    }
+
+    /// Every `auto` gets the same `T` and frame; frames are numbered in order of first use.
+    #[test]
+    fn auto_transforms_share_a_frame() {
+        let (model, diags) = check(
+            "analysis a { method = interval  horizon = 1  transform = auto }\n\
+             analysis b { method = interval  horizon = 1  transform = [[1, 1], [0, 1]] }\n\
+             analysis c { method = interval  horizon = 1  transform = auto }",
+            "x' = y  y' = -4 * x - 5 * y",
+        );
+        assert!(diags.is_empty(), "{diags:?}");
+        let t: Vec<_> = model
+            .analyses
+            .iter()
+            .map(|a| a.spec.transform.clone().unwrap())
+            .collect();
+        assert_eq!([t[0].frame, t[1].frame, t[2].frame], [0, 1, 0]);
+        assert_eq!(t[0], t[2]);
+        assert_eq!(t[1].source, TransformSource::Given);
+        let TransformSource::Auto(AutoFit::LogNorm { chosen, identity }) = t[0].source else {
+            panic!("{:?}", t[0].source);
+        };
+        assert_eq!(identity, 1.0);
+        assert!(chosen < -0.98, "{chosen}");
+    }
+
+    /// A Jacobian that is not finite at the centre (`sqrt` at 0): the identity, and a warning
+    /// on `auto`.
+    #[test]
+    fn non_finite_jacobian_falls_back_to_the_identity() {
+        let (model, diags) = check(
+            "analysis a { method = interval  horizon = 1  transform = auto }",
+            "x' = -sqrt(x - 1)  y' = -y",
+        );
+        let [d] = diags.as_slice() else {
+            panic!("{diags:?}");
+        };
+        assert_eq!(d.severity, Severity::Warning);
+        assert!(d.message.contains("falls back to the identity"), "{d:?}");
+        let t = model.analyses[0].spec.transform.clone().unwrap();
+        assert_eq!(t.matrix, [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(t.source, TransformSource::Auto(AutoFit::NonFiniteJacobian));
     }
 }

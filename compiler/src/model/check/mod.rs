@@ -3,7 +3,8 @@
 //! Passes, in order: constants and declarations (so names can be used before the line that
 //! declares them, except constants and lets, which are ordered); then lets, equations and
 //! blocks in source order; then completeness checks (every state has a drift equation and an
-//! initial set).
+//! initial set); then, on a model without errors, the `transform = auto` choices (they need the
+//! whole drift), and the transforms' frames.
 
 mod analysis;
 mod blocks;
@@ -45,11 +46,16 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         balls: Vec::new(),
         unsafe_sets: Vec::new(),
         analyses: Vec::new(),
+        auto_transforms: Vec::new(),
         constants: Vec::new(),
     };
     c.declarations(spec);
     c.bodies(spec);
     c.completeness(spec);
+    if !has_errors(&c.diags) {
+        c.auto_transforms();
+    }
+    c.number_frames();
     let mut diags = std::mem::take(&mut c.diags);
     // A mistake inside a `for` body is reported once, not once per iteration.
     let mut seen = std::collections::HashSet::new();
@@ -126,6 +132,8 @@ struct Checker<'a> {
     /// Unsafe sets, with the `unsafe` item of each.
     unsafe_sets: Vec<(UnsafeSet, Span)>,
     analyses: Vec<super::Analysis>,
+    /// Analyses with `transform = auto` (index, span of `auto`), chosen after the checks.
+    auto_transforms: Vec<(usize, Span)>,
     constants: Vec<(String, f64)>,
 }
 
