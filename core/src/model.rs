@@ -445,6 +445,11 @@ pub struct Constants {
     /// certified constants: the PRS is the intersection of the sets of this metric and of every
     /// one here, each computed at `delta / K` (`K = 1 + also.len()`).
     pub also: Vec<Constants>,
+    /// Other metrics the engine runs the analysis with as well, keeping the result whose PRS
+    /// has the smallest bounding box at the horizon (a choice from deterministic quantities:
+    /// every candidate's result is valid). Used where the compiler cannot predict the PRS
+    /// (`metric = auto` without bounded constants over the domain).
+    pub alternatives: Vec<Constants>,
 }
 
 impl Constants {
@@ -461,6 +466,7 @@ impl Constants {
             provenance: Provenance::Given,
             region: info.region(f64::INFINITY),
             also: Vec::new(),
+            alternatives: Vec::new(),
         }
     }
 }
@@ -476,6 +482,10 @@ pub enum MetricRegion {
     /// Synthesised for the Jacobian over the initial set's bounding box during the first report
     /// step (where the tube starts; used when the domain admits no contracting metric).
     InitialSet,
+    /// `metric = auto` without bounded constants over the domain: the identity, which gave a
+    /// smaller PRS at the horizon than the metric synthesised over the initial set (the engine
+    /// ran both, see [`Constants::alternatives`]).
+    IdentityAtRun,
 }
 
 impl fmt::Display for MetricRegion {
@@ -485,6 +495,10 @@ impl fmt::Display for MetricRegion {
             MetricRegion::Domain => "synthesised for the Jacobian over the domain",
             MetricRegion::InitialSet => {
                 "synthesised for the Jacobian over the initial set during the first report step"
+            }
+            MetricRegion::IdentityAtRun => {
+                "the identity: a smaller PRS at the horizon than the metric synthesised over the \
+                 initial set (both were run)"
             }
         })
     }

@@ -4,7 +4,8 @@
 use crate::engine::{self, check_initial, Inputs, Needs, Run, RunError, Setup};
 use crate::interval::Interval;
 use crate::model::{
-    Analysis, AnalysisSpec, Bounds, Guarantee, Inclusion, InitialSet, Method, ModelInfo, Rate,
+    Analysis, AnalysisSpec, Bounds, Constants, Guarantee, Inclusion, InitialSet, Method, ModelInfo,
+    Rate,
 };
 use crate::prs::Prs;
 use crate::system::System;
@@ -30,6 +31,9 @@ pub struct Reach<'a> {
     setup: Setup<'a>,
     /// The setups of the analysis' further metrics (`metric = auto(states = [..])`).
     also: Vec<Setup<'a>>,
+    /// The setups of the metrics run as well, the smallest result kept
+    /// ([`Constants::alternatives`](crate::model::Constants::alternatives)).
+    alternatives: Vec<Setup<'a>>,
 }
 
 impl<'a> Reach<'a> {
@@ -91,20 +95,20 @@ impl<'a> Reach<'a> {
             },
         };
         let setup = Setup::new(sys, info, spec, &analysis.constants, needs)?;
-        let also = match &analysis.constants {
-            Ok(c) => c
-                .also
+        let setups = |of: fn(&Constants) -> &Vec<Constants>| match &analysis.constants {
+            Ok(c) => of(c)
                 .iter()
                 .map(|k| Setup::with(sys, info, spec, k, needs))
-                .collect::<Result<_, _>>()?,
-            Err(_) => Vec::new(),
+                .collect::<Result<Vec<_>, _>>(),
+            Err(_) => Ok(Vec::new()),
         };
         Ok(Reach {
             sys,
             info,
             spec: spec.clone(),
             setup,
-            also,
+            also: setups(|c| &c.also)?,
+            alternatives: setups(|c| &c.alternatives)?,
         })
     }
 
@@ -195,10 +199,20 @@ impl<'a> Reach<'a> {
                 inputs,
             })
         };
-        let first = run_with(&self.setup)?;
+        let first = run_with(&self.setup);
         if k == 1 {
-            return Ok(first);
+            // Alternatives: the result with the smallest box at the horizon (where one fails,
+            // the others still stand).
+            let size = |p: &Prs| p.hull(p.horizon).map_or(f64::INFINITY, |h| log_volume(&h));
+            let mut best = first;
+            for other in self.alternatives.iter().filter_map(|s| run_with(s).ok()) {
+                if best.as_ref().map_or(true, |b| size(&other) < size(b)) {
+                    best = Ok(other);
+                }
+            }
+            return best;
         }
+        let first = first?;
         let others = self.also.iter().map(run_with).collect::<Result<_, _>>()?;
         Ok(engine::intersect(
             self.info,
@@ -272,4 +286,9 @@ impl InputPlan {
         }
         Ok(())
     }
+}
+
+/// The sum of the logs of a box's half-widths (`-inf` for a degenerate box).
+fn log_volume(b: &[Bounds]) -> f64 {
+    b.iter().map(|x| (0.5 * (x.hi - x.lo)).ln()).sum()
 }

@@ -746,6 +746,7 @@ fn noise_and_input(
             rho: gain,
         },
         also: Vec::new(),
+        alternatives: Vec::new(),
         region: Region {
             domain: model.domain.clone(),
             input_box: model.input_box.clone(),

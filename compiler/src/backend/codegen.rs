@@ -1486,6 +1486,12 @@ impl InfoWriter {
     fn constants(&mut self, c: &Constants, info: &ModelInfo) -> TokenStream {
         let also: Vec<TokenStream> = c.also.iter().map(|k| self.constants(k, info)).collect();
         let also = list(also);
+        let alternatives: Vec<TokenStream> = c
+            .alternatives
+            .iter()
+            .map(|k| self.constants(k, info))
+            .collect();
+        let alternatives = list(alternatives);
         let metric = self.floats(&c.metric);
         let (cc, sigma, rho) = (float(c.c), float(c.sigma), float(c.rho));
         let provenance = provenance(&c.provenance);
@@ -1506,6 +1512,7 @@ impl InfoWriter {
             MetricRegion::Given => quote!(MetricRegion::Given),
             MetricRegion::Domain => quote!(MetricRegion::Domain),
             MetricRegion::InitialSet => quote!(MetricRegion::InitialSet),
+            MetricRegion::IdentityAtRun => quote!(MetricRegion::IdentityAtRun),
         };
         quote! {
             Constants {
@@ -1517,6 +1524,7 @@ impl InfoWriter {
                 provenance: #provenance,
                 region: Region { domain: #domain, input_box: #input_box, time: #time },
                 also: #also,
+                alternatives: #alternatives,
             }
         }
     }

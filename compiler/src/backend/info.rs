@@ -177,6 +177,24 @@ fn local_constants(
             }
         }
     };
+    let mut chosen = for_metric(model, d, metric, region)?;
+    // Constants over the initial set predict the PRS at the horizon too poorly to compare
+    // metrics by: the engine runs the identity as well and keeps the smaller result.
+    if region == MetricRegion::InitialSet && chosen.metric != identity(n) {
+        let id = for_metric(model, d, identity(n), MetricRegion::IdentityAtRun)?;
+        chosen.alternatives.push(id);
+    }
+    Ok(chosen)
+}
+
+/// The constants of a local-rate analysis for `metric`: the compiler's global ones where it can
+/// bound them, else infinite (the engine certifies local rates only).
+fn for_metric(
+    model: &Model,
+    d: &Derivatives,
+    metric: Vec<f64>,
+    region: MetricRegion,
+) -> Result<Constants, ConstantsError> {
     match constants(model, d, &metric) {
         Ok(c) => Ok(Constants {
             metric_region: region,
@@ -194,6 +212,7 @@ fn local_constants(
                     why: explain(model, d, &e).0,
                 },
                 also: Vec::new(),
+                alternatives: Vec::new(),
                 region: reachc_core::model::Region {
                     domain: model.domain.clone(),
                     input_box: model.input_box.clone(),
@@ -206,8 +225,9 @@ fn local_constants(
 }
 
 /// A metric synthesised for the Jacobian over the initial set's bounding box and
-/// `t in [0, step]` (the identity if that fails). Not chosen for the result: constants over
-/// the initial set predict the PRS at the horizon too poorly to compare metrics by.
+/// `t in [0, step]` (the identity if that fails). Not compared by the PRS predicted at the
+/// horizon (constants over the initial set predict it too poorly): the engine runs the identity
+/// as well and keeps the smaller result.
 fn initial_metric(model: &Model, d: &Derivatives, step: f64) -> Vec<f64> {
     let n = model.states.len();
     let Ok(start) = model.initial.bounding_box() else {
