@@ -77,18 +77,20 @@ fn run_plot_writes_both_figures_for_each_analysis() {
         "1,4",
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    let analyses = [
-        "contraction",
-        "interval",
-        "paper_contraction",
-        "paper_interval",
+    // With whether each has local rates (those also get the rates figure).
+    let local = [
+        ("contraction", true),
+        ("interval", true),
+        ("paper_contraction", false),
+        ("paper_interval", false),
+        ("per_state", false),
+        ("per_state_uniform", true),
     ];
-    // The local-rate analyses (the first two) also get the rates figure.
-    let mut expected: Vec<String> = analyses
+    let analyses = local.map(|(a, _)| a);
+    let mut expected: Vec<String> = local
         .iter()
-        .enumerate()
-        .flat_map(|(k, a)| {
-            let rates = if k < 2 {
+        .flat_map(|&(a, local)| {
+            let rates = if local {
                 &["rates.png", "rates.svg"][..]
             } else {
                 &[]

@@ -296,7 +296,9 @@ fn linear_runs_through_dispatch() {
         assert_eq!(s.psi, t.psi);
     }
     assert!(rc.inclusion.is_none());
-    assert!(matches!(rc.steps[0].det, DetSet::Ball { .. }));
+    // The initial box at t = 0, P-balls after.
+    assert!(matches!(rc.steps[0].det, DetSet::Box { .. }));
+    assert!(matches!(rc.steps[1].det, DetSet::Ball { .. }));
 }
 
 #[test]

@@ -185,8 +185,10 @@ fn results_render() {
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&ball)).unwrap();
     assert_eq!(v["method"], "contraction");
     assert!(v.get("inclusion").is_none());
-    assert_eq!(v["steps"][0]["det_set"]["shape"], "p_ball");
-    assert!(v["steps"][0]["det_set"].get("lo").is_none());
+    // The initial box at t = 0, P-balls after.
+    assert_eq!(v["steps"][0]["det_set"]["shape"], "box");
+    assert_eq!(v["steps"][1]["det_set"]["shape"], "p_ball");
+    assert!(v["steps"][1]["det_set"].get("lo").is_none());
     assert_eq!(
         v["constants"]["how"],
         "given by hand, not certified by reachc"

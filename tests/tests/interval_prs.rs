@@ -352,8 +352,10 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
         final_half_widths(&auto),
     );
     eprintln!("half-widths at t = 5: contraction {hc:?}, interval {hp:?}, interval_auto {ha:?}");
+    // `metric = auto` is chosen for the PRS volume (c = -0.86; the rate-optimal metric
+    // certifies -0.99 but gives a larger PRS).
     assert!(
-        contraction.constants.c < -0.98,
+        contraction.constants.c < -0.8,
         "c = {}",
         contraction.constants.c
     );
@@ -381,8 +383,10 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
             // The hint's float sum against the PRS hull's outward-rounded one.
             assert!((half_width - hp[0]).abs() <= 1e-12 * hp[0], "{half_width}");
             assert!(*half_width > WRAPPING_FACTOR * ball_half_width);
+            // Near the contraction PRS (each analysis' metric is chosen for its own method's
+            // PRS, so the two differ a little).
             assert!(
-                (ball_half_width - hc[0]).abs() <= 0.01 * hc[0],
+                (ball_half_width - hc[0]).abs() <= 0.05 * hc[0],
                 "{ball_half_width}"
             );
             assert_eq!(*c, plain.constants.c);

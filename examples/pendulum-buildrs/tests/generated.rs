@@ -45,7 +45,9 @@ fn info_lists_the_analyses() {
             "contraction",
             "interval",
             "paper_contraction",
-            "paper_interval"
+            "paper_interval",
+            "per_state",
+            "per_state_uniform"
         ]
     );
 }
