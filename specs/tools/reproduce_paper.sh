@@ -26,7 +26,7 @@ done
 # reachc's defaults beside it (validated steps, time-uniform tube).
 "$reachc" simulate specs/pendulum.sde --paths 2000 --seed 1 --backend interp -o "$out/pendulum" -q
 "$reachc" run specs/pendulum.sde --backend interp -o "$out/pendulum" > /dev/null
-for a in paper_contraction paper_interval contraction interval; do
+for a in paper_contraction paper_interval contraction interval per_state; do
     "$reachc" plot "$out/pendulum/$a.json" --spec specs/pendulum.sde --times 1,2,4 \
         --paths 50 > /dev/null
 done
