@@ -176,28 +176,52 @@ pub enum UniformBound {
     Mixture,
 }
 
-/// How `r1` was bounded.
+/// How `r1` was bounded (method.md section 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct R1Bound {
-    /// The bound over the initial box (or the balls' bounding boxes).
-    pub how: R1Method,
-    /// Initial balls were replaced by their bounding boxes (conservative).
-    pub balls_as_boxes: bool,
+    /// How the box part was bounded: the initial boxes and points, and the balls' bounding
+    /// boxes too when `balls` is [`BallBound::BoundingBoxes`].
+    pub boxes: R1Method,
+    /// How the initial balls entered.
+    pub balls: BallBound,
+    /// `r1` is reported only: the interval method propagates the initial set's bounding box.
+    pub reported_only: bool,
 }
 
-/// The bound of `r1` over a box.
+/// The bound over the box part of the initial set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum R1Method {
-    /// The maximum of `|x0 - x*_0|_P` over the box's vertices.
+    /// The maximum over the box's vertices (exact up to rounding).
     Vertices {
-        /// Non-degenerate coordinates of the box.
+        /// Non-degenerate coordinates of the box part.
         active: usize,
     },
     /// `sum_ij |P_ij| h_i h_j` (more than [`crate::engine::MAX_VERTEX_COORDS`] coordinates).
     AbsoluteSum,
-    /// The P-radius of the initial box, reported only (the interval method propagates the box
-    /// itself).
-    ReportedOnly,
+}
+
+/// How the initial balls entered `r1`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BallBound {
+    /// No initial ball of positive radius.
+    NoBalls,
+    /// Jointly with the box part's vertices: per vertex, the S-lemma bound minimised over its
+    /// multiplier. Exact (up to rounding) for one ball; for several, the S-procedure with one
+    /// multiplier per ball, an upper bound that need not be exact.
+    Joint {
+        /// Balls of positive radius.
+        balls: usize,
+    },
+    /// Separately from the box part, `|b + y|_P <= |b|_P + |y|_P` (more than
+    /// [`crate::engine::MAX_VERTEX_COORDS`] box coordinates, or a box part and more than
+    /// [`crate::engine::MAX_BALL_STATES`] ball states); the balls' part as in `Joint`.
+    Separate {
+        /// Balls of positive radius.
+        balls: usize,
+    },
+    /// Replaced by their bounding boxes: the balls' own bound was not smaller (or could not be
+    /// certified).
+    BoundingBoxes,
 }
 
 /// A coordinate transform `y = T x`, as used.

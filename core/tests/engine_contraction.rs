@@ -8,7 +8,7 @@ use reachc_core::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
     ModelInfo, RadiusRule, Rate, Transform, TransformSource, UnsafeSet, UnsafeShape,
 };
-use reachc_core::prs::{DetSet, Prs, Unproved, UnsafeKind, Verdict};
+use reachc_core::prs::{BallBound, DetSet, Prs, Unproved, UnsafeKind, Verdict};
 use reachc_core::{InputPlan, Reach, System};
 
 // ---------------------------------------------------------------------------------------------
@@ -745,9 +745,10 @@ fn euler_uneven_horizon_domain_and_ball() {
     assert_eq!(res.steps.len(), 12);
     assert_eq!(res.steps.last().unwrap().t, 1.05);
     assert_eq!(res.initial_center, vec![1.0, -1.0]);
-    // P = I: r1 = |(0.25, 0.5)| (bounding box corner), conservative vs the true 0.5.
-    let r1 = (0.25f64 * 0.25 + 0.25).sqrt();
-    assert!(res.r1 >= r1 && res.r1 - r1 < 1e-14);
+    // P = I: r1 = 0.5 (the ball's longest semi-axis), not the bounding box's corner
+    // |(0.25, 0.5)| = 0.559.
+    assert!(res.r1 >= 0.5 && res.r1 - 0.5 < 1e-14, "{}", res.r1);
+    assert_eq!(res.r1_bound.balls, BallBound::Joint { balls: 1 });
     // Euler: x*_{k+1} = (1 - 0.04) x*_k on full steps.
     assert!((res.steps[1].nominal()[0] - 0.96).abs() < 1e-15);
     assert!(res.validation.conditional_on_domain);

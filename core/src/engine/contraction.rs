@@ -6,10 +6,10 @@
 use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::defect::{Nominal, NominalStep};
 use super::radius::expm1_over;
-use super::{local, nominal, radius, rates, Run, RunError};
+use super::{local, nominal, r1, radius, rates, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
-use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, Span, Unproved};
+use crate::prs::{DetSet, Proved, Prs, Span, Unproved};
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -19,16 +19,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     // Initial set and inputs.
     let (x0, half) =
         radius::initial_center_and_halfwidths(run.initial, n).map_err(RunError::Invalid)?;
-    let r1 = radius::r1_bound(metric, &half);
-    let active = half.iter().filter(|&&h| h > 0.0).count();
-    let r1_bound = R1Bound {
-        how: if active <= radius::MAX_VERTEX_COORDS {
-            R1Method::Vertices { active }
-        } else {
-            R1Method::AbsoluteSum
-        },
-        balls_as_boxes: !run.initial.balls.is_empty(),
-    };
+    let (r1, r1_bound) = r1::bound(metric, run.initial, &half);
     let grid = nominal::time_grid(spec.horizon, spec.step);
     let (inputs, r2) = run.nominal_inputs(&grid);
     let rho = if run.setup.p == 0 { 0.0 } else { consts.rho };

@@ -29,10 +29,10 @@
 use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::embedding::{BoxStep, Embedding};
 use super::transform::{self, Frame};
-use super::{hints, local, nominal, radius, validate, Run, RunError};
+use super::{hints, local, nominal, r1, radius, validate, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
-use crate::prs::{DetSet, Proved, Prs, R1Bound, R1Method, Span, TransformUsed, Unproved};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, Span, TransformUsed, Unproved};
 use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
@@ -56,7 +56,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         &run_inputs(run, &inputs),
         inclusion,
     )?;
-    let r1 = radius::r1_bound(metric, &half0);
+    let (r1, r1_bound) = r1::bound(metric, run.initial, &half0);
     let (kappa, radius_rule) = radius::stochastic_factor(n, spec);
     let box_radius = radius::BoxRadius::new(metric, n);
     // The set in x of a box of the embedding: the box itself, or the parallelotope T^-1 box
@@ -186,8 +186,8 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         r1,
         r2: 0.0,
         r1_bound: R1Bound {
-            how: R1Method::ReportedOnly,
-            balls_as_boxes: !run.initial.balls.is_empty(),
+            reported_only: true,
+            ..r1_bound
         },
         transform,
         initial_center: x0,

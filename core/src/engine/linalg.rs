@@ -142,6 +142,23 @@ pub(crate) fn inverse_diagonal(l: &[Interval], n: usize) -> Vec<Interval> {
 /// Eigenvalues of a symmetric `f64` matrix by the cyclic Jacobi method (an estimate only; the
 /// callers verify what they use).
 pub(crate) fn jacobi_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
+    jacobi(a, n, None)
+}
+
+/// [`jacobi_eigenvalues`] with the eigenvectors: `(lambda, v)` with `a ~ v diag(lambda) v'`,
+/// `v` row-major `n x n`, eigenvector `i` in column `i` (estimates, like the eigenvalues).
+pub(crate) fn jacobi_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut v = vec![0.0; n * n];
+    for i in 0..n {
+        v[i * n + i] = 1.0;
+    }
+    let lambda = jacobi(a, n, Some(&mut v));
+    (lambda, v)
+}
+
+/// The cyclic Jacobi iteration; the rotations are also applied to the columns of `vectors`
+/// when given (starting from the identity, they accumulate the eigenvectors).
+fn jacobi(a: &[f64], n: usize, mut vectors: Option<&mut [f64]>) -> Vec<f64> {
     let mut m = a.to_vec();
     for _sweep in 0..100 {
         let mut off = 0.0;
@@ -181,6 +198,14 @@ pub(crate) fn jacobi_eigenvalues(a: &[f64], n: usize) -> Vec<f64> {
                     let mqk = m[q * n + k];
                     m[p * n + k] = c * mpk - s * mqk;
                     m[q * n + k] = s * mpk + c * mqk;
+                }
+                if let Some(v) = vectors.as_deref_mut() {
+                    for k in 0..n {
+                        let vkp = v[k * n + p];
+                        let vkq = v[k * n + q];
+                        v[k * n + p] = c * vkp - s * vkq;
+                        v[k * n + q] = s * vkp + c * vkq;
+                    }
                 }
             }
         }
@@ -338,6 +363,21 @@ mod tests {
         let m = ev.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
         let ub = lambda_max_upper(&to_intervals(&a3), 3);
         assert!(ub >= m && ub <= m + 1e-9, "{ub} {m}");
+    }
+
+    #[test]
+    fn jacobi_eigenvectors_diagonalise() {
+        let a = [4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 1.0];
+        let (lambda, v) = jacobi_eigen(&a, 3);
+        assert_eq!(lambda, jacobi_eigenvalues(&a, 3));
+        for i in 0..3 {
+            for j in 0..3 {
+                let vdv: f64 = (0..3)
+                    .map(|k| v[i * 3 + k] * lambda[k] * v[j * 3 + k])
+                    .sum();
+                assert!((vdv - a[i * 3 + j]).abs() < 1e-13, "{i} {j}: {vdv}");
+            }
+        }
     }
 
     #[test]

@@ -29,6 +29,7 @@ pub(crate) mod interval;
 pub(crate) mod linalg;
 mod local;
 mod nominal;
+mod r1;
 pub(crate) mod radius;
 mod rates;
 mod safety;
@@ -37,6 +38,7 @@ mod uniform;
 
 pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
+pub use r1::MAX_BALL_STATES;
 pub use radius::MAX_VERTEX_COORDS;
 
 use crate::interval::Interval;

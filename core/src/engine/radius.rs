@@ -163,18 +163,13 @@ pub(crate) fn initial_center_and_halfwidths(
     Ok((center, half))
 }
 
-/// Upper bound of `max |d|_P` over the box `|d_i| <= h_i` (P row-major `n x n`).
+/// Upper bounds of `max |d|_P` over boxes `|d_i| <= h_i` for one metric `P` (row-major `n x n`).
 ///
 /// `d' P d` is convex in `d`, so its maximum over the box is attained at a vertex. With at most
 /// [`MAX_VERTEX_COORDS`] coordinates of non-zero width every vertex is evaluated (in f64 with a
-/// rigorous bound of the rounding error); otherwise `d' P d <= sum_ij |P_ij| h_i h_j` is used. The square root is
-/// rounded up.
-pub(crate) fn r1_bound(p: &[f64], half: &[f64]) -> f64 {
-    BoxRadius::new(p, half.len()).bound(half)
-}
-
-/// [`r1_bound`] for one metric and many boxes: the non-zero entries of `P` are found once, so
-/// a bound for many coordinates costs `O(nnz(P))` rather than `O(n^2)`.
+/// rigorous bound of the rounding error); otherwise `d' P d <= sum_ij |P_ij| h_i h_j` is used,
+/// over the non-zero entries of `P` found once, so it costs `O(nnz(P))` rather than `O(n^2)`.
+/// The square root is rounded up.
 pub(crate) struct BoxRadius<'a> {
     p: &'a [f64],
     nonzeros: Vec<(usize, usize, f64)>,
@@ -192,7 +187,7 @@ impl<'a> BoxRadius<'a> {
         BoxRadius { p, nonzeros }
     }
 
-    /// Upper bound of `max |d|_P` over `|d_i| <= half_i` (see [`r1_bound`]).
+    /// Upper bound of `max |d|_P` over `|d_i| <= half_i` (see [`BoxRadius`]).
     pub(crate) fn bound(&self, half: &[f64]) -> f64 {
         let (p, n) = (self.p, half.len());
         let active: Vec<usize> = (0..n).filter(|&i| half[i] > 0.0).collect();
@@ -211,16 +206,13 @@ impl<'a> BoxRadius<'a> {
                 });
             return Interval::point(sum.hi().max(0.0)).sqrt().hi();
         }
-        // q_ab = P_ij h_i h_j over the active coordinates in f64 (relative error <= 2u each),
-        // an upper bound of sum |q_ab|, and whether q is diagonal.
+        // q_ab = P_ij h_i h_j over the active coordinates in f64, and whether q is diagonal.
         let mut q = vec![0.0; k * k];
-        let mut abs_sum = Interval::ZERO;
         let mut diagonal = true;
         for (a, &i) in active.iter().enumerate() {
             for (b, &j) in active.iter().enumerate() {
                 let v = p[i * n + j] * half[i] * half[j];
                 q[a * k + b] = v;
-                abs_sum += Interval::point(v.abs());
                 diagonal &= a == b || v == 0.0;
             }
         }
@@ -232,28 +224,50 @@ impl<'a> BoxRadius<'a> {
                     * Interval::point(half[i])
             })
         } else {
-            // Vertex d = (s_a h_a): d'Pd = sum_ab s_a s_b q_ab. Vertices s and -s give the
-            // same value, so fix s_0 = +1 and enumerate the other 2^(k-1) sign patterns.
             let mut max_sq = f64::NEG_INFINITY;
-            for bits in 0u32..(1u32 << (k - 1)) {
-                let sign = |a: usize| {
-                    if a == 0 || (bits >> (a - 1)) & 1 == 0 {
-                        1.0
-                    } else {
-                        -1.0
-                    }
-                };
-                let s: f64 = (0..k)
-                    .map(|a| sign(a) * (0..k).map(|b| sign(b) * q[a * k + b]).sum::<f64>())
-                    .sum();
-                max_sq = max_sq.max(s);
-            }
-            // Each vertex value is a sum of k^2 terms +-q_ab: its error (the products' and
-            // the sums') is below (k^2 + 2) u sum |q_ab|, within the margin with a factor 2.
-            Interval::point(max_sq) + abs_sum * Interval::point((k * k + 2) as f64 * f64::EPSILON)
+            vertex_forms(&q, k, |_, v| max_sq = max_sq.max(v));
+            Interval::point(max_sq) + vertex_rounding(&q, k)
         };
         Interval::point(max_sq.hi().max(0.0)).sqrt().hi()
     }
+}
+
+/// Whether coordinate `a` of vertex number `vertex` of [`vertex_forms`] has the sign `-1`.
+pub(crate) fn vertex_negative(vertex: usize, a: usize) -> bool {
+    a > 0 && (vertex >> (a - 1)) & 1 == 1
+}
+
+/// `s' q s` in f64 for the sign vectors `s` of a box's vertices (`q` is `k x k` row-major,
+/// `k >= 1`), passed to `f` with the vertex's number. Vertices `s` and `-s` give the same value,
+/// so `s_0 = +1` and the other `2^(k-1)` sign patterns are enumerated: `s_a = -1` where
+/// [`vertex_negative`]. Each value is within [`vertex_rounding`] of the exact form of the `q`
+/// given, and of the exact `q` itself when every `q_ab` is an f64 product of at most three exact
+/// factors (`P_ij h_i h_j`).
+pub(crate) fn vertex_forms(q: &[f64], k: usize, mut f: impl FnMut(usize, f64)) {
+    debug_assert!((1..=MAX_VERTEX_COORDS).contains(&k) && q.len() == k * k);
+    for vertex in 0..1usize << (k - 1) {
+        let sign = |a: usize| {
+            if vertex_negative(vertex, a) {
+                -1.0
+            } else {
+                1.0
+            }
+        };
+        let s: f64 = (0..k)
+            .map(|a| sign(a) * (0..k).map(|b| sign(b) * q[a * k + b]).sum::<f64>())
+            .sum();
+        f(vertex, s);
+    }
+}
+
+/// A bound of the rounding error of each value of [`vertex_forms`]: a sum of `k^2` terms
+/// `+-q_ab`, each within `2u |q_ab|` of its exact value; the products' and the sums' errors stay
+/// below `(k^2 + 2) u sum |q_ab|`, within this margin with a factor 2 (rounded up).
+pub(crate) fn vertex_rounding(q: &[f64], k: usize) -> Interval {
+    let abs_sum = q
+        .iter()
+        .fold(Interval::ZERO, |acc, v| acc + Interval::point(v.abs()));
+    abs_sum * Interval::point((k * k + 2) as f64 * f64::EPSILON)
 }
 
 /// `kappa(n, delta)` of the analysis' radius rule, and the rule as used (with the minimising
@@ -337,10 +351,10 @@ mod tests {
     #[test]
     fn r1_vertices_vs_sum_bound() {
         // P = [[2, 1], [1, 2]], h = (1, 1): vertex max at (1, 1): 6.
-        let r = r1_bound(&[2.0, 1.0, 1.0, 2.0], &[1.0, 1.0]);
+        let r = BoxRadius::new(&[2.0, 1.0, 1.0, 2.0], 2).bound(&[1.0, 1.0]);
         assert!(r >= 6f64.sqrt() && r <= 6f64.sqrt() * (1.0 + 1e-14));
         // Negative coupling: max at (1, -1): 2 + 2 + 2 = 6 as well.
-        let r = r1_bound(&[2.0, -1.0, -1.0, 2.0], &[1.0, 1.0]);
+        let r = BoxRadius::new(&[2.0, -1.0, -1.0, 2.0], 2).bound(&[1.0, 1.0]);
         assert!(r >= 6f64.sqrt() && r <= 6f64.sqrt() * (1.0 + 1e-14));
     }
 

@@ -3,8 +3,8 @@
 use super::{csv_field, num, summary_indices};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
 use reachc_core::prs::{
-    DetSet, Hint, Proved, Prs, R1Method, Step, TransformUsed, UniformBound, Unproved, UnsafeKind,
-    UnsafeVerdict, Verdict,
+    BallBound, DetSet, Hint, Proved, Prs, R1Method, Step, TransformUsed, UniformBound, Unproved,
+    UnsafeKind, UnsafeVerdict, Verdict,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -418,32 +418,71 @@ fn rate_note(rate: Rate) -> String {
 /// How `r1` was bounded, in words.
 fn r1_how(prs: &Prs) -> String {
     let b = prs.r1_bound;
-    let (how, balls) = match b.how {
-        R1Method::Vertices { active } => (
-            format!(
-                "max of |x0 - x*_0|_P over the vertices of the initial box ({active} \
-                 non-degenerate coordinates)"
-            ),
-            "; balls replaced by their bounding boxes (conservative)",
+    let how = match b.balls {
+        BallBound::NoBalls => r1_over_box(b.boxes, "the initial box"),
+        BallBound::BoundingBoxes => format!(
+            "{}; balls replaced by their bounding boxes (conservative: the balls' own bound was \
+             not smaller)",
+            r1_over_box(b.boxes, "the initial box")
         ),
-        R1Method::AbsoluteSum => (
-            format!(
-                "sum_ij |P_ij| h_i h_j over the initial box (more than {} coordinates)",
-                reachc_core::engine::MAX_VERTEX_COORDS
-            ),
-            "; balls replaced by their bounding boxes (conservative)",
-        ),
-        R1Method::ReportedOnly => (
-            "P-radius of the initial box around its centre (reported only: the interval method \
-             propagates the box itself)"
-                .to_string(),
-            "; initial balls replaced by their bounding boxes (conservative)",
+        BallBound::Joint { balls } => r1_joint(balls, b.boxes),
+        BallBound::Separate { balls } => format!(
+            "|b|_P + |y|_P, the box part b and the ball part y bounded separately: {}; {}",
+            r1_over_box(b.boxes, "the box part"),
+            match balls {
+                1 => "the initial ball by r sqrt(lambda_max(P, M)), exact for the ball alone"
+                    .to_string(),
+                m => format!("the {m} initial balls by the S-procedure (not exact in general)"),
+            }
         ),
     };
-    if b.balls_as_boxes {
-        how + balls
-    } else {
-        how
+    match (b.reported_only, b.balls) {
+        (false, _) => how,
+        (true, BallBound::NoBalls) => "P-radius of the initial box around its centre (reported \
+                                       only: the interval method propagates the box itself)"
+            .to_string(),
+        (true, _) => format!(
+            "{how} (reported only: the interval method propagates the initial set's bounding box)"
+        ),
+    }
+}
+
+/// The bound of `r1` over a box part, in words.
+fn r1_over_box(boxes: R1Method, what: &str) -> String {
+    match boxes {
+        R1Method::Vertices { active } => format!(
+            "max of |x0 - x*_0|_P over the vertices of {what} ({active} non-degenerate \
+             coordinates)"
+        ),
+        R1Method::AbsoluteSum => format!(
+            "sum_ij |P_ij| h_i h_j over {what} (more than {} coordinates)",
+            reachc_core::engine::MAX_VERTEX_COORDS
+        ),
+    }
+}
+
+/// The bound of `r1` over balls jointly with the box part's vertices, in words.
+fn r1_joint(balls: usize, boxes: R1Method) -> String {
+    let vertices = match boxes {
+        R1Method::Vertices { active: 0 } => String::new(),
+        R1Method::Vertices { active } => {
+            format!(" and the vertices of the box part ({active} non-degenerate coordinates)")
+        }
+        R1Method::AbsoluteSum => " and the box part".to_string(),
+    };
+    match (balls, boxes) {
+        (1, R1Method::Vertices { active: 0 }) => "max of |x0 - x*_0|_P over the initial ball, \
+                                                  exact: r sqrt(lambda_max(P, M)), certified by \
+                                                  interval Cholesky"
+            .to_string(),
+        (1, _) => format!(
+            "max of |x0 - x*_0|_P over the initial ball{vertices}, exact (S-lemma, one \
+             multiplier per vertex, interval arithmetic)"
+        ),
+        (m, _) => format!(
+            "upper bound of |x0 - x*_0|_P over the {m} initial balls{vertices} by the \
+             S-procedure (one multiplier per ball; not exact in general)"
+        ),
     }
 }
 
