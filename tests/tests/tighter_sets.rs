@@ -226,4 +226,18 @@ fn several_metrics_intersect_their_sets() {
     assert!(omega_far > 0.6, "{omega_far}");
     assert!(!prs.contains_at(k, &x));
     assert!(prs.contains_at(k, c));
+    // The CSV carries the intersection's box after the first metric's radii.
+    let mut csv = Vec::new();
+    reachc_runtime::report::write_csv(&prs, &mut csv).unwrap();
+    let csv = String::from_utf8(csv).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    assert_eq!(header[header.len() - 2..], ["prs_omega_lo", "prs_omega_hi"]);
+    let last: Vec<f64> = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(last[last.len() - 1], hull[1].hi);
 }

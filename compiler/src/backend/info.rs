@@ -122,11 +122,9 @@ fn one_metric(
     spec: &AnalysisSpec,
     objective: Objective,
 ) -> Result<Constants, ConstantsError> {
-    let n = model.states.len();
-    let metric = || match &spec.metric {
-        MetricChoice::Identity => Ok(identity(n)),
-        MetricChoice::Matrix(m) => Ok(m.clone()),
-        MetricChoice::Auto | MetricChoice::PerState(_) => {
+    let metric = || match given_metric(spec, model.states.len()) {
+        Some(p) => Ok(p),
+        None => {
             synthesize_metric(model, d).map(|p| metric_for_result(model, d, spec, p, objective))
         }
     };
@@ -156,10 +154,9 @@ fn local_constants(
     objective: Objective,
 ) -> Result<Constants, ConstantsError> {
     let n = model.states.len();
-    let (metric, region) = match &spec.metric {
-        MetricChoice::Identity => (identity(n), MetricRegion::Given),
-        MetricChoice::Matrix(m) => (m.clone(), MetricRegion::Given),
-        MetricChoice::Auto | MetricChoice::PerState(_) => {
+    let (metric, region) = match given_metric(spec, n) {
+        Some(p) => (p, MetricRegion::Given),
+        None => {
             let global = synthesize_metric(model, d)
                 .map(|p| metric_for_result(model, d, spec, p, objective))
                 .and_then(|p| constants(model, d, &p));
@@ -236,6 +233,15 @@ fn initial_metric(model: &Model, d: &Derivatives, step: f64) -> Vec<f64> {
     let mut at_start = model.clone();
     at_start.domain = start;
     synthesize_metric_over(&at_start, d, Interval::new(0.0, step)).unwrap_or_else(|_| identity(n))
+}
+
+/// The metric the spec gives (`identity` or a matrix); `None` for the compiler to choose.
+fn given_metric(spec: &AnalysisSpec, n: usize) -> Option<Vec<f64>> {
+    match &spec.metric {
+        MetricChoice::Identity => Some(identity(n)),
+        MetricChoice::Matrix(m) => Some(m.clone()),
+        MetricChoice::Auto | MetricChoice::PerState(_) => None,
+    }
 }
 
 fn identity(n: usize) -> Vec<f64> {

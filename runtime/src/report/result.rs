@@ -631,8 +631,22 @@ pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
         header.push_str(&csv_field(&prs.states[i]));
     }
     header.push_str(",det_radius,r_t,psi,c,sigma,prs_radius");
+    // Several metrics: the radii are the first metric's; the PRS is the intersection, whose
+    // bounding box follows.
+    let boxes = !prs.also.is_empty();
+    if boxes {
+        for &i in &shown {
+            let name = &prs.states[i];
+            let _ = write!(
+                header,
+                ",{},{}",
+                csv_field(&format!("prs_{name}_lo")),
+                csv_field(&format!("prs_{name}_hi"))
+            );
+        }
+    }
     writeln!(w, "{header}")?;
-    for s in &prs.steps {
+    for (k, s) in prs.steps.iter().enumerate() {
         let mut row = format!("{}", s.t);
         for &i in &shown {
             let _ = write!(row, ",{}", s.nominal()[i]);
@@ -647,6 +661,11 @@ pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
             s.sigma,
             s.prs_radius
         );
+        if let (true, Some(hull)) = (boxes, prs.hull_at(k)) {
+            for &i in &shown {
+                let _ = write!(row, ",{},{}", hull[i].lo, hull[i].hi);
+            }
+        }
         writeln!(w, "{row}")?;
     }
     Ok(())
