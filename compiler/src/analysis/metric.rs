@@ -124,7 +124,7 @@ fn metric_for(set: &MatrixSet, n: usize) -> Vec<f64> {
 }
 
 /// The identity, row-major.
-fn identity(n: usize) -> Vec<f64> {
+pub(crate) fn identity(n: usize) -> Vec<f64> {
     let mut p = vec![0.0; n * n];
     for i in 0..n {
         p[i * n + i] = 1.0;

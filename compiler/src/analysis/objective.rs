@@ -18,7 +18,7 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use super::contraction::constants;
-use super::metric::normalise;
+use super::metric::{identity, normalise};
 use super::Derivatives;
 use crate::model::{Method, Model};
 use reachc_core::model::{AnalysisSpec, Constants};
@@ -209,10 +209,6 @@ fn geometric(n: usize, s: f64) -> Vec<f64> {
         p[i * n + i] = s.powi(2 * i as i32);
     }
     p
-}
-
-fn identity(n: usize) -> Vec<f64> {
-    geometric(n, 1.0)
 }
 
 /// `(M + M') / 2`, row-major.

@@ -40,6 +40,10 @@ pub(crate) const MAX_STATES: usize = 64;
 /// The most epochs of the mixture tube (as for the AMGF tube).
 const MAX_EPOCHS: usize = 64;
 
+/// The most pieces a report step is cut into to enclose `e^(-A theta)` over it (the mixture
+/// tube's bound between report times); beyond, the mixture tube is not offered.
+const MAX_PIECES: usize = 64;
+
 /// Taylor terms are added until the remainder is below this (relative to the leading term).
 const REMAINDER: f64 = 1e-20;
 
@@ -72,9 +76,10 @@ pub(super) fn radii(run: &Run, times: &[f64]) -> Option<GaussianRadii> {
     let lin = Linear::of(run)?;
     let n = lin.n;
     let quantile = chi2_quantile_upper(n, run.spec.delta);
-    // Sigma at every report time, and the steps' flows (reused while the step repeats).
+    // Sigma at every report time and the steps' lengths (the flow is reused while the step
+    // repeats).
     let mut sigma = Vec::with_capacity(times.len());
-    let mut flows: Vec<(Interval, Mat)> = Vec::with_capacity(times.len());
+    let mut steps = Vec::with_capacity(times.len());
     let mut cur = vec![Interval::ZERO; n * n];
     let mut t0 = 0.0;
     let mut cache: Option<(Interval, Mat, Mat)> = None;
@@ -90,7 +95,7 @@ pub(super) fn radii(run: &Run, times: &[f64]) -> Option<GaussianRadii> {
         };
         cur = add(&congruence(&phi, &cur, n), &q);
         sigma.push(cur.clone());
-        flows.push((h, phi));
+        steps.push(h);
         t0 = t;
     }
     let lam: Vec<f64> = sigma.iter().map(|s| lin.lambda(s)).collect();
@@ -102,7 +107,7 @@ pub(super) fn radii(run: &Run, times: &[f64]) -> Option<GaussianRadii> {
         .iter()
         .map(|&l| (q * Interval::point(l.max(0.0))).sqrt().hi())
         .collect();
-    let uniform = lin.mixture(run, times, &sigma, &flows, &lam);
+    let uniform = lin.mixture(run, times, &sigma, &steps, &lam);
     Some(GaussianRadii {
         quantile,
         pointwise,
@@ -190,12 +195,15 @@ impl Linear {
         (phi, q)
     }
 
-    /// An enclosure of `e^(s A theta)` for every `theta` in `[0, h]`.
-    fn flow_over(&self, s: f64, h: Interval) -> Mat {
+    /// An enclosure of `e^(s A theta)` for every `theta` in `[0, h]`, or `None` when that takes
+    /// more than [`MAX_PIECES`] pieces (a stiff `A` against the report step).
+    fn flow_over(&self, s: f64, h: Interval) -> Option<Mat> {
         let norm = self.norm();
-        let pieces = ((Interval::point(norm) * h).hi() / 0.5)
-            .ceil()
-            .clamp(1.0, 1e6) as usize;
+        let pieces = ((Interval::point(norm) * h).hi() / 0.5).ceil().max(1.0);
+        if pieces > MAX_PIECES as f64 {
+            return None;
+        }
+        let pieces = pieces as usize;
         let sub = Interval::new(0.0, (h / Interval::point(pieces as f64)).hi());
         let (over, _) = self.taylor(s, sub, norm);
         let (step, _) = self.flow(s, h / Interval::point(pieces as f64));
@@ -207,7 +215,7 @@ impl Linear {
             let part = product(&start, &over, self.n, self.n, self.n);
             hull = hull.iter().zip(&part).map(|(a, b)| a.hull(*b)).collect();
         }
-        hull
+        Some(hull)
     }
 
     /// Taylor enclosures for `(norm h) <= 1/2` (`norm` from [`Linear::norm`]): the partial sums
@@ -257,13 +265,14 @@ impl Linear {
     }
 
     /// The mixture tube (see the module documentation), or `None` when `Sigma` is singular at
-    /// the first report time (then `H` would not be positive definite).
+    /// the first report time (then `H` would not be positive definite) or `A` is too stiff for
+    /// the report step ([`MAX_PIECES`]).
     fn mixture(
         &self,
         run: &Run,
         times: &[f64],
         sigma: &[Mat],
-        flows: &[(Interval, Mat)],
+        steps: &[Interval],
         lam: &[f64],
     ) -> Option<(Vec<(f64, f64)>, usize)> {
         let n = self.n;
@@ -300,11 +309,11 @@ impl Linear {
             // B at the epoch's end is Sigma there; backwards with e^(-A h).
             let mut b = sigma[end].clone();
             for idx in (start..=end).rev() {
-                let (h, _) = &flows[idx];
+                let h = &steps[idx];
                 let at = add(&sigma[idx], &scale(&b, eta));
                 let r_end = (beta * Interval::point(self.lambda(&at))).sqrt().hi();
                 // Over (t_(idx-1), t_idx]: Sigma at most its end's, B_t = e^(-A th) B e^(-A' th).
-                let back_over = self.flow_over(-1.0, *h);
+                let back_over = self.flow_over(-1.0, *h)?;
                 let b_over = self.lambda(&congruence(&back_over, &b, n));
                 let over = (beta
                     * (Interval::point(lam[idx]) + eta * Interval::point(b_over.max(0.0))))
