@@ -80,11 +80,14 @@ pub struct Prs {
     /// With local rates, the region of each internal step and the rates certified on it (empty
     /// otherwise).
     pub regions: Vec<RateRegion>,
-    /// The results of the analysis' further metrics (`metric = auto(states = [..])`, method.md
-    /// section 8.6), on the same report times. With `K = 1 + also.len()` metrics, this result's
-    /// sets and theirs are each computed at `delta / K`, and the PRS is their intersection:
-    /// [`Prs::contains`], [`Prs::span_contains`], [`Prs::hull`], the margins and the verdicts
-    /// answer for the intersection ([`Prs::delta`] is the analysis' `delta`).
+    /// Further results of the same run, on the same report times, the PRS their intersection
+    /// with this one: [`Prs::contains`], [`Prs::span_contains`], [`Prs::hull`], the margins and
+    /// the verdicts answer for the intersection ([`Prs::delta`] is the analysis' `delta`).
+    /// They are the analysis' further metrics (`metric = auto(states = [..])`, method.md
+    /// section 8.6: with `K` metrics each computed at `delta / K`), and for a contraction
+    /// analysis with global rates the interval method's box of each metric's run (section
+    /// 8.7: same stochastic event, so at that metric's `delta`); each member's `delta` says
+    /// which.
     pub also: Vec<Prs>,
     /// Advice on the result (interval method: a wrapping box, a box leaving the domain).
     pub hints: Vec<Hint>,
@@ -683,7 +686,7 @@ impl Prs {
     }
 
     /// [`Prs::hull_at`] for this result's own metric.
-    fn own_hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
+    pub(crate) fn own_hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
         let st = &self.steps[k];
         let n = self.n();
         let w = &self.constants.spread;

@@ -8,7 +8,7 @@ use reachc_core::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
     ModelInfo, RadiusRule, Rate, Transform, TransformSource, UnsafeSet, UnsafeShape,
 };
-use reachc_core::prs::{BallBound, DetSet, Prs, Unproved, UnsafeKind, Verdict};
+use reachc_core::prs::{BallBound, DetSet, Prs, Span, Unproved, UnsafeKind, Verdict};
 use reachc_core::{InputPlan, Reach, System};
 
 // ---------------------------------------------------------------------------------------------
@@ -262,6 +262,11 @@ fn pendulum_setup() -> (Pendulum, ModelInfo, Analysis) {
     // The paper's constants (Sec. VIII-B).
     let constants = Constants::given(&inf, PENDULUM_P.to_vec(), -0.5, 0.1130, 0.0);
     (Pendulum, inf, analysis(1e-3, 4.0, 0.01, constants))
+}
+
+/// A result and the results it is intersected with.
+fn members(res: &Prs) -> impl Iterator<Item = &Prs> {
+    std::iter::once(res).chain(&res.also)
 }
 
 fn step_at(res: &Prs, t: f64) -> usize {
@@ -543,10 +548,16 @@ fn safety_against_boxes_and_balls() {
             let (x, r) = (prev.nominal()[0], prev.prs_radius);
             assert!(span.lo[0] - span.radius <= x - r && x + r <= span.hi[0] + span.radius);
         }
-        let (lo, hi) = (span.lo[0] - span.radius, span.hi[0] + span.radius);
-        let box_gap = 5.0 - hi;
+        // The intersection with the interval box (method.md 8.7): the larger margin.
+        let gaps = members(&res).map(|m| {
+            let span = &m.steps[k].span;
+            let (lo, hi) = (span.lo[0] - span.radius, span.hi[0] + span.radius);
+            (5.0 - hi, (lo + 4.0) - 1.0)
+        });
+        let (box_gap, ball_gap) = gaps.fold((f64::NEG_INFINITY, f64::NEG_INFINITY), |a, b| {
+            (a.0.max(b.0), a.1.max(b.1))
+        });
         assert!(st.margins[0] <= box_gap && box_gap - st.margins[0] < 1e-12);
-        let ball_gap = (lo + 4.0) - 1.0;
         assert!(st.margins[1] <= ball_gap && ball_gap - st.margins[1] < 1e-12);
     }
     assert!(res.unsafe_sets[0].safe && res.unsafe_sets[1].safe);
@@ -589,22 +600,10 @@ fn pendulum_half_space_uses_inverse_metric() {
     // lambda_max of the 2x2 inverse.
     let (tr, dt) = (pinv[0] + pinv[3], pinv[0] * pinv[3] - pinv[1] * pinv[2]);
     let lmax = tr / 2.0 + (tr * tr / 4.0 - dt).sqrt();
-    for st in &res.steps {
-        // Margins over the report interval: of its span, the box [lo, hi] plus the P-ball of
-        // radius r (the PRS at t lies in it: checked below against its boundary).
-        let (lo, hi, r) = (&st.span.lo, &st.span.hi, st.span.radius);
-        // At t = 0 the set is the initial box itself (span radius 0), later a P-ball.
-        if matches!(st.det, DetSet::Ball { .. }) {
-            assert!(r >= st.prs_radius);
-        }
-        let e0 = 1.0 - hi[0] - r * pinv[0].sqrt();
-        assert!(
-            st.margins[0] <= e0 && e0 - st.margins[0] < 1e-12,
-            "{} {e0}",
-            st.margins[0]
-        );
-        let e1 = 3.0 - (hi[1] + r * pinv[3].sqrt());
-        assert!(st.margins[1] <= e1 && e1 - st.margins[1] < 1e-12);
+    // Margins over the report interval: of its span, the box [lo, hi] plus the P-ball of
+    // radius r (the PRS at t lies in it: checked below against its boundary).
+    let want = |span: &Span| {
+        let (lo, hi, r) = (&span.lo, &span.hi, span.radius);
         // A ball: the larger of two lower bounds of the gap, through the ellipse's spread
         // and through its bounding box.
         let gap = |c: f64, a: f64, b: f64| (a - c).max(c - b).max(0.0);
@@ -614,12 +613,30 @@ fn pendulum_half_space_uses_inverse_metric() {
         };
         let by_spread = dist(0.0, 0.0) - r * lmax.sqrt() - 0.5;
         let by_box = dist(r * pinv[0].sqrt(), r * pinv[3].sqrt()) - 0.5;
-        let want = by_spread.max(by_box);
-        assert!(
-            st.margins[2] <= want && want - st.margins[2] < 1e-9,
-            "{} {want}",
-            st.margins[2]
-        );
+        [
+            1.0 - hi[0] - r * pinv[0].sqrt(),
+            3.0 - (hi[1] + r * pinv[3].sqrt()),
+            by_spread.max(by_box),
+        ]
+    };
+    for (k, st) in res.steps.iter().enumerate() {
+        // At t = 0 the set is the initial box itself (span radius 0), later a P-ball.
+        if matches!(st.det, DetSet::Ball { .. }) {
+            assert!(st.span.radius >= st.prs_radius);
+        }
+        // The intersection with the interval box (method.md 8.7): the larger margin.
+        let wants = members(&res).map(|m| want(&m.steps[k].span));
+        let e = wants.fold([f64::NEG_INFINITY; 3], |a, b| {
+            [0, 1, 2].map(|j| a[j].max(b[j]))
+        });
+        for (j, tol) in [(0, 1e-12), (1, 1e-12), (2, 1e-9)] {
+            assert!(
+                st.margins[j] <= e[j] && e[j] - st.margins[j] < tol,
+                "{j}: {} {}",
+                st.margins[j],
+                e[j]
+            );
+        }
         if !matches!(st.det, DetSet::Ball { .. }) {
             continue;
         }
@@ -830,6 +847,12 @@ fn reach_from_a_box_is_the_run_from_that_box() {
     let reach = Reach::new(&sys, &inf, "main").unwrap();
     let x0 = [Bounds::new(0.1, 0.2), Bounds::new(-0.05, 0.0)];
     let prs = reach.from_box(&x0).unwrap();
+    // The ball's own questions (the interval box it is intersected with is checked in
+    // tests/tests/tighter_sets.rs).
+    let prs = Prs {
+        also: Vec::new(),
+        ..prs
+    };
     let mut moved = inf.clone();
     moved.initial = InitialSet::from_box(&x0);
     let direct = engine::run(&sys, &moved, &moved.analyses[0]).unwrap();

@@ -5,7 +5,7 @@
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::driver::{check_source, load};
 use reachc_e2e::{interpreter_of, shipped, shipped_specs, workspace};
-use reachc_runtime::model::ModelInfo;
+use reachc_runtime::model::{Method, ModelInfo};
 use reachc_runtime::prs::{Proved, UniformBound};
 use reachc_runtime::simulate::{
     self, clopper_pearson_lower as lower_bound, clopper_pearson_upper as upper_bound, Options,
@@ -202,9 +202,17 @@ fn the_initial_box_is_the_set_at_time_zero() {
 fn several_metrics_intersect_their_sets() {
     let (sys, info) = shipped("pendulum.sde");
     let prs = Reach::new(&sys, &info, "per_state").unwrap().run().unwrap();
-    assert_eq!(prs.also.len(), 1);
+    // The second metric's ball, and each metric's interval box (section 8.7).
+    let balls: Vec<&Prs> = prs
+        .also
+        .iter()
+        .filter(|m| m.method == Method::Contraction)
+        .collect();
+    assert_eq!((balls.len(), prs.also.len()), (1, 3));
     assert_eq!(prs.delta, 1e-3);
-    assert_eq!(prs.also[0].delta, (1e-3f64 / 2.0).next_down());
+    for m in &prs.also {
+        assert_eq!(m.delta, (1e-3f64 / 2.0).next_down());
+    }
     let k = prs.steps.len() - 1;
     let hull = prs.hull_at(k).unwrap();
     let (theta, omega) = (
@@ -215,7 +223,7 @@ fn several_metrics_intersect_their_sets() {
         theta <= 0.12 && omega <= 0.60,
         "theta {theta}, omega {omega}"
     );
-    let theirs = prs.also[0].hull_at(k).unwrap();
+    let theirs = balls[0].hull_at(k).unwrap();
     assert!(theirs[1].hi >= hull[1].hi && theirs[0].hi >= hull[0].hi);
     // A point of the first metric's ball along omega, beyond the intersection's box.
     let st = &prs.steps[k];
@@ -240,4 +248,60 @@ fn several_metrics_intersect_their_sets() {
         .map(|v| v.parse().unwrap())
         .collect();
     assert_eq!(last[last.len() - 1], hull[1].hi);
+}
+
+/// Intersect what is known (method.md section 8.7): the pendulum's contraction ball is cut by
+/// the interval box of the same run, widened by the same radii at the same delta. At t = 1.2
+/// omega's half-width falls from 1.9 (the ball) to 0.8; a point of the ball outside the box
+/// is outside the PRS; and the intersection holds for simulated paths at delta = 0.1.
+#[test]
+fn the_contraction_ball_is_cut_by_the_interval_box() {
+    let (sys, info) = shipped("pendulum.sde");
+    let reach = Reach::new(&sys, &info, "contraction").unwrap();
+    let prs = reach.run().unwrap();
+    assert_eq!(prs.also.len(), 1);
+    let boxes = &prs.also[0];
+    assert_eq!((boxes.method, boxes.delta), (Method::Interval, prs.delta));
+    // The same stochastic radii widen both sets.
+    for (a, b) in prs.steps.iter().zip(&boxes.steps) {
+        assert_eq!((a.t, a.r_t), (b.t, b.r_t));
+    }
+    let k = prs.step_index(1.2).unwrap();
+    let ball = Prs {
+        also: Vec::new(),
+        ..prs.clone()
+    };
+    let half = |p: &Prs| {
+        let h = p.hull_at(k).unwrap();
+        (0.5 * (h[0].hi - h[0].lo), 0.5 * (h[1].hi - h[1].lo))
+    };
+    let (own, cut) = (half(&ball), half(&prs));
+    assert!(
+        own.1 > 1.8 && cut.1 < 0.85,
+        "ball {own:?}, intersection {cut:?}"
+    );
+    assert!(cut.0 <= own.0);
+    // Along omega from the nominal state: in the ball, beyond the box.
+    let c = prs.steps[k].det.center().to_vec();
+    let x = [c[0], c[1] + 1.5 * cut.1];
+    assert!(ball.contains_at(k, &x) && !prs.contains_at(k, &x));
+    assert!(prs.contains_at(k, &c));
+
+    let prs = reach.with_delta(0.1).unwrap().run().unwrap();
+    assert_eq!(prs.also.len(), 1);
+    let paths = 4000;
+    let opts = Options {
+        paths,
+        seed: 5,
+        ..Options::default()
+    };
+    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    for step in &report.steps {
+        assert!(
+            lower_bound(step.outside, paths, 1e-4) <= 0.1,
+            "t = {}: {} of {paths} outside",
+            step.t,
+            step.outside
+        );
+    }
 }

@@ -62,7 +62,8 @@ pub(super) struct Header {
 
 /// The stochastic radius at each report time and its largest value over the report interval
 /// ending there, for the run's guarantee; and the pointwise `Psi`, `r` at each report time.
-struct Radii {
+#[derive(Clone)]
+pub(super) struct Radii {
     /// Per report time after 0: `(Psi upper, pointwise r)`.
     pointwise: Vec<(f64, f64)>,
     /// Per report time after 0: `(radius at it, largest radius over its report interval)` of
@@ -75,7 +76,8 @@ struct Radii {
 }
 
 impl Radii {
-    fn new(run: &Run, det: &Deterministic, kappa: f64) -> Radii {
+    /// The radii of a run whose deterministic part is `det`, with the factor `kappa`.
+    pub(super) fn new(run: &Run, det: &Deterministic, kappa: f64) -> Radii {
         let mut stochastic = Stochastic::new(kappa);
         let mut t0 = 0.0;
         let mut pointwise = Vec::new();
@@ -170,13 +172,25 @@ fn amgf_tube(run: &Run, det: &Deterministic) -> (Vec<(f64, f64)>, usize) {
 /// The result of a run: the radii along the internal steps, the PRS at each report time and
 /// over each report interval, the margins over the intervals, and the verdicts.
 pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Option<Found>) -> Prs {
+    let radii = Radii::new(run, &det, header.kappa);
+    assemble_with(run, det, header, local, radii)
+}
+
+/// [`assemble`] with the stochastic radii of another deterministic part of the same run (they
+/// bound the same process, so they hold for any set holding the noise-free solutions).
+pub(super) fn assemble_with(
+    run: &Run,
+    det: Deterministic,
+    header: Header,
+    local: Option<Found>,
+    radii: Radii,
+) -> Prs {
     let setup = run.setup;
     let w = spread(run);
     let context = Context {
         w: &w,
         frame: det.frame.as_ref(),
     };
-    let radii = Radii::new(run, &det, header.kappa);
     let margins = |span: &Span| -> Vec<f64> {
         setup
             .checks

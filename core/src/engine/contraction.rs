@@ -3,13 +3,20 @@
 //! zero for an exact solution): on validated steps by default (`defect.rs`), or one
 //! unvalidated RK4 or Euler step per report step when the spec asks for it.
 
-use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
+use super::assemble::{
+    assemble_with, constants_used, rate_used, Deterministic, Header, Piece, Radii,
+};
 use super::defect::{Nominal, NominalStep};
+use super::intersect::intersect;
 use super::radius::expm1_over;
-use super::{local, nominal, r1, radius, rates, Run, RunError};
+use super::{interval, local, nominal, r1, radius, rates, Run, RunError};
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
 use crate::prs::{DetSet, Proved, Prs, Span, Unproved};
+
+/// The largest model whose contraction runs also compute the interval box (method.md 8.7):
+/// the embedding evaluates `2 n` faces per step, beyond this it costs far more than the ball.
+pub const MAX_BOX_STATES: usize = 100;
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -125,7 +132,44 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         rigorous,
         not_validated,
     };
-    Ok(assemble(run, det, header, local))
+    // The interval method's boxes of the same run, when they cut the ball somewhere
+    // (method.md section 8.7): both sets hold the noise-free solutions, so the same stochastic
+    // radii widen both and the PRS is their intersection at the same delta.
+    // (Validated runs only: the box must not add an unproved step.)
+    let boxes = (validated && n <= MAX_BOX_STATES)
+        .then(|| interval::deterministic(run, spec.inclusion).ok())
+        .flatten();
+    let radii = Radii::new(run, &det, header.kappa);
+    let rate = header.rate.clone();
+    let rates_proved = header.rigorous[0].clone();
+    let ball = assemble_with(run, det, header, local, radii.clone());
+    let Some((det, mut header)) = boxes else {
+        return Ok(ball);
+    };
+    header.rate = rate;
+    header.rigorous[0] = rates_proved;
+    let boxes = assemble_with(run, det, header, None, radii);
+    Ok(if cuts(&ball, &boxes) {
+        intersect(run.info, &run.setup.checks, spec.delta, ball, vec![boxes])
+    } else {
+        ball
+    })
+}
+
+/// Whether `boxes` makes `ball` smaller somewhere: a tighter bound of a coordinate at a report
+/// time, or a larger safety margin.
+fn cuts(ball: &Prs, boxes: &Prs) -> bool {
+    ball.steps
+        .iter()
+        .zip(&boxes.steps)
+        .enumerate()
+        .any(|(k, (a, b))| {
+            let tighter = match (ball.own_hull_at(k), boxes.own_hull_at(k)) {
+                (Some(x), Some(y)) => x.iter().zip(&y).any(|(x, y)| y.lo > x.lo || y.hi < x.hi),
+                _ => false,
+            };
+            tighter || a.margins.iter().zip(&b.margins).any(|(x, y)| y > x)
+        })
 }
 
 /// The pieces along the nominal's steps, `R` following `R' = c R + rho r2 + |d|_P` with the

@@ -18,6 +18,15 @@ pub(crate) fn intersect(
     mut first: Prs,
     others: Vec<Prs>,
 ) -> Prs {
+    // One level of members: a member's own members join the list (their margins are already
+    // in the member's).
+    let mut members = std::mem::take(&mut first.also);
+    for mut other in others {
+        let theirs = std::mem::take(&mut other.also);
+        members.push(other);
+        members.extend(theirs);
+    }
+    let others = members;
     for (k, step) in first.steps.iter_mut().enumerate() {
         for other in &others {
             let theirs = &other.steps[k];

@@ -37,6 +37,42 @@ use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
 pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
+    let (mut det, mut header) = deterministic(run, inclusion)?;
+    // Local rates: certified per step on the box widened by the tube.
+    let local = if run.spec.rate == Rate::Local {
+        let pieces = &mut det.pieces;
+        let local = local::passes(run, |stepper| {
+            let mut t0 = 0.0;
+            let mut rates = Vec::with_capacity(pieces.len());
+            for p in pieces.iter() {
+                let r = stepper.step(&p.over.lo, &p.over.hi, (t0, p.t1), |_| p.over.radius)?;
+                rates.push((r.c, r.sigma));
+                t0 = p.t1;
+            }
+            let first = pieces.iter().position(|p| p.end.is_some()).unwrap_or(0) + 1;
+            Ok((rates, first))
+        })?;
+        for (p, &r) in pieces.iter_mut().zip(&local.result) {
+            p.rates = r;
+        }
+        let found = local::Found::of(&local);
+        det.tube = Some(found.tube.clone());
+        header.rate = rate_used(run.spec.rate, &det.pieces, Some(&found));
+        Some(found)
+    } else {
+        None
+    };
+    let mut prs = assemble(run, det, header, local);
+    prs.hints = hints::interval(run, &prs);
+    Ok(prs)
+}
+
+/// The deterministic part of an interval run (the embedding's boxes on its steps, with the
+/// compiler's constant rates) and what its result says besides the sets.
+pub(super) fn deterministic(
+    run: &Run,
+    inclusion: Inclusion,
+) -> Result<(Deterministic, Header), RunError> {
     let (spec, consts, n) = (run.spec, run.setup.consts, run.setup.n);
     let metric = &consts.metric;
     let grid = nominal::time_grid(spec.horizon, spec.step);
@@ -95,7 +131,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         }
     };
     let internal = steps.len();
-    let mut pieces: Vec<Piece> = steps
+    let pieces: Vec<Piece> = steps
         .into_iter()
         .map(|step| {
             let (lo, hi) = x_box(&step.over_lo, &step.over_hi);
@@ -111,26 +147,6 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
             }
         })
         .collect();
-    // Local rates: certified per step on the box widened by the tube.
-    let local = if spec.rate == Rate::Local {
-        let local = local::passes(run, |stepper| {
-            let mut t0 = 0.0;
-            let mut rates = Vec::with_capacity(pieces.len());
-            for p in &pieces {
-                let r = stepper.step(&p.over.lo, &p.over.hi, (t0, p.t1), |_| p.over.radius)?;
-                rates.push((r.c, r.sigma));
-                t0 = p.t1;
-            }
-            let first = pieces.iter().position(|p| p.end.is_some()).unwrap_or(0) + 1;
-            Ok((rates, first))
-        })?;
-        for (p, &r) in pieces.iter_mut().zip(&local.result) {
-            p.rates = r;
-        }
-        Some(local::Found::of(&local))
-    } else {
-        None
-    };
     let transform = frame.as_ref().map(Frame::used);
     let validated = spec.integrator == Integrator::Validated;
     let mut rigorous = vec![
@@ -174,12 +190,12 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         start: det_set(start),
         pieces,
         frame,
-        tube: local.as_ref().map(|found| found.tube.clone()),
+        tube: None,
     };
     let header = Header {
         method: Method::Interval,
         inclusion: Some(inclusion),
-        rate: rate_used(spec.rate, &det.pieces, local.as_ref()),
+        rate: rate_used(spec.rate, &det.pieces, None),
         constants: constants_used(run, consts.rho),
         radius_rule,
         kappa,
@@ -195,9 +211,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
         rigorous,
         not_validated,
     };
-    let mut prs = assemble(run, det, header, local);
-    prs.hints = hints::interval(run, &prs);
-    Ok(prs)
+    Ok((det, header))
 }
 
 /// The input box of each report step: the model's box, or the plan's point.

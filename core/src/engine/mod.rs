@@ -36,6 +36,7 @@ mod safety;
 pub(crate) mod transform;
 mod uniform;
 
+pub use contraction::MAX_BOX_STATES;
 pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
 pub use r1::MAX_BALL_STATES;
