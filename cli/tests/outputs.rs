@@ -7,59 +7,29 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use common::{reachc, spec};
+use common::reachc;
 
-/// `x' = 400 x` with unit noise from 0, global rate: `r_t` overflows after about t = 1.7.
-/// `short` stops before, `long` does not.
-const GROWING: &str = "model growing
-state x = 0
-noise w
-drift {
-    x' = 400 * x
-}
-diffusion {
-    x: w
-}
-analysis short {
-    method = contraction
-    horizon = 0.5
-    step = 0.1
-    rate = global
-}
-analysis long {
-    method = contraction
-    horizon = 2
-    step = 0.1
-    rate = global
-}
-";
+/// `x' = 400 x` from 0 with a global rate: analysis `short` runs, `long`'s radius overflows.
+const GROWING: &str = "radius_overflow.sde";
+/// A decay through an unsafe half-space: not shown safe, first at t = 0.3.
+const THROUGH: &str = "not_shown_safe.sde";
 
-/// A decay towards 0 from 1 through the unsafe half-space `x <= 0.5`: not shown safe, first on
-/// the report interval ending at t = 0.3 (0.30000000000000004 as computed).
-const THROUGH: &str = "model through
-state x = 1
-noise w
-drift {
-    x' = -3 * x
-}
-diffusion {
-    x: 0.01 * w
-}
-unsafe low halfspace { x <= 0.5 }
-analysis contraction {
-    method = contraction
-    horizon = 1
-    step = 0.1
-}
-";
-
-/// A fresh directory for one test, with `spec.sde` holding `spec`.
+/// A fresh directory for one test, with `spec.sde` a copy of `tests/good/SPEC`.
 fn scratch(name: &str, spec: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("reachc-outputs-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("spec.sde"), spec).unwrap();
+    let good = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/good");
+    std::fs::copy(good.join(spec), dir.join("spec.sde")).unwrap();
     dir
+}
+
+/// `reachc simulate DIR/spec.sde --backend interp EXTRA...`.
+fn simulate_interp(dir: &Path, extra: &[&str]) -> Output {
+    let spec = dir.join("spec.sde");
+    let mut args = vec!["simulate", s(&spec), "--backend", "interp"];
+    args.extend_from_slice(extra);
+    reachc(&args)
 }
 
 fn s(p: &Path) -> &str {
@@ -142,19 +112,10 @@ fn a_result_that_is_not_finite_is_an_error_of_its_analysis() {
     );
     assert!(!out.exists());
     // simulate: the same error, nothing written.
-    let spec = dir.join("spec.sde");
-    let o = reachc(&[
-        "simulate",
-        s(&spec),
-        "--backend",
-        "interp",
-        "--paths",
-        "10",
-        "--analysis",
-        "long",
-        "-o",
-        s(&out),
-    ]);
+    let o = simulate_interp(
+        &dir,
+        &["--paths", "10", "--analysis", "long", "-o", s(&out)],
+    );
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("error: analysis `long`: the PRS is not finite from t = 1.8"));
     assert!(!out.exists());
@@ -167,7 +128,6 @@ fn write_errors_exit_2_and_write_nothing() {
     let file = dir.join("a-file");
     std::fs::write(&file, "mine").unwrap();
     let long = dir.join("n".repeat(300));
-    let spec = dir.join("spec.sde");
     for target in [file.clone(), PathBuf::from("/proc/reachc-out"), long] {
         let o = run_interp(&dir, &["-o", s(&target)]);
         assert_eq!(
@@ -178,16 +138,7 @@ fn write_errors_exit_2_and_write_nothing() {
             text(&o)
         );
         assert!(text(&o).contains("(nothing written)"), "{}", text(&o));
-        let o = reachc(&[
-            "simulate",
-            s(&spec),
-            "--backend",
-            "interp",
-            "--paths",
-            "20",
-            "-o",
-            s(&target),
-        ]);
+        let o = simulate_interp(&dir, &["--paths", "20", "-o", s(&target)]);
         assert_eq!(
             o.status.code(),
             Some(2),
@@ -236,23 +187,15 @@ fn messages_count_in_the_singular_and_plural() {
         String::from_utf8_lossy(&o.stdout),
         "ok: model `through` (1 state, 0 inputs, 1 noise channel, 1 analysis)\n"
     );
-    let o = reachc(&["check", &spec("linear.sde")]);
+    let o = reachc(&["check", &common::spec("linear.sde")]);
     assert_eq!(
         String::from_utf8_lossy(&o.stdout),
-        "ok: model `linear` (2 states, 0 inputs, 2 noise channels, 4 analyses)\n"
+        "ok: model `linear` (2 states, 0 inputs, 2 noise channels, 3 analyses)\n"
     );
-    let o = reachc(&[
-        "simulate",
-        s(&spec),
-        "--backend",
-        "interp",
-        "--paths",
-        "1",
-        "--threads",
-        "1",
-        "-o",
-        s(&dir.join("out")),
-    ]);
+    let o = simulate_interp(
+        &dir,
+        &["--paths", "1", "--threads", "1", "-o", s(&dir.join("out"))],
+    );
     let t = text(&o);
     assert!(
         t.contains("  1 path (seed 0), Euler-Maruyama with dt = 0.1 (10 steps per path)"),

@@ -3,45 +3,14 @@
 //! crate is compiled. The CLI's codes are checked in cli/tests/outputs.rs.
 
 use reachc_compiler::driver::load;
-use reachc_e2e::interpreter_of;
+use reachc_e2e::{interpreter_of, workspace};
 use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_UNSAFE, EXIT_USAGE};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-/// A decay through the unsafe half-space `x <= 0.5`: not shown safe.
-const THROUGH: &str = "model through
-state x = 1
-noise w
-drift {
-    x' = -3 * x
-}
-diffusion {
-    x: 0.01 * w
-}
-unsafe low halfspace { x <= 0.5 }
-analysis contraction {
-    method = contraction
-    horizon = 1
-    step = 0.1
-}
-";
-
-/// `x' = 400 x` with a global rate: the radius overflows after about t = 1.7.
-const GROWING: &str = "model growing
-state x = 0
-noise w
-drift {
-    x' = 400 * x
-}
-diffusion {
-    x: w
-}
-analysis long {
-    method = contraction
-    horizon = 2
-    step = 0.1
-    rate = global
-}
-";
+/// A decay through an unsafe half-space: not shown safe.
+const THROUGH: &str = "not_shown_safe.sde";
+/// `x' = 400 x` from 0 with a global rate: the radius of analysis `long` overflows.
+const GROWING: &str = "radius_overflow.sde";
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("reachc-exit-{}-{name}", std::process::id()));
@@ -50,10 +19,9 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// Runs the binary's command line `args` on `spec`; its exit code and stderr.
-fn binary(dir: &Path, spec: &str, args: &[&str]) -> (u8, String) {
-    let path = dir.join("spec.sde");
-    std::fs::write(&path, spec).unwrap();
+/// Runs the binary's command line `args` on `tests/good/SPEC`; its exit code and stderr.
+fn binary(spec: &str, args: &[&str]) -> (u8, String) {
+    let path = workspace().join("tests/good").join(spec);
     let (sys, info) = interpreter_of(load(&path).unwrap().model);
     let args: Vec<String> = args.iter().map(|a| a.to_string()).collect();
     let (mut out, mut err) = (Vec::new(), Vec::new());
@@ -67,22 +35,21 @@ fn generated_binaries_follow_the_exit_code_policy() {
     let out = dir.join("out");
     let o = out.to_str().unwrap();
     // Not shown safe: 0, or 3 with --deny-unsafe (the results written).
-    assert_eq!(binary(&dir, THROUGH, &["-o", o, "-q"]).0, EXIT_OK);
+    assert_eq!(binary(THROUGH, &["-o", o, "-q"]).0, EXIT_OK);
     std::fs::remove_dir_all(&out).unwrap();
-    let (code, err) = binary(&dir, THROUGH, &["-o", o, "-q", "--deny-unsafe"]);
+    let (code, err) = binary(THROUGH, &["-o", o, "-q", "--deny-unsafe"]);
     assert_eq!(code, EXIT_UNSAFE, "{err}");
     assert_eq!(EXIT_UNSAFE, 3);
     assert!(out.join("contraction.json").is_file());
     // A file in place of the output folder: an I/O error, 2, the file untouched.
     let file = dir.join("file");
     std::fs::write(&file, "mine").unwrap();
-    let (code, err) = binary(&dir, THROUGH, &["-o", file.to_str().unwrap()]);
+    let (code, err) = binary(THROUGH, &["-o", file.to_str().unwrap()]);
     assert_eq!(code, EXIT_USAGE, "{err}");
     assert!(err.contains("(nothing written)"), "{err}");
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "mine");
     // The same for simulate.
     let (code, err) = binary(
-        &dir,
         THROUGH,
         &[
             "simulate",
@@ -95,11 +62,11 @@ fn generated_binaries_follow_the_exit_code_policy() {
     );
     assert_eq!(code, EXIT_USAGE, "{err}");
     // An unknown analysis: a usage error.
-    let (code, err) = binary(&dir, THROUGH, &["--analysis", "nope", "-o", o]);
+    let (code, err) = binary(THROUGH, &["--analysis", "nope", "-o", o]);
     assert_eq!(code, EXIT_USAGE, "{err}");
     // A result that is not finite: the analysis failed, nothing written.
     let fresh = dir.join("fresh");
-    let (code, err) = binary(&dir, GROWING, &["-q", "-o", fresh.to_str().unwrap()]);
+    let (code, err) = binary(GROWING, &["-q", "-o", fresh.to_str().unwrap()]);
     assert_eq!(code, EXIT_FAILED, "{err}");
     assert!(
         err.contains("the PRS is not finite from t = 1.8 on"),

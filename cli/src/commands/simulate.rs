@@ -244,7 +244,7 @@ mod tests {
 
     #[test]
     fn rates_print_three_significant_digits() {
-        assert_eq!(rate(17_297_925.3962), "17.3 M paths/s");
+        assert_eq!(rate(17_297_925.396_2), "17.3 M paths/s");
         assert_eq!(rate(1_234.5), "1.23 k paths/s");
         assert_eq!(rate(999.0), "999 paths/s");
         assert_eq!(rate(2.5e9), "2.50 G paths/s");

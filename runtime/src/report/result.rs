@@ -1,6 +1,6 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
-use super::{csv_field, num, summary_indices, time};
+use super::{count, csv_field, num, summary_indices, time};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
 use reachc_core::prs::{
     BallBound, DetSet, Hint, Proved, Prs, R1Method, Step, TransformUsed, UniformBound, Unproved,
@@ -528,13 +528,15 @@ fn proved(p: &Proved) -> String {
              contraction rate): the sets hold over whole steps, not only at report times"
         ),
         Proved::ValidatedEmbedding { steps } => format!(
-            "embedding system on {steps} validated steps (the comparison principle on each \
+            "embedding system on {} (the comparison principle on each \
              step's hull, time as an interval): the boxes hold over whole steps, not only at \
-             report times"
+             report times",
+            count(*steps as u64, "validated step")
         ),
         Proved::LocalRates { regions, metric } => format!(
-            "local rates on {regions} regions, each holding the tube over its step, so the \
-             process never leaves them on the tube's event (metric {metric})"
+            "local rates on {}, each holding the tube over its step, so the process never \
+             leaves them on the tube's event (metric {metric})",
+            count(*regions as u64, "region")
         ),
         Proved::UniformTube { epochs } => format!(
             "time-uniform tube: Ville's inequality on the averaged-MGF supermartingale over \
