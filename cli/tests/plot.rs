@@ -263,7 +263,8 @@ fn plot_errors_are_usage_errors_and_write_nothing() {
     // An output directory that cannot be made: an I/O error.
     let o = reachc(&["plot", r, "-o", bad.join("sub").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o).contains("cannot create"), "{}", text(&o));
+    assert!(text(&o).contains("cannot write"), "{}", text(&o));
+    assert!(text(&o).contains("(nothing written)"), "{}", text(&o));
     // None of the failures wrote a picture (nor a temporary file).
     assert!(
         files(&dir)

@@ -5,27 +5,37 @@
 //! [`run`] and [`simulate`] take typed options ([`RunOptions`], [`SimulateOptions`]); a
 //! generated binary's command line is their textual form, parsed by [`Command::parse`] and
 //! written by `to_args` (by hand, no clap, so the runtime stays light):
-//! `[--analysis NAME] [-o DIR] [--quiet]`, or `simulate --paths N [options]` (see
-//! [`SIMULATE_USAGE`]).
+//! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe]`, or `simulate --paths N [options]`
+//! (see [`SIMULATE_USAGE`]).
+//!
+//! Exit codes (the CLI's too): [`EXIT_OK`], [`EXIT_FAILED`] (an analysis could not run, its
+//! result is not finite, or a coverage check failed), [`EXIT_USAGE`] (a bad command line,
+//! including an analysis name the model does not have, or a file that cannot be written),
+//! [`EXIT_UNSAFE`] (`--deny-unsafe` and a verdict "not shown safe"). The files of one command
+//! are written whole or not at all ([`crate::output`]): nothing when an analysis fails.
 
+use crate::output::Files;
 use crate::report;
 use reachc_core::engine::RunError;
 use reachc_core::model::ModelInfo;
 use reachc_core::simulate::{self, InputMode, SimError};
 use reachc_core::{Reach, System};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Default output directory.
 pub const DEFAULT_OUT_DIR: &str = "reachc-out";
 
-const USAGE: &str = "usage: <model> [--analysis NAME] [-o DIR] [--quiet]
+const USAGE: &str = "usage: <model> [--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe]
        <model> simulate --paths N [options]   (Monte Carlo check; simulate --help)
   --analysis NAME  run only this analysis (default: all)
   -o, --out DIR    output directory for <analysis>.json and <analysis>.csv (default: reachc-out)
   -q, --quiet      do not print the summaries
-  -h, --help       print this help";
+  --deny-unsafe    exit with status 3 when a verdict is \"not shown safe\"
+  -h, --help       print this help
+  Exit status: 0 ok, 1 an analysis could not run (nothing is written), 2 usage or I/O
+  error, 3 not shown safe with --deny-unsafe (the results are written).";
 
 /// Help of the `simulate` mode.
 pub const SIMULATE_USAGE: &str =
@@ -33,7 +43,9 @@ pub const SIMULATE_USAGE: &str =
          [--delta D] [--inputs random|corners|centre] [--hold T] [--confidence C]
          [--threads T] [-o DIR] [--quiet] [--progress]
   Euler-Maruyama sample paths checked against each analysis' delta-PRS; writes
-  DIR/<analysis>.sim.json. Exit status 0 when every coverage check passes, 1 when one fails.
+  DIR/<analysis>.sim.json. Exit status 0 when every coverage check passes, 1 when one fails
+  (the reports are written) or an analysis cannot be simulated (nothing is written), 2 on
+  usage or I/O errors.
   --paths N          number of sample paths (required)
   --analysis NAME    check only this analysis (default: all)
   --seed S           random seed (default 0); the same seed gives the same results
@@ -50,10 +62,15 @@ pub const SIMULATE_USAGE: &str =
 
 /// Exit status of a successful run.
 pub const EXIT_OK: u8 = 0;
-/// Exit status when an analysis could not run (or its results could not be written).
+/// Exit status when an analysis could not run or its result is not finite (nothing is written),
+/// or, for `simulate`, a coverage check failed.
 pub const EXIT_FAILED: u8 = 1;
-/// Exit status of a usage error.
+/// Exit status of a usage error (an unknown analysis name too) or an I/O error (a file that
+/// cannot be written: nothing is).
 pub const EXIT_USAGE: u8 = 2;
+/// Exit status of `run --deny-unsafe` when some verdict is "not shown safe" (the results are
+/// written).
+pub const EXIT_UNSAFE: u8 = 3;
 
 /// What `run` does.
 #[derive(Clone, Debug, PartialEq)]
@@ -64,6 +81,11 @@ pub struct RunOptions {
     pub out_dir: PathBuf,
     /// Do not print the summaries.
     pub quiet: bool,
+    /// Exit with [`EXIT_UNSAFE`] when a verdict is "not shown safe".
+    pub deny_unsafe: bool,
+    /// `out_dir` is a staging directory that the caller moves into place (`reachc run --plot`):
+    /// do not print where the files were written.
+    pub stage: bool,
 }
 
 impl Default for RunOptions {
@@ -72,6 +94,8 @@ impl Default for RunOptions {
             analysis: None,
             out_dir: PathBuf::from(DEFAULT_OUT_DIR),
             quiet: false,
+            deny_unsafe: false,
+            stage: false,
         }
     }
 }
@@ -174,6 +198,8 @@ fn parse_run(args: &[String]) -> Result<Command, String> {
             "--analysis" => opts.analysis = Some(args.value(flag, inline)?.to_string()),
             "-o" | "--out" => opts.out_dir = PathBuf::from(args.value(flag, inline)?),
             "-q" | "--quiet" => opts.quiet = true,
+            "--deny-unsafe" => opts.deny_unsafe = true,
+            "--stage" => opts.stage = true,
             "-h" | "--help" => return Ok(Command::Help(USAGE)),
             other => return Err(format!("unexpected argument `{other}`")),
         }
@@ -238,8 +264,14 @@ impl RunOptions {
         if let Some(name) = &self.analysis {
             args.extend(["--analysis".to_string(), name.clone()]);
         }
-        if self.quiet {
-            args.push("--quiet".into());
+        for (on, flag) in [
+            (self.quiet, "--quiet"),
+            (self.deny_unsafe, "--deny-unsafe"),
+            (self.stage, "--stage"),
+        ] {
+            if on {
+                args.push(flag.into());
+            }
         }
         args
     }
@@ -316,8 +348,10 @@ pub fn run_cli<S: System + Sync>(
 }
 
 /// Runs the selected analyses, prints their summaries and writes `DIR/<analysis>.json` and
-/// `.csv`. Returns [`EXIT_OK`], [`EXIT_FAILED`] if some analysis could not run or its files
-/// could not be written, [`EXIT_USAGE`] for an unknown analysis name. Analyses with an
+/// `.csv`, all at the end and only when every analysis ran. Returns [`EXIT_OK`],
+/// [`EXIT_FAILED`] if some analysis could not run or its result is not finite (nothing is
+/// written then), [`EXIT_USAGE`] for an unknown analysis name or files that cannot be written,
+/// [`EXIT_UNSAFE`] with `deny_unsafe` when a verdict is "not shown safe". Analyses with an
 /// unsupported method are reported as skipped, not as failures.
 pub fn run<S: System + Sync>(
     sys: &S,
@@ -329,51 +363,74 @@ pub fn run<S: System + Sync>(
     let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
-    let mut status = EXIT_OK;
+    let (mut files, mut failed, mut not_safe) = (Files::new(), false, false);
     for name in selected {
-        match Reach::new(sys, info, name).and_then(|r| r.run()) {
-            Ok(res) => {
-                if !opts.quiet {
-                    let _ = writeln!(out, "{}", report::summary(&res));
-                }
-                match write_files(&res, &opts.out_dir) {
-                    Ok((json, csv)) => {
-                        if !opts.quiet {
-                            let _ = writeln!(out, "  wrote {} and {}\n", json, csv);
-                        }
-                    }
-                    Err(e) => {
-                        let _ = writeln!(
-                            err,
-                            "error: analysis `{name}`: cannot write results to {}: {e}",
-                            opts.out_dir.display()
-                        );
-                        status = EXIT_FAILED;
-                    }
-                }
-            }
+        let res = match Reach::new(sys, info, name).and_then(|r| r.run()) {
+            Ok(res) => res,
             Err(RunError::Unsupported(why)) => {
                 let _ = writeln!(err, "skipped analysis `{name}`: {why}");
+                continue;
             }
             Err(e) => {
                 let _ = writeln!(err, "error: analysis `{name}` could not run: {e}");
-                status = EXIT_FAILED;
+                failed = true;
+                continue;
             }
+        };
+        if let Some(why) = report::not_finite(&res) {
+            let _ = writeln!(err, "error: analysis `{name}`: {why}");
+            failed = true;
+            continue;
         }
+        if !opts.quiet {
+            let _ = writeln!(out, "{}", report::summary(&res));
+        }
+        not_safe |= matches!(res.verdict, reachc_core::prs::Verdict::NotShownSafe { .. });
+        let mut csv = Vec::new();
+        // Writing into memory cannot fail.
+        let _ = report::write_csv(&res, &mut csv);
+        let dir = &opts.out_dir;
+        files.add(
+            dir.join(format!("{name}.json")),
+            (report::to_json(&res) + "\n").into(),
+        );
+        files.add(dir.join(format!("{name}.csv")), csv);
     }
-    status
+    if failed {
+        let _ = writeln!(err, "nothing written: an analysis failed");
+        return EXIT_FAILED;
+    }
+    if let Err(code) = commit(files, !opts.quiet && !opts.stage, out, err) {
+        return code;
+    }
+    if opts.deny_unsafe && not_safe {
+        let _ = writeln!(err, "error: not shown safe (--deny-unsafe)");
+        return EXIT_UNSAFE;
+    }
+    EXIT_OK
 }
 
-/// Writes `DIR/<analysis>.json` and `DIR/<analysis>.csv`; returns their paths.
-fn write_files(res: &reachc_core::Prs, dir: &Path) -> std::io::Result<(String, String)> {
-    std::fs::create_dir_all(dir)?;
-    let json = dir.join(format!("{}.json", res.analysis));
-    std::fs::write(&json, report::to_json(res) + "\n")?;
-    let csv = dir.join(format!("{}.csv", res.analysis));
-    let mut f = std::io::BufWriter::new(std::fs::File::create(&csv)?);
-    report::write_csv(res, &mut f)?;
-    f.flush()?;
-    Ok((json.display().to_string(), csv.display().to_string()))
+/// Writes `files` whole or not at all, printing their names when `announce`; the exit code of
+/// a failure ([`EXIT_USAGE`]: an I/O error).
+pub fn commit(
+    files: Files,
+    announce: bool,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), u8> {
+    match files.commit() {
+        Ok(paths) => {
+            if announce && !paths.is_empty() {
+                let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+                let _ = writeln!(out, "wrote {}", names.join(", "));
+            }
+            Ok(())
+        }
+        Err(e) => {
+            let _ = writeln!(err, "error: {e} (nothing written)");
+            Err(EXIT_USAGE)
+        }
+    }
 }
 
 /// The names of the analyses to run: all, or the one named (`None` after reporting an unknown
@@ -405,9 +462,10 @@ fn select<'a>(
 pub type Progress<'a> = dyn FnMut(&str, u64, u64) + 'a;
 
 /// For each selected analysis: compute its PRS (at `opts.delta` if given), simulate the paths,
-/// print the summary and write `DIR/<analysis>.sim.json`. Returns [`EXIT_OK`] when every
-/// coverage check passes, [`EXIT_FAILED`] when one fails or an analysis or its files fail,
-/// [`EXIT_USAGE`] for a usage error. Analyses without a PRS (no constants, unsupported
+/// print the summary; at the end, write every `DIR/<analysis>.sim.json` (whole or not at all).
+/// Returns [`EXIT_OK`] when every coverage check passes, [`EXIT_FAILED`] when one fails (the
+/// reports are written) or an analysis cannot run or be simulated (nothing is written),
+/// [`EXIT_USAGE`] for a usage error or files that cannot be written. Analyses without a PRS (no constants, unsupported
 /// transform) are skipped with a message. `progress(analysis, done, total)` is called after each
 /// batch of paths; without it, `opts.progress` writes `reachc-progress` lines to `err` instead.
 pub fn simulate<S: System + Sync>(
@@ -421,7 +479,7 @@ pub fn simulate<S: System + Sync>(
     let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
-    let mut status = EXIT_OK;
+    let (mut files, mut failed, mut coverage_failed) = (Files::new(), false, false);
     for name in selected {
         let reach = Reach::new(sys, info, name).and_then(|r| match opts.delta {
             Some(d) => r.with_delta(d),
@@ -435,10 +493,15 @@ pub fn simulate<S: System + Sync>(
             }
             Err(e) => {
                 let _ = writeln!(err, "error: analysis `{name}` could not run: {e}");
-                status = EXIT_FAILED;
+                failed = true;
                 continue;
             }
         };
+        if let Some(why) = report::not_finite(&result) {
+            let _ = writeln!(err, "error: analysis `{name}`: {why}");
+            failed = true;
+            continue;
+        }
         let started = std::time::Instant::now();
         let simulated = {
             let mut report_progress = |done: u64, total: u64| match progress.as_mut() {
@@ -458,7 +521,7 @@ pub fn simulate<S: System + Sync>(
             }
             Err(SimError::Invalid(m)) => {
                 let _ = writeln!(err, "error: analysis `{name}` cannot be simulated: {m}");
-                status = EXIT_FAILED;
+                failed = true;
                 continue;
             }
         };
@@ -468,30 +531,29 @@ pub fn simulate<S: System + Sync>(
             let _ = write!(out, "{}", report::simulation::summary(&sim));
             let _ = writeln!(
                 out,
-                "  time: {secs:.3} s for {path_steps:.3e} path-steps ({:.3e} path-steps/s, {} \
-                 threads)",
+                "  time: {secs:.3} s for {path_steps:.3e} path-steps ({:.3e} path-steps/s, {})\n",
                 path_steps / secs,
-                simulate::thread_count(opts.sim.threads)
+                report::count(simulate::thread_count(opts.sim.threads) as u64, "thread")
             );
         }
         let file = opts.out_dir.join(format!("{}.sim.json", sim.analysis));
-        let written = std::fs::create_dir_all(&opts.out_dir)
-            .and_then(|()| std::fs::write(&file, report::simulation::to_json(&sim) + "\n"));
-        match written {
-            Ok(()) if !opts.quiet => {
-                let _ = writeln!(out, "  wrote {}\n", file.display());
-            }
-            Ok(()) => {}
-            Err(e) => {
-                let _ = writeln!(err, "error: cannot write {}: {e}", file.display());
-                status = EXIT_FAILED;
-            }
-        }
+        files.add(file, (report::simulation::to_json(&sim) + "\n").into());
         if !sim.passed() {
-            status = EXIT_FAILED;
+            coverage_failed = true;
         }
     }
-    status
+    if failed {
+        let _ = writeln!(err, "nothing written: an analysis failed");
+        return EXIT_FAILED;
+    }
+    if let Err(code) = commit(files, !opts.quiet, out, err) {
+        return code;
+    }
+    if coverage_failed {
+        EXIT_FAILED
+    } else {
+        EXIT_OK
+    }
 }
 
 #[cfg(test)]
@@ -508,6 +570,8 @@ mod tests {
             analysis: Some("contraction".into()),
             out_dir: PathBuf::from("some dir/out"),
             quiet: true,
+            deny_unsafe: true,
+            stage: true,
         };
         assert_eq!(Command::parse(&run.to_args()), Ok(Command::Run(run)));
         let sim = SimulateOptions {

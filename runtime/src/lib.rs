@@ -74,5 +74,7 @@ pub use reachc_core::{Bounds, InputPlan, Interval, ModelInfo, Prs, Reach, System
 #[cfg(feature = "app")]
 pub mod app;
 mod include;
+#[cfg(feature = "app")]
+pub mod output;
 #[cfg(feature = "report")]
 pub mod report;

@@ -1,4 +1,6 @@
-//! The `reachc` command line. Exit codes: 0 ok, 1 spec errors, 2 usage or I/O errors.
+//! The `reachc` command line. Exit codes: 0 ok, 1 spec errors or an analysis that cannot run
+//! (or a failed coverage check), 2 usage, I/O or cargo errors, 3 "not shown safe" with
+//! `run --deny-unsafe` ([`reachc_runtime::app`]).
 
 mod build;
 pub mod inspect;
@@ -15,6 +17,7 @@ use clap::{Parser, Subcommand};
 
 use reachc_compiler::diagnostics::render;
 use reachc_compiler::driver::{load, LoadError, Loaded};
+use reachc_runtime::report::count;
 
 /// reachc: a compiler for stochastic reachability (delta-probabilistic reachable sets).
 #[derive(Parser, Debug)]
@@ -74,6 +77,9 @@ pub enum Command {
         /// Pictures of the results.
         #[command(flatten)]
         plot: plot::RunPlotArgs,
+        /// Exit with code 3 when a verdict is "not shown safe" (the results are written).
+        #[arg(long)]
+        deny_unsafe: bool,
         /// Do not show cargo's progress (compiled backend).
         #[arg(short, long)]
         quiet: bool,
@@ -134,8 +140,9 @@ fn run(command: Command) -> Result<(), u8> {
             backend,
             out,
             plot,
+            deny_unsafe,
             quiet,
-        } => run::run_spec(&spec, analysis, backend, out, &plot, quiet),
+        } => run::run_spec(&spec, analysis, backend, out, &plot, (deny_unsafe, quiet)),
         Command::Simulate {
             spec,
             sim,
@@ -145,13 +152,23 @@ fn run(command: Command) -> Result<(), u8> {
         Command::Plot(args) => plot::run_plot(&args),
         Command::Check { spec } => {
             let loaded = load_reporting(&spec)?;
+            let m = &loaded.model;
+            let counts = [
+                (m.states.len(), "state"),
+                (m.inputs.len(), "input"),
+                (m.noises.len(), "noise channel"),
+            ]
+            .map(|(n, noun)| count(n as u64, noun));
             println!(
-                "ok: model `{}` ({} states, {} inputs, {} noise channels, {} analyses)",
-                loaded.model.name,
-                loaded.model.states.len(),
-                loaded.model.inputs.len(),
-                loaded.model.noises.len(),
-                loaded.model.analyses.len()
+                "ok: model `{}` ({}, {} {})",
+                m.name,
+                counts.join(", "),
+                m.analyses.len(),
+                if m.analyses.len() == 1 {
+                    "analysis"
+                } else {
+                    "analyses"
+                }
             );
             Ok(())
         }

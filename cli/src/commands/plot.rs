@@ -8,10 +8,11 @@
 //! [`RUN_QUANTILE_PATHS`] paths itself, and `reachc plot` draws no quantile.
 
 use std::path::{Path, PathBuf};
-use std::time::SystemTime;
 
+use reachc_runtime::app::commit;
 use reachc_runtime::engine;
 use reachc_runtime::model::ModelInfo;
+use reachc_runtime::output::Files;
 use reachc_runtime::simulate::{self, SimReport};
 
 use super::{load_reporting, EXIT_USAGE};
@@ -100,36 +101,17 @@ pub(super) fn check_states(args: &RunPlotArgs, loaded: &Loaded) -> Result<(), u8
         })
 }
 
-/// When each analysis' result in `out_dir` was last modified (`None`: absent), taken before a
-/// run: a result is from the run if it changed. (Comparing with the run's start time is not
-/// enough: many file systems stamp files with a clock that lags the system time by a few
-/// milliseconds.)
-pub(super) fn result_stamps(args: &RunPlotArgs, loaded: &Loaded, out_dir: &Path) -> Stamps {
-    if args.plot.is_none() {
-        return Vec::new();
-    }
-    loaded
-        .model
-        .analyses
-        .iter()
-        .map(|a| {
-            (
-                a.spec.name.clone(),
-                modified(&result_path(out_dir, &a.spec.name)),
-            )
-        })
-        .collect()
+/// A fresh staging directory for `reachc run --plot`: the run writes its results there, the
+/// plots are drawn from them, and both are then written together into their places.
+pub(super) fn staging_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("reachc-run-{}", std::process::id()));
+    // Left by an earlier process with the same id that was killed.
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
 }
-
-/// Modification times of results, per analysis (see [`result_stamps`]).
-pub(super) type Stamps = Vec<(String, Option<SystemTime>)>;
 
 fn result_path(out_dir: &Path, analysis: &str) -> PathBuf {
     out_dir.join(format!("{analysis}.json"))
-}
-
-fn modified(path: &Path) -> Option<SystemTime> {
-    std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 
 /// The interpreter of a loaded spec, without printing its warnings again.
@@ -139,10 +121,14 @@ pub(super) fn interpreter_quiet(mut loaded: Loaded) -> (Interpreter, ModelInfo) 
     (Interpreter::new(loaded.model, &prepared), info)
 }
 
-/// Prints the files written.
-fn report_written(files: &[PathBuf]) {
-    let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
-    println!("  plotted {}", names.join(", "));
+/// Writes `files` whole or not at all and prints their names; the exit code of a failure.
+fn write(files: Files) -> Result<(), u8> {
+    commit(
+        files,
+        true,
+        &mut std::io::stdout().lock(),
+        &mut std::io::stderr().lock(),
+    )
 }
 
 /// The quantile of a Monte Carlo report.
@@ -220,8 +206,7 @@ pub fn run_plot(args: &PlotArgs) -> Result<(), u8> {
     });
     let files = plot::plot_result(&result, model.as_ref(), quantile.as_ref(), &choice, &dir)
         .map_err(usage)?;
-    report_written(&files);
-    Ok(())
+    write(files)
 }
 
 /// The quantile for `reachc run --plot`: the report beside the result, or a simulation of
@@ -274,19 +259,29 @@ fn run_quantile(model: &Model<'_>, json: &Path, result: &ResultFile) -> Option<Q
     })
 }
 
-/// After `reachc run` wrote its results into `out_dir` (`before`: their [`result_stamps`]
-/// before the run): plots each selected analysis into `args.plot`. `interp` is the spec's interpreter and model info.
-/// Analyses without a PRS get sample paths and unsafe sets only; those without a fresh result
-/// (they failed or were skipped) are not plotted. Returns the exit code of a failure.
+/// After `reachc run` wrote its results into `staging` (see [`staging_dir`]): plots each
+/// selected analysis into `args.plot`, then writes the results into `out_dir` and the plots
+/// together, whole or not at all (nothing when a plot fails). `interp` is the spec's
+/// interpreter and model info. Analyses without a PRS get sample paths and unsafe sets only;
+/// those without a result (skipped) are not plotted. Returns the exit code of a failure.
 pub(super) fn plot_after_run(
     args: &RunPlotArgs,
     (sys, info): (&Interpreter, &ModelInfo),
     analysis: Option<&str>,
+    staging: &Path,
     out_dir: &Path,
-    before: &Stamps,
 ) -> Result<(), u8> {
     let Some(dir) = &args.plot else {
         return Ok(());
+    };
+    // No staging directory: every analysis was skipped, nothing was written.
+    let mut files = if staging.is_dir() {
+        Files::read_dir(staging, out_dir).map_err(|e| {
+            eprintln!("error: reading the results in {}: {e}", staging.display());
+            EXIT_USAGE
+        })?
+    } else {
+        Files::new()
     };
     let model = Model {
         sys,
@@ -300,7 +295,6 @@ pub(super) fn plot_after_run(
         seed: 0,
         envelope: args.plot_envelope,
     };
-    let mut status = Ok(());
     for a in info
         .analyses
         .iter()
@@ -313,31 +307,31 @@ pub(super) fn plot_after_run(
             );
             plot::plot_without_result(&model, a, &choice, dir)
         } else {
-            let json = result_path(out_dir, &a.spec.name);
-            let previous = before
-                .iter()
-                .find(|(n, _)| *n == a.spec.name)
-                .and_then(|b| b.1);
-            let fresh = modified(&json).is_some_and(|t| Some(t) != previous);
-            if !fresh {
+            let staged = result_path(staging, &a.spec.name);
+            if !staged.is_file() {
                 eprintln!(
                     "note: no result for analysis `{}` from this run: not plotted",
                     a.spec.name
                 );
                 continue;
             }
-            ResultFile::read(&json).and_then(|result| {
+            ResultFile::read(&staged).and_then(|result| {
+                // A Monte Carlo report beside the final result is used for the quantile.
+                let json = result_path(out_dir, &a.spec.name);
                 let quantile = run_quantile(&model, &json, &result);
                 plot::plot_result(&result, Some(&model), quantile.as_ref(), &choice, dir)
             })
         };
         match plotted {
-            Ok(files) => report_written(&files),
+            Ok(f) => files.extend(f),
             Err(e) => {
-                eprintln!("error: plotting analysis `{}`: {e}", a.spec.name);
-                status = Err(EXIT_USAGE);
+                eprintln!(
+                    "error: plotting analysis `{}`: {e} (nothing written)",
+                    a.spec.name
+                );
+                return Err(EXIT_USAGE);
             }
         }
     }
-    status
+    write(files)
 }

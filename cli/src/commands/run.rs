@@ -8,13 +8,13 @@ use clap::ValueEnum;
 
 use super::plot::{self, RunPlotArgs};
 use super::progress::CompileDisplay;
-use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
+use super::{load_reporting, EXIT_USAGE};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_compiler::diagnostics::render;
 use reachc_compiler::driver::Loaded;
 use reachc_compiler::package::{Cache, Profile};
-use reachc_runtime::app::{RunOptions, DEFAULT_OUT_DIR};
+use reachc_runtime::app::{RunOptions, DEFAULT_OUT_DIR, EXIT_OK};
 use reachc_runtime::model::ModelInfo;
 
 /// Which backend computes the sets.
@@ -26,26 +26,31 @@ pub enum Backend {
     Interp,
 }
 
-/// Runs `reachc run` (and, with `--plot`, plots the results). Exit codes: 0 ok, 1 spec errors
-/// or an analysis that cannot run, 2 usage, I/O or cargo failures.
+/// Runs `reachc run` (and, with `--plot`, plots the results). Exit codes as the runtime's
+/// [`reachc_runtime::app::run`]: 0 ok, 1 spec errors or an analysis that cannot run (nothing
+/// written), 2 usage, I/O or cargo failures (nothing written), 3 "not shown safe" with
+/// `--deny-unsafe` (everything written).
 pub fn run_spec(
     spec: &Path,
     analysis: Option<String>,
     backend: Backend,
     out: Option<PathBuf>,
     plot: &RunPlotArgs,
-    quiet: bool,
+    (deny_unsafe, quiet): (bool, bool),
 ) -> Result<(), u8> {
     let color = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
     plot::check_states(plot, &loaded)?;
+    let out_dir = out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR));
+    // With --plot, the results are staged and written together with the pictures.
+    let staging = plot.plot.as_ref().map(|_| plot::staging_dir());
     let opts = RunOptions {
         analysis: analysis.clone(),
-        out_dir: out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR)),
+        out_dir: staging.clone().unwrap_or_else(|| out_dir.clone()),
         quiet: false,
+        deny_unsafe,
+        stage: staging.is_some(),
     };
-    let out_dir = opts.out_dir.clone();
-    let before = plot::result_stamps(plot, &loaded, &out_dir);
     let (code, model) = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
@@ -56,7 +61,7 @@ pub fn run_spec(
                 &mut std::io::stdout().lock(),
                 &mut std::io::stderr().lock(),
             );
-            (code, Some((interp, info)))
+            (code, (interp, info))
         }
         Backend::Compiled => {
             let binary = compiled_binary(&mut loaded, color, quiet)?;
@@ -67,33 +72,39 @@ pub fn run_spec(
                     eprintln!("error: cannot run {}: {e}", binary.display());
                     EXIT_USAGE
                 })?;
-            let code = status
-                .code()
-                .map_or(EXIT_USAGE, |c| u8::try_from(c).unwrap_or(EXIT_USAGE));
             // The plots simulate paths in-process: the interpreter computes the same numbers.
-            (
-                code,
-                plot.plot.is_some().then(|| plot::interpreter_quiet(loaded)),
-            )
+            (exit_code(status), plot::interpreter_quiet(loaded))
         }
     };
-    // A usage error (e.g. an unknown analysis) ran nothing worth plotting.
-    let plotted = match model {
-        Some((interp, info)) if code != EXIT_USAGE => plot::plot_after_run(
-            plot,
-            (&interp, &info),
-            analysis.as_deref(),
-            &out_dir,
-            &before,
-        ),
-        _ => Ok(()),
-    };
-    match (code, plotted) {
-        (0, p) => p,
-        (1, Err(p)) => Err(p.max(EXIT_SPEC)),
-        (1, Ok(())) => Err(EXIT_SPEC),
-        (c, _) => Err(c),
+    if let Some(staging) = staging {
+        // A usage error ran nothing. A failed run staged no results: only the analyses without
+        // a PRS get their picture (sample paths and unsafe sets, to see why).
+        let plotted = if code != EXIT_USAGE {
+            let (interp, info) = &model;
+            plot::plot_after_run(
+                plot,
+                (interp, info),
+                analysis.as_deref(),
+                &staging,
+                &out_dir,
+            )
+        } else {
+            Ok(())
+        };
+        let _ = std::fs::remove_dir_all(&staging);
+        plotted?;
     }
+    match code {
+        EXIT_OK => Ok(()),
+        c => Err(c),
+    }
+}
+
+/// A child's exit status as ours (killed by a signal: a usage/I/O-class failure).
+pub(super) fn exit_code(status: std::process::ExitStatus) -> u8 {
+    status
+        .code()
+        .map_or(EXIT_USAGE, |c| u8::try_from(c).unwrap_or(EXIT_USAGE))
 }
 
 /// The interpreter backend of a loaded spec and its model info (warnings printed to stderr).

@@ -6,9 +6,11 @@ use std::io::{BufRead, BufReader, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
+use std::fmt::Write as FmtWrite;
 
-use super::run::{compiled_binary, interpreter, Backend};
+use indicatif::{MultiProgress, ProgressBar, ProgressState, ProgressStyle};
+
+use super::run::{compiled_binary, exit_code, interpreter, Backend};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
 use reachc_runtime::app::{SimulateOptions, DEFAULT_OUT_DIR};
 use reachc_runtime::simulate::{self, InputMode};
@@ -87,6 +89,23 @@ impl SimulateArgs {
     }
 }
 
+/// Paths per second, three significant digits with an SI prefix: `17.3 M paths/s` (indicatif's
+/// own `{per_sec}` prints `17,297,925.3962/s`).
+fn rate(per_sec: f64) -> String {
+    let (v, prefix) = [(1e9, "G "), (1e6, "M "), (1e3, "k ")]
+        .into_iter()
+        .find(|&(scale, _)| per_sec >= scale)
+        .map_or((per_sec, ""), |(scale, p)| (per_sec / scale, p));
+    let decimals = if v >= 100.0 {
+        0
+    } else if v >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{v:.decimals$} {prefix}paths/s")
+}
+
 /// One progress bar per analysis, under a [`MultiProgress`] that also prints other output.
 struct Bars {
     multi: MultiProgress,
@@ -108,8 +127,11 @@ impl Bars {
             let bar = self.multi.add(ProgressBar::new(total));
             // A fixed template: cannot fail to parse.
             if let Ok(style) = ProgressStyle::with_template(
-                "{msg} [{bar:40}] {pos}/{len} paths, {per_sec}, eta {eta}",
+                "{msg} [{bar:40}] {pos}/{len} paths, {rate}, eta {eta}",
             ) {
+                let style = style.with_key("rate", |s: &ProgressState, w: &mut dyn FmtWrite| {
+                    let _ = w.write_str(&rate(s.per_sec()));
+                });
                 bar.set_style(style.progress_chars("=> "));
             }
             bar.set_message(format!("simulating `{analysis}`"));
@@ -216,16 +238,17 @@ fn parse_progress(line: &str) -> Option<(&str, u64, u64)> {
     Some((a, d.parse().ok()?, t.parse().ok()?))
 }
 
-/// A child's exit status as ours (killed by a signal: a usage/I/O-class failure).
-fn exit_code(status: std::process::ExitStatus) -> u8 {
-    status
-        .code()
-        .map_or(EXIT_USAGE, |c| u8::try_from(c).unwrap_or(EXIT_USAGE))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rates_print_three_significant_digits() {
+        assert_eq!(rate(17_297_925.396_2), "17.3 M paths/s");
+        assert_eq!(rate(1_234.5), "1.23 k paths/s");
+        assert_eq!(rate(999.0), "999 paths/s");
+        assert_eq!(rate(2.5e9), "2.50 G paths/s");
+    }
 
     #[test]
     fn progress_lines_parse() {

@@ -15,6 +15,7 @@ use super::font::FAMILY;
 use super::geometry::Point;
 use super::output::Draw;
 use super::scene::{RadiusScene, RatesScene, SetsScene};
+use reachc_runtime::report::count;
 
 /// Size of the sets figure.
 pub const SETS_SIZE: (u32, u32) = (1100, 780);
@@ -355,7 +356,10 @@ impl Draw for SetsScene {
         if !self.paths.is_empty() {
             entries.push((
                 Mark::Line(PATHS.mix(0.6), 1),
-                format!("{} sample paths (Euler-Maruyama)", self.paths.len()),
+                format!(
+                    "{} (Euler-Maruyama)",
+                    count(self.paths.len() as u64, "sample path")
+                ),
             ));
         }
         let mut any_det = false;

@@ -7,10 +7,11 @@
 //! - [`regions`]: the unsafe sets in the plane;
 //! - [`scene`]: what the figures show, in plot coordinates;
 //! - [`figures`], [`font`], [`raster`], [`output`]: drawing with plotters, the bundled font,
-//!   the PNG backend's text, SVG and PNG files written atomically.
+//!   the PNG backend's text, SVG and PNG renderings in memory.
 //!
 //! This file ties them together: from a result (and, if given, the spec's model for sample
-//! paths and unsafe sets) to the files.
+//! paths and unsafe sets) to the files, in memory; the caller writes them whole or not at all
+//! ([`reachc_runtime::output::Files`]).
 
 pub mod figures;
 pub mod font;
@@ -25,6 +26,7 @@ pub mod select;
 use std::path::{Path, PathBuf};
 
 use reachc_runtime::model::{Analysis, ModelInfo};
+use reachc_runtime::output::Files;
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::System;
 
@@ -133,20 +135,13 @@ fn sample(
         .map_err(|e| format!("cannot simulate sample paths: {e}"))
 }
 
-/// Renders every figure first (so that a failure writes nothing), then writes the files.
-fn write_all(
-    dir: &Path,
-    files: Vec<(PathBuf, Result<Vec<u8>, String>)>,
-) -> Result<Vec<PathBuf>, String> {
-    let mut rendered = Vec::with_capacity(files.len());
+/// The rendered figures, or the first rendering's error.
+fn rendered(files: Vec<(PathBuf, Result<Vec<u8>, String>)>) -> Result<Files, String> {
+    let mut out = Files::new();
     for (path, bytes) in files {
-        rendered.push((path, bytes?));
+        out.add(path, bytes?);
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    rendered
-        .iter()
-        .map(|(path, bytes)| output::write_atomic(path, bytes))
-        .collect()
+    Ok(out)
 }
 
 /// Both renderings of a figure.
@@ -169,14 +164,14 @@ fn renderings<F: Draw>(
 /// Plots a result: `DIR/<analysis>_sets.svg/.png` (the sets at the chosen times, sample paths
 /// and unsafe sets when the model is given), `DIR/<analysis>_radius.svg/.png` and, when the
 /// rates vary in time (local or empirical), `DIR/<analysis>_rates.svg/.png` (`c_t`). Returns the
-/// files written; the error is a message (nothing is written then).
+/// files, rendered but not written; the error is a message.
 pub fn plot_result(
     result: &ResultFile,
     model: Option<&Model<'_>>,
     quantile: Option<&Quantile>,
     choice: &Choice,
     dir: &Path,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Files, String> {
     font::register()?;
     if let Some(m) = model {
         if m.info.name != result.model || m.info.states != result.states {
@@ -231,7 +226,7 @@ pub fn plot_result(
             "rates",
         ));
     }
-    write_all(dir, files)
+    rendered(files)
 }
 
 /// The report times `0, step, 2 step, ..., horizon` of an analysis (the last step may be
@@ -245,13 +240,13 @@ fn report_times(analysis: &Analysis) -> Vec<f64> {
 }
 
 /// Plots an analysis that has no PRS (its constants could not be bounded): sample paths and
-/// unsafe sets only, `DIR/<analysis>_sets.svg/.png`.
+/// unsafe sets only, `DIR/<analysis>_sets.svg/.png` (rendered, not written).
 pub fn plot_without_result(
     model: &Model<'_>,
     analysis: &Analysis,
     choice: &Choice,
     dir: &Path,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Files, String> {
     font::register()?;
     let info = model.info;
     let a = &analysis.spec;
@@ -271,8 +266,5 @@ pub fn plot_without_result(
     let mut sets = scene::paths_scene(info, analysis, &plane, (&times, &picked), &paths, regions);
     sets.reference = reference(model, states);
     sets.notes.extend(notes);
-    write_all(
-        dir,
-        renderings(&sets, figures::SETS_SIZE, dir, &a.name, "sets"),
-    )
+    rendered(renderings(&sets, figures::SETS_SIZE, dir, &a.name, "sets"))
 }

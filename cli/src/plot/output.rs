@@ -1,9 +1,5 @@
-//! Rendering a figure to SVG and PNG in memory, and writing files atomically: each file is
-//! written to a temporary name in the same directory and renamed, so a reader never sees a
-//! partial picture and an error leaves no stray file.
-
-use std::io::Write;
-use std::path::{Path, PathBuf};
+//! Rendering a figure to SVG and PNG in memory (the files are written by
+//! [`reachc_runtime::output::Files`]: whole or not at all).
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -70,23 +66,4 @@ pub fn png<F: Draw>(figure: &F, size: Size) -> Result<Vec<u8>, String> {
     writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
     writer.finish().map_err(|e| e.to_string())?;
     Ok(out)
-}
-
-/// Writes `bytes` to `path` atomically (temporary file in the same directory, then rename).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<PathBuf, String> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let written = std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
-        .and_then(|()| std::fs::rename(&tmp, path));
-    match written {
-        Ok(()) => Ok(path.to_path_buf()),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(format!("cannot write {}: {e}", path.display()))
-        }
-    }
 }

@@ -7,6 +7,7 @@ use super::geometry::{clip, Plane, Point, Projected};
 use super::input::{Guarantee, Method, RateSource, ResultFile, Shape, Step};
 use super::regions::Region;
 use reachc_runtime::model::{Analysis, ModelInfo};
+use reachc_runtime::report::count;
 
 /// The sets figure: a 2-D projection.
 #[derive(Clone, Debug)]
@@ -348,7 +349,10 @@ pub fn radius_scene(
         notes.push(format!("quantile: {source}"));
         (
             values,
-            format!("empirical (1-δ) quantile of |X_t - x*_t|_P ({paths} paths)"),
+            format!(
+                "empirical (1-δ) quantile of |X_t - x*_t|_P ({})",
+                count(paths, "path")
+            ),
         )
     });
     if quantile.is_none() {

@@ -161,8 +161,30 @@ pub fn type_name(model_name: &str) -> String {
 /// The Cargo package name of a model's generated crate: lowercase words joined by `-`
 /// (`van_der_pol` -> `van-der-pol`, `VanDerPol` -> `van-der-pol`). A name that is empty,
 /// starts with a digit, or is a Rust keyword or a name Cargo reserves gets the prefix
-/// `model-` (`3d` -> `model-3d`, `fn` -> `model-fn`).
+/// `model-` (`3d` -> `model-3d`, `fn` -> `model-fn`). A name longer than [`MAX_CRATE_NAME`]
+/// bytes is cut and ends with a hash of the model's name (see [`bounded`]).
 pub fn crate_name(model_name: &str) -> String {
+    bounded(model_name, unbounded_crate_name(model_name))
+}
+
+/// The longest crate name: it names the cached crate's directory, the binary and cargo's
+/// files (`<name>-<16 hex>.d`), each at most 255 bytes on common file systems.
+pub const MAX_CRATE_NAME: usize = 64;
+
+/// `name` if it has at most [`MAX_CRATE_NAME`] bytes; otherwise its first 47 bytes and 16 hex
+/// digits of the SHA-256 of `model_name`, so that distinct long model names stay distinct.
+fn bounded(model_name: &str, name: String) -> String {
+    if name.len() <= MAX_CRATE_NAME {
+        return name;
+    }
+    let mut hash = crate::package::sha256::Sha256::new();
+    hash.update(model_name.as_bytes());
+    let hex = hash.finish_hex();
+    let cut = name.char_indices().nth(47).map_or(name.len(), |(i, _)| i);
+    format!("{}-{}", name[..cut].trim_end_matches('-'), &hex[..16])
+}
+
+fn unbounded_crate_name(model_name: &str) -> String {
     let name = words(model_name)
         .iter()
         .map(|w| w.to_ascii_lowercase())
@@ -277,6 +299,18 @@ mod tests {
         assert_eq!(crate_name("build"), "model-build");
         assert_eq!(crate_name(""), "model");
         assert_eq!(crate_name("**"), "model");
+        // Long names are cut and hashed: at most 64 bytes, distinct names stay distinct.
+        let long_a = "a".repeat(300);
+        let long_b = format!("{}b", "a".repeat(299));
+        let (a, b) = (crate_name(&long_a), crate_name(&long_b));
+        assert_eq!(a.len(), 64);
+        assert!(
+            a.starts_with(&"a".repeat(47)) && a.as_bytes()[47] == b'-',
+            "{a}"
+        );
+        assert_ne!(a, b);
+        assert_eq!(b.len(), 64);
+        assert_eq!(crate_name(&"a".repeat(64)), "a".repeat(64));
         assert_eq!(crate_ident("van-der-pol"), "van_der_pol");
     }
 

@@ -35,7 +35,7 @@ pub mod cargo;
 pub mod embedded;
 mod fsutil;
 pub mod lock;
-mod sha256;
+pub(crate) mod sha256;
 pub mod writer;
 
 use std::fmt;

@@ -1,6 +1,6 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
-use super::{csv_field, num, summary_indices};
+use super::{count, csv_field, num, summary_indices, time};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
 use reachc_core::prs::{
     BallBound, DetSet, Hint, Proved, Prs, R1Method, Step, TransformUsed, UniformBound, Unproved,
@@ -528,13 +528,15 @@ fn proved(p: &Proved) -> String {
              contraction rate): the sets hold over whole steps, not only at report times"
         ),
         Proved::ValidatedEmbedding { steps } => format!(
-            "embedding system on {steps} validated steps (the comparison principle on each \
+            "embedding system on {} (the comparison principle on each \
              step's hull, time as an interval): the boxes hold over whole steps, not only at \
-             report times"
+             report times",
+            count(*steps as u64, "validated step")
         ),
         Proved::LocalRates { regions, metric } => format!(
-            "local rates on {regions} regions, each holding the tube over its step, so the \
-             process never leaves them on the tube's event (metric {metric})"
+            "local rates on {}, each holding the tube over its step, so the process never \
+             leaves them on the tube's event (metric {metric})",
+            count(*regions as u64, "region")
         ),
         Proved::UniformTube { epochs } => format!(
             "time-uniform tube: Ville's inequality on the averaged-MGF supermartingale over \
@@ -735,8 +737,9 @@ pub fn summary(prs: &Prs) -> String {
             if let Some(t) = prs.rate.global_from {
                 let _ = writeln!(
                     s,
-                    "  from t = {t}, no region around the tube closed: the global constants over \
-                     the domain took over (the result is conditional on the domain)"
+                    "  from t = {}, no region around the tube closed: the global constants over \
+                     the domain took over (the result is conditional on the domain)",
+                    time(t)
                 );
             }
         }
@@ -823,18 +826,18 @@ pub fn summary(prs: &Prs) -> String {
                 "safe".to_string()
             } else {
                 format!(
-                    "NOT SHOWN SAFE (first at t = {:.4})",
-                    u.first_not_safe_t.unwrap_or(f64::NAN)
+                    "NOT SHOWN SAFE (first at t = {})",
+                    time(u.first_not_safe_t.unwrap_or(f64::NAN))
                 )
             };
             let unit = UnsafeJson::of(u).margin_unit;
             let _ = writeln!(
                 s,
-                "  unsafe set `{}` ({}): {status}; min margin {} at t = {:.4} ({unit})",
+                "  unsafe set `{}` ({}): {status}; min margin {} at t = {} ({unit})",
                 u.name,
                 unsafe_kind(u.kind),
                 num(u.min_margin),
-                u.min_margin_t,
+                time(u.min_margin_t),
             );
         }
     }
@@ -860,8 +863,9 @@ pub fn summary(prs: &Prs) -> String {
         },
         Verdict::NoUnsafeSets => "no unsafe sets to check".to_string(),
         Verdict::NotShownSafe { t, set, .. } => format!(
-            "not shown safe: the PRS over the interval ending at t = {t:.4} meets `{}` (this \
+            "not shown safe: the PRS over the interval ending at t = {} meets `{}` (this \
              does not prove a violation)",
+            time(*t),
             prs.unsafe_sets[*set].name
         ),
     };
@@ -929,11 +933,12 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
         } => {
             let ball = if c < 0.0 { "shrinks" } else { "bounds" };
             format!(
-                "the box grows (wrapping): the PRS's half-width in `{}` is {} by t = {t:.4} while \
+                "the box grows (wrapping): the PRS's half-width in `{}` is {} by t = {} while \
                  the contraction rate c = {} {ball} P-balls (half-width {} from the same initial \
                  set and r_t): {try_this}",
                 prs.states[state],
                 num(half_width),
+                time(t),
                 num(c),
                 num(ball_half_width)
             )
@@ -944,9 +949,10 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
             range,
             domain,
         } => format!(
-            "the box leaves the domain in `{}` at t = {t:.4} ([{}, {}] is not in [{}, {}]; the \
+            "the box leaves the domain in `{}` at t = {} ([{}, {}] is not in [{}, {}]; the \
              constants hold only in the domain): {try_this}",
             prs.states[state],
+            time(t),
             num(range.lo),
             num(range.hi),
             num(domain.lo),

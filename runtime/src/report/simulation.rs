@@ -2,7 +2,7 @@
 //! summary.
 
 use super::result::unsafe_kind;
-use super::summary_indices;
+use super::{count, summary_indices, time};
 use reachc_core::model::Guarantee;
 use reachc_core::simulate::{InitialSampling, InputMode, NoiseKind, SimReport};
 use serde::Serialize;
@@ -259,11 +259,13 @@ pub fn summary(r: &SimReport) -> String {
         r.guarantee.name()
     );
     // dt is a quotient (step / substeps): show it without its last-digit noise.
-    let dt: f64 = format!("{:.10e}", r.dt).parse().unwrap_or(r.dt);
     let _ = writeln!(
         s,
-        "  {} paths (seed {}), Euler-Maruyama with dt = {dt} ({} steps per path)",
-        r.paths, r.seed, r.steps_per_path
+        "  {} (seed {}), Euler-Maruyama with dt = {} ({} per path)",
+        count(r.paths, "path"),
+        r.seed,
+        time(r.dt),
+        count(r.steps_per_path, "step")
     );
     let _ = writeln!(s, "  initial states: {}", initial_states(r.initial_states));
     let _ = writeln!(s, "  inputs: {}", inputs(r));
@@ -296,9 +298,11 @@ pub fn summary(r: &SimReport) -> String {
     }
     let _ = write!(
         s,
-        "  over the horizon: {} paths ({:.3e}) outside the PRS at some report time (CP upper \
+        "  over the horizon: {} ({:.3e}) outside the PRS at some report time (CP upper \
          {:.3e})",
-        r.horizon.outside_any, r.horizon.fraction, r.horizon.cp_upper
+        count(r.horizon.outside_any, "path"),
+        r.horizon.fraction,
+        r.horizon.cp_upper
     );
     if r.guarantee == Guarantee::Pointwise {
         s.push_str("; the PRS bounds each time separately, not uniformly in time");
@@ -307,44 +311,54 @@ pub fn summary(r: &SimReport) -> String {
     if let Some(t) = &r.tube {
         let _ = writeln!(
             s,
-            "  tube, all times at once: {} paths ({:.3e}) left it at some time (Clopper-Pearson \
+            "  tube, all times at once: {} ({:.3e}) left it at some time (Clopper-Pearson \
              bounds [{:.3e}, {:.3e}] at confidence {}); checked at every Euler-Maruyama step ({} \
              states per path) against the PRS over its report interval, and at each report time \
              against that time's PRS",
-            t.outside, t.fraction, t.cp_lower, t.cp_upper, r.confidence, t.checks_per_path
+            count(t.outside, "path"),
+            t.fraction,
+            t.cp_lower,
+            t.cp_upper,
+            r.confidence,
+            t.checks_per_path
         );
     }
     for u in &r.unsafe_sets {
         let first = u
             .first_hit_t
-            .map_or(String::new(), |t| format!(", first at t = {t:.4}"));
+            .map_or(String::new(), |t| format!(", first at t = {}", time(t)));
         let _ = writeln!(
             s,
-            "  unsafe set `{}` ({}): entered by {} paths ({:.3e}){first}",
+            "  unsafe set `{}` ({}): entered by {} ({:.3e}){first}",
             u.name,
             unsafe_kind(u.kind),
-            u.hits,
+            count(u.hits, "path"),
             u.fraction
         );
     }
     if let Some(left) = r.left_domain {
         let _ = writeln!(
             s,
-            "  left the domain: {left} paths (the PRS holds only while the state stays in it)"
+            "  left the domain: {} (the PRS holds only while the state stays in it)",
+            count(left, "path")
         );
     }
     if r.diverged > 0 {
-        let _ = writeln!(s, "  diverged (non-finite state): {} paths", r.diverged);
+        let _ = writeln!(
+            s,
+            "  diverged (non-finite state): {}",
+            count(r.diverged, "path")
+        );
     }
     let v = &r.verdict;
     let verdict = if r.passed() { "PASS" } else { "FAIL" };
     let per_time = format!(
         "{} of {} report times with a Clopper-Pearson lower bound above delta at level 1 - \
-         {:.1e}; worst t = {:.4}: {} outside, lower bound {:.3e}",
+         {:.1e}; worst t = {}: {} outside, lower bound {:.3e}",
         v.failing_steps,
         r.steps.len(),
         v.alpha_per_step,
-        v.worst_t,
+        time(v.worst_t),
         v.worst_outside,
         v.worst_cp_lower
     );
