@@ -48,7 +48,7 @@ fn main() {
         };
         let start = Instant::now();
         let progress = |done: usize, total: usize| {
-            if done % 500 == 0 || done == total {
+            if done.is_multiple_of(500) || done == total {
                 eprintln!(
                     "{}: {done}/{total} ({:.0} s)",
                     command.name(),
