@@ -118,6 +118,15 @@ pub fn scale_matrix(src: &str, toks: &[Token], at: &Pick, factor: &str) -> Strin
     out + &src[last..]
 }
 
+/// The block of the item or loop starting with `word` that `at` picks: the indices of that
+/// token, of the `{` after it and of the matching `}`.
+fn block(src: &str, toks: &[Token], word: &str, at: &Pick) -> Option<(usize, usize, usize)> {
+    let starts: Vec<usize> = positions(src, toks, word).collect();
+    let start = *starts.get(at.of(starts.len().max(1)))?;
+    let open = (start..toks.len()).find(|&i| &src[toks[i].span.clone()] == "{")?;
+    Some((start, open, closing(src, toks, open)?))
+}
+
 /// Repeats the `for` loop `at` picks right after itself, or wraps it in `times` loops.
 pub fn for_loop(
     src: &str,
@@ -127,15 +136,7 @@ pub fn for_loop(
     times: usize,
     end: &str,
 ) -> String {
-    let fors: Vec<usize> = positions(src, toks, "for").collect();
-    if fors.is_empty() {
-        return src.into();
-    }
-    let start = fors[at.of(fors.len())];
-    let Some(open) = (start..toks.len()).find(|&i| &src[toks[i].span.clone()] == "{") else {
-        return src.into();
-    };
-    let Some(close) = closing(src, toks, open) else {
+    let Some((start, _, close)) = block(src, toks, "for", at) else {
         return src.into();
     };
     let span = toks[start].span.start..toks[close].span.end;
@@ -155,15 +156,9 @@ pub fn for_loop(
 pub fn analysis_key(src: &str, toks: &[Token], at: &Pick, key: &Pick, value: &Pick) -> String {
     let (key, values) = ANALYSIS[key.of(ANALYSIS.len())];
     let value = values[value.of(values.len())];
-    let blocks: Vec<usize> = positions(src, toks, "analysis").collect();
-    if blocks.is_empty() {
-        return src.into();
-    }
-    let start = blocks[at.of(blocks.len())];
-    let Some(open) = (start..toks.len()).find(|&i| &src[toks[i].span.clone()] == "{") else {
+    let Some((_, open, close)) = block(src, toks, "analysis", at) else {
         return src.into();
     };
-    let close = closing(src, toks, open).unwrap_or(toks.len() - 1);
     let text = |i: usize| &src[toks[i].span.clone()];
     let field = |i: usize| toks[i].kind == Kind::Ident && i + 1 < close && text(i + 1) == "=";
     let existing = (open + 1..close).find(|&i| text(i) == key && field(i));
