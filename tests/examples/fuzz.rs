@@ -3,8 +3,9 @@
 //! prints the outcome counts and rates, and saves one minimised reproducer per failure class.
 //!
 //! `cargo run --release -p reachc-e2e --example fuzz -- [--check N] [--run N] [--threads N]
-//! [--seed N] [--findings DIR] [--minimise N]` (defaults: 10000, 1000, 2, 15,
-//! tests/fuzz/findings, 150 runs per reproducer).
+//! [--seed N] [--findings DIR] [--minimise N] [--failures DIR]` (defaults: 10000, 1000, 2, 15,
+//! tests/fuzz/findings, 150 runs per reproducer; with `--failures`, every failing mutant is
+//! also written there, unminimised, as COMMAND-INDEX-CLASS.sde, for triage).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -20,7 +21,9 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     for pair in args.chunks(2) {
         let [key, value] = pair else {
-            panic!("options come in pairs: --check N --run N --threads N --seed N --findings DIR --minimise N");
+            panic!(
+                "options come in pairs: --check N --run N --threads N --seed N --findings DIR .."
+            );
         };
         opts.insert(key.trim_start_matches("--").to_string(), value.clone());
     }
@@ -68,6 +71,13 @@ fn main() {
     println!("\n| command | outcome | count |\n|---|---|---|");
     for ((command, outcome), n) in counts(&records) {
         println!("| {} | {} | {n} |", command.name(), outcome.name());
+    }
+    if let Some(dir) = opts.get("failures") {
+        std::fs::create_dir_all(dir).expect("the failures folder can be created");
+        for r in records.iter().filter(|r| r.outcome.is_failure()) {
+            let name = format!("{}-{}-{}.sde", r.command.name(), r.index, r.outcome.name());
+            std::fs::write(PathBuf::from(dir).join(name), &r.bytes).expect("writable");
+        }
     }
     save_findings(&records, &findings, num("minimise", 150) as usize);
 }

@@ -19,7 +19,8 @@ pub enum Outcome {
     NoLocation,
     /// Failure: a Rust panic (the message, or exit code 101).
     Panic,
-    /// Failure: killed at the end of its time budget.
+    /// Failure: out of CPU time (`SIGXCPU`, or `SIGKILL` at the hard limit) or of wall-clock
+    /// time.
     Timeout,
     /// Failure: an allocation failed under the address-space limit.
     OutOfMemory,
@@ -81,6 +82,7 @@ pub fn classify(exit: &Exit, spec_error: bool) -> Outcome {
         return Outcome::StackOverflow;
     }
     match (exit.code, exit.signal) {
+        (_, Some(libc::SIGXCPU | libc::SIGKILL)) => Outcome::Timeout,
         (_, Some(libc::SIGXFSZ)) => Outcome::OutputTooLarge,
         (_, Some(libc::SIGABRT)) | (Some(134), _) => Outcome::Abort,
         (_, Some(signal)) => Outcome::Signal(signal),

@@ -1,5 +1,7 @@
-//! Runs `reachc` as a subprocess under a budget: a wall-clock timeout (the child is killed),
-//! an address-space limit (`RLIMIT_AS`, so a huge allocation fails inside the child instead of
+//! Runs `reachc` as a subprocess under a budget: a CPU-time limit (`RLIMIT_CPU`: the measure
+//! of a hang that does not depend on how loaded the shared machine is), a wall-clock timeout
+//! at three times that (the child is killed; catches a child that blocks), an address-space
+//! limit (`RLIMIT_AS`, so a huge allocation fails inside the child instead of
 //! exhausting the machine), a limit on the size of any file it writes (`RLIMIT_FSIZE`) and no
 //! core dumps.
 
@@ -13,8 +15,9 @@ use std::time::{Duration, Instant};
 /// What one input may spend.
 #[derive(Clone, Copy, Debug)]
 pub struct Budget {
-    /// Wall-clock time before the child is killed.
-    pub wall: Duration,
+    /// CPU time of the child (whole seconds, at least one); the wall clock allows three times
+    /// as much.
+    pub cpu: Duration,
     /// Address space of the child, in bytes.
     pub memory: u64,
     /// Largest file the child may write (its stderr included), in bytes.
@@ -22,15 +25,15 @@ pub struct Budget {
 }
 
 impl Budget {
-    /// The budget of a `check`: 2 s, 1 GiB, 16 MiB files.
+    /// The budget of a `check`: 2 s of CPU, 1 GiB, 16 MiB files.
     pub const CHECK: Budget = Budget {
-        wall: Duration::from_secs(2),
+        cpu: Duration::from_secs(2),
         memory: 1 << 30,
         file: 16 << 20,
     };
-    /// The budget of a `run --backend interp`: 10 s, 2 GiB, 64 MiB files.
+    /// The budget of a `run --backend interp`: 10 s of CPU, 2 GiB, 64 MiB files.
     pub const RUN: Budget = Budget {
-        wall: Duration::from_secs(10),
+        cpu: Duration::from_secs(10),
         memory: 2 << 30,
         file: 64 << 20,
     };
@@ -43,7 +46,7 @@ pub struct Exit {
     pub code: Option<i32>,
     /// The signal that ended it, if one did (not counting our kill on timeout).
     pub signal: Option<i32>,
-    /// Whether it was killed at the end of its time.
+    /// Whether it was killed at the end of its wall-clock time.
     pub timed_out: bool,
     /// Its standard error (lossy UTF-8).
     pub stderr: String,
@@ -62,15 +65,18 @@ pub fn run(mut cmd: Command, budget: &Budget, stderr_file: &Path) -> std::io::Re
     unsafe {
         cmd.pre_exec(move || {
             // The resource type differs between C libraries: let the array infer it.
+            let cpu = limits.cpu.as_secs().max(1);
             let limits = [
-                (libc::RLIMIT_AS, limits.memory),
-                (libc::RLIMIT_FSIZE, limits.file),
-                (libc::RLIMIT_CORE, 0),
+                (libc::RLIMIT_AS, limits.memory, limits.memory),
+                // SIGXCPU at the soft limit, SIGKILL a second later if it is ignored.
+                (libc::RLIMIT_CPU, cpu, cpu + 1),
+                (libc::RLIMIT_FSIZE, limits.file, limits.file),
+                (libc::RLIMIT_CORE, 0, 0),
             ];
-            for (resource, value) in limits {
+            for (resource, soft, hard) in limits {
                 let rl = libc::rlimit {
-                    rlim_cur: value,
-                    rlim_max: value,
+                    rlim_cur: soft,
+                    rlim_max: hard,
                 };
                 if libc::setrlimit(resource, &rl) != 0 {
                     return Err(std::io::Error::last_os_error());
@@ -86,7 +92,7 @@ pub fn run(mut cmd: Command, budget: &Budget, stderr_file: &Path) -> std::io::Re
         if let Some(status) = child.try_wait()? {
             break (status, false);
         }
-        if start.elapsed() >= budget.wall {
+        if start.elapsed() >= budget.cpu.max(Duration::from_secs(1)) * 3 {
             // Already exited between try_wait and kill is fine: wait reaps it either way.
             let _ = child.kill();
             break (child.wait()?, true);
