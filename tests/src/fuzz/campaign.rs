@@ -195,8 +195,9 @@ impl Drop for Scratch {
     }
 }
 
-/// Runs `bytes` as a spec through `command` in `dir`; `spec_error` as in [`classify`]. Returns
-/// the outcome, the first lines of stderr and the time taken.
+/// Runs `bytes` as a spec through `command` in `dir` (for `run`, `check` first: an exit 1 of
+/// `run` needs a located diagnostic only when the spec does not check). Returns the outcome,
+/// the first lines of stderr and the time taken.
 pub fn run_one(command: Command, bytes: &[u8], dir: &Path) -> (Outcome, String, Duration) {
     let spec = dir.join("mutant.sde");
     let out = dir.join("out");
