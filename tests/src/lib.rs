@@ -6,6 +6,8 @@ use reachc_compiler::driver::load;
 use reachc_runtime::model::ModelInfo;
 use std::path::{Path, PathBuf};
 
+pub mod fuzz;
+
 /// The interpreter of a checked model, with its model data.
 pub fn interpreter_of(mut model: reachc_compiler::model::Model) -> (Interpreter, ModelInfo) {
     let prepared = prepare(&mut model);

@@ -98,7 +98,10 @@ impl Tube {
             };
         }
         let ratio = (s_last / s_first.max(f64::MIN_POSITIVE)).max(1.0);
-        let k = (ratio.log2().ceil() as usize + 1).clamp(1, MAX_EPOCHS);
+        // An infinite scale (a run that diverges) saturates the cast: add without overflow.
+        let k = (ratio.log2().ceil() as usize)
+            .saturating_add(1)
+            .clamp(1, MAX_EPOCHS);
         // A little below delta / K, so that the K shares sum to at most delta.
         let delta_k = (delta / k as f64).next_down();
         let (kappa, z) = amgf_minimiser(n, delta_k);
@@ -223,6 +226,14 @@ mod tests {
 
     /// At each epoch's threshold the tube's radius is the pointwise one at delta / K; between
     /// thresholds it is larger than the pointwise one at delta, by a bounded factor.
+    #[test]
+    fn an_infinite_scale_gets_the_most_epochs_without_overflow() {
+        // Found by the fuzz campaign (tests/fuzz/findings/run-panic.sde): `horizon = 100000`
+        // on an unstable model, whose scale overflows to infinity.
+        let tube = Tube::new(2, 1e-3, 1e-2, f64::INFINITY);
+        assert_eq!(tube.epochs.len(), MAX_EPOCHS);
+    }
+
     #[test]
     fn the_tube_meets_the_pointwise_radius_at_the_thresholds() {
         let (n, delta) = (2, 1e-3);
