@@ -113,7 +113,8 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
             source: String::new(),
         });
     };
-    let source = String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))?;
+    let source =
+        String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let (model, diagnostics) = check_source(&source, dir);
     match model {

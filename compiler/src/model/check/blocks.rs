@@ -4,8 +4,8 @@ use super::lower::{Allow, LoopEnv};
 use super::scope::{Symbol, VarKind};
 use super::Checker;
 use crate::diagnostics::{Diagnostic, Span};
-use crate::limits::MAX_UNROLLED;
 use crate::ir::{ExprId, Var};
+use crate::limits::MAX_UNROLLED;
 use crate::model::Bounds;
 use crate::syntax::ast::{Expr, ExprKind, Item, Spec, Stmt, Target};
 
