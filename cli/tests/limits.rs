@@ -167,5 +167,5 @@ fn a_spec_that_is_not_utf8_is_a_located_spec_error() {
     .unwrap();
     let out = reachc(&["check", path.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("bad.sde:2:16"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("bad.sde:2:19"), "{}", stderr(&out));
 }

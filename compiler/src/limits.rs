@@ -12,7 +12,7 @@ pub const MAX_TABLE_LEN: usize = 8 * 1024 * 1024;
 /// Deepest accepted nesting of parentheses, brackets, calls, indices, unary minus, `^` and blocks.
 pub const MAX_DEPTH: usize = 200;
 
-/// Tallest accepted expression tree (long `a + b + c + ...` chains count one level per operator).
+/// Most operators on one path of an expression tree (a chain `a + b + c + ...` counts each).
 pub const MAX_HEIGHT: usize = 1000;
 
 /// Most statements (and loop iterations) that unrolling `for` loops may produce in one spec,

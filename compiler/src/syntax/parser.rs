@@ -1047,7 +1047,8 @@ impl<'s> Parser<'s> {
     fn binary(&mut self, op: BinOp, op_span: Span, lhs: HExpr, rhs: HExpr) -> P<HExpr> {
         let h = 1 + lhs.1.max(rhs.1);
         let span = lhs.0.span.start..rhs.0.span.end;
-        if h > MAX_HEIGHT {
+        // Heights count leaves as 1: `h - 1` operators on the longest path.
+        if h - 1 > MAX_HEIGHT {
             return Err(self.too_long(op_span));
         }
         let kind = ExprKind::Binary {

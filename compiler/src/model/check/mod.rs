@@ -404,7 +404,9 @@ impl Checker<'_> {
                 );
             }
         }
-        if self.states.is_empty() {
+        // A declaration with errors (a family too large) was already reported.
+        let declared = spec.items.iter().any(|i| matches!(i, Item::State(_)));
+        if self.states.is_empty() && !declared {
             let span = spec.model.as_ref().map_or(0..0, |m| m.span.clone());
             self.diags.push(
                 Diagnostic::error(
