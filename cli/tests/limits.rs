@@ -4,11 +4,11 @@
 
 mod common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::time::{Duration, Instant};
 
-use common::reachc;
+use common::{reachc, spec};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("reachc-cli-limits-{}-{name}", std::process::id()));
@@ -43,6 +43,15 @@ fn quick(args: &[&str], secs: u64) -> Output {
         "{args:?} took {:?}",
         start.elapsed()
     );
+    out
+}
+
+/// Runs `spec` with the interpreter into `out` next to it (under 20 s); the output folder.
+fn run_interp(spec: &Path) -> PathBuf {
+    let out = spec.with_file_name("out");
+    let args = ["run", "--backend", "interp", "-o"];
+    let (out_s, spec_s) = (out.to_str().unwrap(), spec.to_str().unwrap());
+    quick(&[&args[..], &[out_s, spec_s]].concat(), 20);
     out
 }
 
@@ -82,18 +91,7 @@ fn shared_subexpressions_stay_linear_in_every_command() {
         );
         assert!(lets.len() >= n / 2 - 2, "{n}: {} lets", lets.len());
 
-        let out = dir.join("out");
-        quick(
-            &[
-                "run",
-                "--backend",
-                "interp",
-                "-o",
-                out.to_str().unwrap(),
-                spec,
-            ],
-            20,
-        );
+        let out = run_interp(&path);
         assert!(std::fs::metadata(out.join("a.json")).unwrap().len() < 100_000);
 
         let krate = dir.join("crate");
@@ -104,6 +102,13 @@ fn shared_subexpressions_stay_linear_in_every_command() {
         let lib = std::fs::metadata(krate.join("src/lib.rs")).unwrap().len();
         assert!(lib < 1_000_000, "{n}: lib.rs has {lib} bytes");
     }
+}
+
+#[test]
+fn small_models_print_without_shared_lets() {
+    let out = quick(&["inspect", "--json", &spec("pendulum.sde")], 20);
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["lets"], serde_json::json!([]));
 }
 
 /// The hull of the PRS at the horizon, from `run --backend interp`.
@@ -119,18 +124,7 @@ fn final_hull(name: &str, metric: &str) -> Vec<f64> {
         ),
     )
     .unwrap();
-    let out = dir.join("out");
-    quick(
-        &[
-            "run",
-            "--backend",
-            "interp",
-            "-o",
-            out.to_str().unwrap(),
-            path.to_str().unwrap(),
-        ],
-        30,
-    );
+    let out = run_interp(&path);
     let j: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("a.json")).unwrap()).unwrap();
     let last = j["steps"].as_array().unwrap().last().unwrap().clone();
