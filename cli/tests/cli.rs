@@ -74,10 +74,10 @@ fn hostile_input_gives_diagnostics_not_crashes() {
 
     let binary = temp_spec("binary.sde", "");
     std::fs::write(&binary, [0xff, 0xfe, 0x00, 0x41]).unwrap();
-    assert_eq!(
-        reachc(&["check", binary.to_str().unwrap()]).status.code(),
-        Some(2)
-    );
+    // Not UTF-8: a spec error at the first bad byte (docs/language.md, "Limits").
+    let out = reachc(&["check", binary.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("binary.sde:1:1"), "{}", stderr(&out));
 }
 
 fn inspect_json(name: &str) -> serde_json::Value {

@@ -96,7 +96,7 @@ pub fn has_errors(diags: &[Diagnostic]) -> bool {
 /// Renders diagnostics for the source `src` named `path`, in source order.
 /// `color` selects ANSI colours (off for tests and pipes).
 pub fn render(diags: &[Diagnostic], path: &str, src: &str, color: bool) -> String {
-    use ariadne::{Config, Label as ALabel, Report, ReportKind, Source};
+    use ariadne::{Config, IndexType, Label as ALabel, Report, ReportKind, Source};
     let mut out = Vec::new();
     let mut sorted: Vec<&Diagnostic> = diags.iter().collect();
     sorted.sort_by_key(|d| d.span().start);
@@ -109,7 +109,12 @@ pub fn render(diags: &[Diagnostic], path: &str, src: &str, color: bool) -> Strin
         };
         let primary = clamp(&d.span());
         let mut report = Report::build(kind, (path, primary.clone()))
-            .with_config(Config::default().with_color(color))
+            // Spans are byte offsets (ariadne counts chars unless told).
+            .with_config(
+                Config::default()
+                    .with_color(color)
+                    .with_index_type(IndexType::Byte),
+            )
             .with_message(&d.message);
         for (i, l) in d.labels.iter().enumerate() {
             let mut label = ALabel::new((path, clamp(&l.span)));

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::diagnostics::{has_errors, render, Diagnostic};
+use crate::limits::MAX_SOURCE_LEN;
 use crate::model::{check, Model};
 use crate::syntax::parse;
 
@@ -71,17 +72,49 @@ pub fn check_source(source: &str, dir: &Path) -> (Option<Model>, Vec<Diagnostic>
     (model, all)
 }
 
+/// The bytes of the file at `path`, or `None` if it has more than `cap` bytes. Reads at most
+/// `cap + 1` bytes, so a special file (`/dev/zero`, a FIFO fed forever) cannot exhaust memory.
+pub(crate) fn read_capped(path: &Path, cap: usize) -> std::io::Result<Option<Vec<u8>>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    let limit = u64::try_from(cap).map_or(u64::MAX, |c| c.saturating_add(1));
+    std::fs::File::open(path)?
+        .take(limit)
+        .read_to_end(&mut bytes)?;
+    Ok((bytes.len() <= cap).then_some(bytes))
+}
+
+/// A spec error at the first invalid byte of `bytes` (rendered over the text with invalid bytes
+/// replaced, which is the same text up to that byte, so line and column are right).
+fn not_utf8(path: &Path, bytes: &[u8], e: std::str::Utf8Error) -> LoadError {
+    let at = e.valid_up_to();
+    let source = String::from_utf8_lossy(bytes).into_owned();
+    let d = Diagnostic::error(
+        "the spec is not UTF-8 text",
+        at..at + char::REPLACEMENT_CHARACTER.len_utf8(),
+        format!("invalid byte 0x{:02x} (offset {at})", bytes[at]),
+    )
+    .with_help("save the file as UTF-8");
+    LoadError::Spec {
+        diagnostics: vec![d],
+        path: path.display().to_string(),
+        source,
+    }
+}
+
 /// Reads, parses and checks the spec at `path`.
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
-    let bytes = std::fs::read(path)
+    let bytes = read_capped(path, MAX_SOURCE_LEN)
         .map_err(|e| LoadError::Io(format!("cannot read {}: {e}", path.display())))?;
-    let source = String::from_utf8(bytes).map_err(|e| {
-        LoadError::Io(format!(
-            "{} is not UTF-8 text (byte {})",
-            path.display(),
-            e.utf8_error().valid_up_to()
-        ))
-    })?;
+    let Some(bytes) = bytes else {
+        return Err(LoadError::Spec {
+            diagnostics: vec![crate::syntax::too_large()],
+            path: path.display().to_string(),
+            source: String::new(),
+        });
+    };
+    let source =
+        String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let (model, diagnostics) = check_source(&source, dir);
     match model {

@@ -14,6 +14,7 @@ pub mod config;
 pub mod diagnostics;
 pub mod driver;
 pub mod ir;
+pub mod limits;
 pub mod model;
 pub mod package;
 pub mod syntax;

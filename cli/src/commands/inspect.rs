@@ -1,8 +1,9 @@
 //! `reachc inspect`: the checked model, its Jacobians, atoms and bounds, as text or JSON.
 //!
 //! Both forms come from one `Report`. Expressions are printed once per distinct IR node (a
-//! 1000-state chain has a million Jacobian entries but few distinct ones), and the JSON is
-//! streamed from borrowed data rather than built as a tree.
+//! 1000-state chain has a million Jacobian entries but few distinct ones), large shared
+//! sub-expressions once as `let`s (so the output stays linear in the size of the IR), and the
+//! JSON is streamed from borrowed data rather than built as a tree.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -40,6 +41,8 @@ struct Report {
     time: Interval,
     /// Every expression shown, printed in `.sde` syntax.
     printed: HashMap<ExprId, String>,
+    /// The shared sub-expressions the printed expressions use, `(name, expression)` in order.
+    lets: Vec<(String, String)>,
 }
 
 fn names(v: &[Variable]) -> Vec<String> {
@@ -113,15 +116,13 @@ fn report(model: &mut Model) -> Report {
         noises: &noises,
         tables: &model.tables,
     };
-    let printed = all
-        .into_iter()
-        .map(|e| (e, model.pool.to_sde(e, &sde_names)))
-        .collect();
+    let shared = model.pool.to_sde_shared(&all, &sde_names);
     Report {
         matrices,
         jac_g,
         time,
-        printed,
+        printed: all.into_iter().zip(shared.exprs).collect(),
+        lets: shared.lets,
     }
 }
 
@@ -170,6 +171,12 @@ struct UnboundedDoc<'a> {
 }
 
 #[derive(Serialize)]
+struct LetDoc<'a> {
+    name: &'a str,
+    expr: &'a str,
+}
+
+#[derive(Serialize)]
 struct Doc<'a> {
     model: &'a str,
     doc: Option<&'a str>,
@@ -180,6 +187,7 @@ struct Doc<'a> {
     initial_balls: Vec<Value>,
     domain_given: bool,
     time_range: [f64; 2],
+    lets: Vec<LetDoc<'a>>,
     drift: Vec<&'a str>,
     diffusion: Vec<Vec<&'a str>>,
     jacobian_x: Vec<Vec<&'a str>>,
@@ -261,6 +269,7 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             .collect(),
         domain_given: model.has_domain,
         time_range: ends(r.time),
+        lets: r.lets.iter().map(|(name, expr)| LetDoc { name, expr }).collect(),
         drift: model.drift.iter().map(|&e| r.sde(e)).collect(),
         diffusion: grid(&r.matrices[0].rows),
         jacobian_x: grid(&r.matrices[1].rows),
@@ -381,6 +390,12 @@ pub fn text(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     if !model.noises.is_empty() {
         let ws: Vec<&str> = model.noises.iter().map(|w| w.name.as_str()).collect();
         let _ = writeln!(o, "\nnoise: {}", ws.join(", "));
+    }
+    if !r.lets.is_empty() {
+        let _ = writeln!(o, "\nshared sub-expressions:");
+        for (name, e) in &r.lets {
+            let _ = writeln!(o, "  let {name} = {e}");
+        }
     }
     let _ = writeln!(o, "\ndrift (simplified):");
     for (s, &f) in model.states.iter().zip(&model.drift) {

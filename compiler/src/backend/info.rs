@@ -9,6 +9,9 @@ use crate::analysis::{
 };
 use crate::diagnostics::Diagnostic;
 use crate::ir::Names;
+
+/// Longest expression an "unbounded" message shows, in bytes (then ` ...`).
+const MAX_SHOWN: usize = 200;
 use crate::model::{self, MetricChoice, Model, Rate};
 use reachc_core::interval::Interval;
 use reachc_core::model::{AnalysisSpec, Constants, MetricRegion, Provenance};
@@ -286,10 +289,14 @@ fn explain(model: &Model, d: &Derivatives, e: &ConstantsError) -> (String, Strin
             d.jac_x[row][column],
         ),
     };
-    let message = format!(
-        "{what} = {} is unbounded over the domain",
-        model.pool.to_sde(expr, &sde)
-    );
+    // A prefix: printed as a tree, an entry over shared lets can be millions of characters.
+    let mut shown = model.pool.to_sde_prefix(expr, &sde, MAX_SHOWN);
+    if shown.len() > MAX_SHOWN {
+        let cut = (0..=MAX_SHOWN).rev().find(|&i| shown.is_char_boundary(i));
+        shown.truncate(cut.unwrap_or(0));
+        shown.push_str(" ...");
+    }
+    let message = format!("{what} = {shown} is unbounded over the domain");
     let vars: Vec<String> = model
         .pool
         .vars_of(expr)

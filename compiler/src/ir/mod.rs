@@ -13,10 +13,12 @@ mod eval;
 mod node;
 mod pool;
 mod print;
+mod shared;
 mod table;
 
 pub use eval::{Arith, VarValues};
 pub use node::{ExprId, Func1, Func2, Node, Var, F64};
 pub use pool::Pool;
 pub use print::Names;
+pub use shared::SharedText;
 pub use table::Table;

@@ -71,8 +71,9 @@ impl Pool {
     /// the `.sde` grammar because no spec can write them: `sign(x)` (derivative of `abs`) and
     /// `(cos(x) - sinc(x))/x` for [`Func1::DSinc`], which equals it except at `x = 0`.
     ///
-    /// Printing expands the DAG into a tree (shared sub-expressions repeat) and uses an
-    /// explicit stack, so any depth is fine.
+    /// Printing expands the DAG into a tree (shared sub-expressions repeat, so the text can be
+    /// exponentially longer than the DAG: [`Pool::to_sde_shared`] names them instead) and uses
+    /// an explicit stack, so any depth is fine.
     pub fn to_sde(&self, e: ExprId, names: &Names<'_>) -> String {
         self.to_sde_prefix(e, names, usize::MAX)
     }
@@ -81,6 +82,18 @@ impl Pool {
     /// it is at most `max` bytes long, else a prefix of it longer than `max`. The expanded tree
     /// can be exponentially larger than the DAG, so this bounds the work, e.g. for docs.
     pub fn to_sde_prefix(&self, e: ExprId, names: &Names<'_>, max: usize) -> String {
+        self.print(e, names, max, &|_| None)
+    }
+
+    /// [`Pool::to_sde_prefix`] where every sub-expression below `e` that `named` names prints
+    /// as that name (the `let`s of [`Pool::to_sde_shared`]).
+    pub(super) fn print<'n>(
+        &self,
+        e: ExprId,
+        names: &Names<'_>,
+        max: usize,
+        named: &dyn Fn(ExprId) -> Option<&'n str>,
+    ) -> String {
         let mut out = String::new();
         let mut stack = vec![Piece::Expr(e, 0)];
         let mut pieces = Vec::new();
@@ -90,6 +103,9 @@ impl Pool {
             }
             match p {
                 Piece::Text(s) => out.push_str(&s),
+                Piece::Expr(id, _) if id != e && named(id).is_some() => {
+                    out.push_str(named(id).unwrap_or_default());
+                }
                 Piece::Expr(id, min) => {
                     self.pieces(id, names, &mut pieces);
                     let paren = self.level(id) < min;
@@ -119,6 +135,25 @@ impl Pool {
             Node::Sum { constant, terms } if constant.get() == 0.0 && terms.len() == 1 => MUL,
             Node::Sum { .. } => ADD,
         }
+    }
+
+    /// The sub-expressions `e` prints (in order, with repeats) and the length of the rest of
+    /// its text, counting the parentheses each sub-expression may get.
+    pub(super) fn print_refs(&self, e: ExprId, names: &Names<'_>) -> (Vec<ExprId>, usize) {
+        let mut pieces = Vec::new();
+        self.pieces(e, names, &mut pieces);
+        let mut refs = Vec::new();
+        let mut len = 0;
+        for p in pieces {
+            match p {
+                Piece::Text(s) => len += s.len(),
+                Piece::Expr(id, _) => {
+                    refs.push(id);
+                    len += 2;
+                }
+            }
+        }
+        (refs, len)
     }
 
     /// The pieces `e` prints as (without its own parentheses).

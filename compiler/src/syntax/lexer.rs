@@ -193,6 +193,21 @@ fn starts_something(c: char, next: Option<char>) -> bool {
     }
 }
 
+/// Length in bytes of the run of characters at the start of `rest` that cannot start anything;
+/// with `first`, the first character is taken as such whatever it is.
+fn bad_run(rest: &str, first: bool) -> usize {
+    let mut end = 0;
+    let mut chars = rest.char_indices().peekable();
+    while let Some((i, ch)) = chars.next() {
+        let next = chars.peek().map(|&(_, n)| n);
+        if (i > 0 || !first) && starts_something(ch, next) {
+            break;
+        }
+        end = i + ch.len_utf8();
+    }
+    end
+}
+
 impl<'s> Lexer<'s> {
     /// A lexer over the whole of `src`.
     pub(crate) fn new(src: &'s str) -> Self {
@@ -314,9 +329,10 @@ impl<'s> Lexer<'s> {
         };
         if let Ok((after, word)) = ident(rest) {
             let end = self.offset(after);
+            let glued = self.glued_name_end(end);
             return match Kw::from_str(word) {
-                Some(kw) => (Tok::Kw(kw), end),
-                None => (Tok::Ident, end),
+                Some(kw) if glued == end => (Tok::Kw(kw), end),
+                _ => (Tok::Ident, glued),
             };
         }
         if let Ok((after, text)) = number(rest) {
@@ -328,16 +344,31 @@ impl<'s> Lexer<'s> {
         if let Ok((after, tok)) = punct(rest) {
             return (tok, self.offset(after));
         }
-        // A run of characters that cannot start anything.
-        let mut end = start;
-        let mut chars = rest.char_indices().peekable();
-        while let Some((i, ch)) = chars.next() {
-            let next = chars.peek().map(|&(_, n)| n);
-            if i > 0 && starts_something(ch, next) {
-                break;
-            }
-            end = start + i + ch.len_utf8();
+        let end = start + bad_run(rest, true);
+        self.bad_characters(c, start, end);
+        (Tok::Error, end)
+    }
+
+    /// Where a name ending at `end` really ends: a name glued to characters that cannot start
+    /// anything and then to more name (`r#x`, `a$b`) is one name with those characters
+    /// reported, so the parser does not trip over its tail with a second, confusing error.
+    fn glued_name_end(&mut self, mut end: usize) -> usize {
+        loop {
+            let rest = &self.src[end..];
+            let bad = bad_run(rest, false);
+            let Some(c) = rest.chars().next().filter(|_| bad > 0) else {
+                return end;
+            };
+            let Ok((after, _)) = ident(&rest[bad..]) else {
+                return end;
+            };
+            self.bad_characters(c, end, end + bad);
+            end = self.offset(after);
         }
+    }
+
+    /// Reports the characters `start..end`, which cannot start anything; `c` is the first.
+    fn bad_characters(&mut self, c: char, start: usize, end: usize) {
         let text = &self.src[start..end];
         let plural = if text.chars().count() > 1 { "s" } else { "" };
         let mut d = Diagnostic::error(
@@ -351,7 +382,6 @@ impl<'s> Lexer<'s> {
             d = d.with_help("names are ASCII: letters, digits and `_`");
         }
         self.report(d);
-        (Tok::Error, end)
     }
 
     fn number_token(&mut self, after: &'s str, text: &str, start: usize) -> (Tok, usize) {

@@ -8,6 +8,7 @@ pub mod ast;
 mod lexer;
 mod parser;
 
+pub(crate) use parser::too_large;
 pub use parser::{MAX_DEPTH, MAX_DIAGNOSTICS, MAX_HEIGHT, MAX_SOURCE_LEN};
 
 /// Stack for the parsing thread: recursion is bounded by [`MAX_DEPTH`], but unoptimized builds

@@ -9,12 +9,7 @@ use super::ast::*;
 use super::lexer::{clip, Kw, Lexer, Tok, Token};
 use crate::diagnostics::{Diagnostic, Span};
 
-/// Largest accepted source, in bytes.
-pub const MAX_SOURCE_LEN: usize = 8 * 1024 * 1024;
-/// Deepest accepted nesting of parentheses, brackets, calls, indices, unary minus, `^` and blocks.
-pub const MAX_DEPTH: usize = 200;
-/// Tallest accepted expression tree (long `a + b + c + ...` chains count one level per operator).
-pub const MAX_HEIGHT: usize = 1000;
+pub use crate::limits::{MAX_DEPTH, MAX_HEIGHT, MAX_SOURCE_LEN};
 
 /// After this many diagnostics the parser stops (and says so).
 pub const MAX_DIAGNOSTICS: usize = 500;
@@ -131,24 +126,25 @@ impl Ctx {
     }
 }
 
+/// The error for a spec of more than [`MAX_SOURCE_LEN`] bytes (at `0..0`: the file is not kept).
+pub(crate) fn too_large() -> Diagnostic {
+    Diagnostic::error(
+        format!("spec file too large: more than {MAX_SOURCE_LEN} bytes (8 MiB)"),
+        0..0,
+        "file rejected",
+    )
+    .with_help("a spec this large is generated: use families and `for` loops instead")
+}
+
 /// Parses `src`; see [`super::parse`].
 pub(crate) fn parse_spec(src: &str) -> (Spec, Vec<Diagnostic>) {
     if src.len() > MAX_SOURCE_LEN {
-        let d = Diagnostic::error(
-            format!(
-                "spec file too large ({} bytes; the limit is {} bytes)",
-                src.len(),
-                MAX_SOURCE_LEN
-            ),
-            0..0,
-            "file rejected",
-        );
         let spec = Spec {
             doc: None,
             model: None,
             items: Vec::new(),
         };
-        return (spec, vec![d]);
+        return (spec, vec![too_large()]);
     }
     let mut p = Parser::new(src);
     let spec = p.spec();
@@ -1031,21 +1027,29 @@ impl<'s> Parser<'s> {
 
     #[cold]
     #[inline(never)]
-    fn too_long(&mut self, span: Span) -> Fail {
+    fn too_long(&mut self, op: Span) -> Fail {
         self.diags.push(
-            Diagnostic::error("expression too long", span, "this expression").with_help(format!(
+            Diagnostic::error(
+                "expression too long",
+                op,
+                format!("more than {MAX_HEIGHT} operators deep here"),
+            )
+            .with_help(format!(
                 "an expression may be at most {MAX_HEIGHT} operators deep; split it with `let`"
             )),
         );
         Fail
     }
 
-    /// Builds `lhs op rhs`, enforcing the height limit.
-    fn binary(&mut self, op: BinOp, lhs: HExpr, rhs: HExpr) -> P<HExpr> {
+    /// Builds `lhs op rhs` (`op_span`: the operator's token), enforcing the height limit; an
+    /// expression over the limit is labelled at the operator that passes it, not as a whole
+    /// (which may be megabytes long).
+    fn binary(&mut self, op: BinOp, op_span: Span, lhs: HExpr, rhs: HExpr) -> P<HExpr> {
         let h = 1 + lhs.1.max(rhs.1);
         let span = lhs.0.span.start..rhs.0.span.end;
-        if h > MAX_HEIGHT {
-            return Err(self.too_long(span));
+        // Heights count leaves as 1: `h - 1` operators on the longest path.
+        if h - 1 > MAX_HEIGHT {
+            return Err(self.too_long(op_span));
         }
         let kind = ExprKind::Binary {
             op,
@@ -1064,9 +1068,9 @@ impl<'s> Parser<'s> {
                 Tok::Minus => BinOp::Sub,
                 _ => return Ok(lhs),
             };
-            self.advance();
+            let op_span = self.advance().span;
             let rhs = self.term(None)?;
-            lhs = self.binary(op, lhs, rhs)?;
+            lhs = self.binary(op, op_span, lhs, rhs)?;
         }
     }
 
@@ -1079,9 +1083,9 @@ impl<'s> Parser<'s> {
                 Tok::Slash => BinOp::Div,
                 _ => return Ok(lhs),
             };
-            self.advance();
+            let op_span = self.advance().span;
             let rhs = self.unary(None)?;
-            lhs = self.binary(op, lhs, rhs)?;
+            lhs = self.binary(op, op_span, lhs, rhs)?;
         }
     }
 
@@ -1116,10 +1120,10 @@ impl<'s> Parser<'s> {
             return Ok(base);
         }
         self.enter("expression")?;
-        self.advance();
+        let op_span = self.advance().span;
         let r = self.unary(None);
         self.leave();
-        self.binary(BinOp::Pow, base, r?)
+        self.binary(BinOp::Pow, op_span, base, r?)
     }
 
     fn primary(&mut self) -> P<HExpr> {

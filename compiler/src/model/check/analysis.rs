@@ -7,6 +7,7 @@ use super::Checker;
 use crate::analysis::{choose_transform, jacobian_at, MAX_AUTO_STATES};
 use crate::diagnostics::{Diagnostic, Span};
 use crate::ir::ExprId;
+use crate::limits::MAX_REPORT_STEPS;
 use crate::model::{
     Analysis, AnalysisSpec, Bounds, Guarantee, Inclusion, Integrator, Method,
     MetricChoice as Metric, RadiusRule, Rate, Transform,
@@ -125,6 +126,7 @@ impl Checker<'_> {
                 }
             })
         });
+        let step = step.and_then(|s| self.report_steps(&f, horizon?, s).then_some(s));
         let metric = match f.get("metric") {
             None => Some(Metric::Identity),
             Some((e, _)) => match &e.kind {
@@ -339,6 +341,29 @@ impl Checker<'_> {
         }
     }
 
+    /// Whether `horizon / step` is within [`MAX_REPORT_STEPS`] (reported at `step`, or at
+    /// `horizon` when the step is the default): every report step is kept in the result.
+    fn report_steps(&mut self, f: &Fields, horizon: f64, step: f64) -> bool {
+        let steps = horizon / step;
+        if steps <= MAX_REPORT_STEPS {
+            return true;
+        }
+        let Some((e, _)) = f.get("step").or_else(|| f.get("horizon")) else {
+            return true; // unreachable: the horizon is given when it is positive
+        };
+        self.diags.push(
+            Diagnostic::error(
+                format!("{steps:.3e} report steps (horizon / step); at most {MAX_REPORT_STEPS:e}"),
+                e.span.clone(),
+                "too many report steps",
+            )
+            .with_help(
+                "every report step is kept in the result: use a larger step or a shorter horizon",
+            ),
+        );
+        false
+    }
+
     /// A coordinate transform: `auto`, or an invertible n x n matrix (with its inverse; its
     /// frame is numbered by `number_frames`).
     fn transform(&mut self, e: &Expr, n: usize) -> Option<TransformKey> {
@@ -500,9 +525,11 @@ impl Checker<'_> {
         }
     }
 
-    /// An n x n matrix, symmetric positive definite (`spd`) or non-singular.
+    /// An n x n matrix, symmetric positive definite (`spd`: an analysis metric, returned
+    /// normalised by a power of two) or non-singular.
     fn square(&mut self, e: &Expr, n: usize, key: &str, spd: bool) -> Option<Vec<Vec<f64>>> {
         let m = self.matrix(e)?;
+        let m = if spd { matrix::normalised(m) } else { m };
         let check = matrix::check_square(&m, n).and_then(|()| {
             if spd {
                 matrix::check_spd(&m)

@@ -3,13 +3,11 @@
 use super::lower::{Allow, LoopEnv};
 use super::scope::{Symbol, VarKind};
 use super::Checker;
-use crate::diagnostics::Diagnostic;
+use crate::diagnostics::{Diagnostic, Span};
 use crate::ir::{ExprId, Var};
+use crate::limits::MAX_UNROLLED;
 use crate::model::Bounds;
 use crate::syntax::ast::{Expr, ExprKind, Item, Spec, Stmt, Target};
-
-/// Upper limit on statements produced by unrolling `for` loops (bounds work on hostile input).
-const UNROLL_BUDGET: usize = 10_000_000;
 
 /// A statement handler: gets each non-`let`, non-`for` statement after unrolling.
 type Handler<'h, 'a> = &'h mut dyn FnMut(&mut Checker<'a>, &Stmt, &LoopEnv);
@@ -17,7 +15,7 @@ type Handler<'h, 'a> = &'h mut dyn FnMut(&mut Checker<'a>, &Stmt, &LoopEnv);
 impl<'a> Checker<'a> {
     /// Second pass: items with bodies, in source order.
     pub(super) fn bodies(&mut self, spec: &Spec) {
-        let mut budget = UNROLL_BUDGET;
+        let mut budget = MAX_UNROLLED;
         for item in &spec.items {
             match item {
                 Item::Stmt(s) => self.walk(
@@ -95,16 +93,7 @@ impl<'a> Checker<'a> {
         handler: Handler<'_, 'a>,
     ) {
         for s in stmts {
-            if *budget == 0 {
-                return;
-            }
-            *budget -= 1;
-            if *budget == 0 {
-                self.diags.push(Diagnostic::error(
-                    format!("`for` loops unroll to more than {UNROLL_BUDGET} statements"),
-                    stmt_span(s),
-                    "stopped unrolling here",
-                ));
+            if !self.spend(budget, 1, head_span(s)) {
                 return;
             }
             match s {
@@ -129,6 +118,11 @@ impl<'a> Checker<'a> {
                     else {
                         continue;
                     };
+                    // Each iteration counts, so loops with empty bodies are bounded too.
+                    let iterations = usize::try_from(i128::from(hi) - i128::from(lo) + 1);
+                    if !self.spend(budget, iterations.unwrap_or(0), head_span(s)) {
+                        return;
+                    }
                     for i in lo..=hi {
                         env.push((var.name.clone(), i));
                         self.walk_in(&body.stmts, place, allow_let, budget, env, handler);
@@ -147,6 +141,28 @@ impl<'a> Checker<'a> {
                 _ => handler(self, s, env),
             }
         }
+    }
+
+    /// Takes `n` units of the unrolling budget; `false` (after reporting at `span`, the first
+    /// time) once it is spent.
+    fn spend(&mut self, budget: &mut usize, n: usize, span: Span) -> bool {
+        if *budget == 0 {
+            return false;
+        }
+        if n < *budget {
+            *budget -= n;
+            return true;
+        }
+        *budget = 0;
+        self.diags.push(
+            Diagnostic::error(
+                format!("`for` loops unroll to more than {MAX_UNROLLED} statements"),
+                span,
+                "the limit is passed here",
+            )
+            .with_help("a model this large is beyond what the analyses can use; make it smaller"),
+        );
+        false
     }
 
     fn define_let(&mut self, target: &Target, value: &Expr, env: &LoopEnv) {
@@ -458,6 +474,15 @@ impl<'a> Checker<'a> {
             }
         }
         self.domain[i] = b;
+    }
+}
+
+/// The span of a statement's first line: a `for` loop's head (`for i in LO..HI`), so that a
+/// diagnostic about the loop does not underline its whole body.
+fn head_span(s: &Stmt) -> Span {
+    match s {
+        Stmt::For { span, range, .. } => span.start..range.span.end,
+        _ => stmt_span(s),
     }
 }
 

@@ -2,13 +2,27 @@
 
 use std::path::Path;
 
+use crate::driver::read_capped;
 use crate::ir::Table;
+use crate::limits::MAX_TABLE_LEN;
 
 /// Reads a CSV table: a header line of column names (the first is time), then rows of finite
-/// numbers with strictly increasing times. Errors are `"SHOWN:LINE: what"` strings, where
-/// `shown` is the path as the spec wrote it.
+/// numbers with strictly increasing times. Also accepted, as documented: blank lines and lines
+/// starting with `#` (comments, anywhere), CRLF line ends, spaces around cells. At most
+/// [`MAX_TABLE_LEN`] bytes are read. Errors are `"SHOWN:LINE: what"` strings, where `shown` is
+/// the path as the spec wrote it.
 pub(super) fn load(name: &str, path: &Path, shown: &str) -> Result<Table, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{shown}: cannot read: {e}"))?;
+    let bytes = read_capped(path, MAX_TABLE_LEN)
+        .map_err(|e| format!("{shown}: cannot read: {e}"))?
+        .ok_or_else(|| {
+            format!("{shown}: the file is larger than the limit of {MAX_TABLE_LEN} bytes (8 MiB)")
+        })?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "{shown}: not UTF-8 text (invalid byte at offset {})",
+            e.utf8_error().valid_up_to()
+        )
+    })?;
     let mut lines = text
         .lines()
         .enumerate()

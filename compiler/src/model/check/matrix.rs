@@ -68,6 +68,24 @@ fn max_abs(m: &[Vec<f64>]) -> f64 {
     m.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()))
 }
 
+/// `m` scaled by a power of two (so exactly, short of subnormal entries) to a largest entry in
+/// `[1, 2)` in absolute value. An analysis metric's rates and sets do not change when it is
+/// scaled, but its factorisations overflow near 1e300 (and underflow near 1e-300): both the
+/// compiler and the run factorise the metric the checker returns, so this is the one place.
+pub(super) fn normalised(mut m: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+    let max = max_abs(&m);
+    if !(max.is_finite() && max > 0.0) {
+        return m; // rejected by the checks that follow
+    }
+    let k = max.log2().floor() as i32;
+    // Two factors, each a normal float, as 2^-k alone overflows for subnormal maxima.
+    let (a, b) = (2f64.powi(-(k / 2)), 2f64.powi(-(k - k / 2)));
+    for v in m.iter_mut().flatten() {
+        *v = *v * a * b;
+    }
+    m
+}
+
 /// Checks symmetry (to a relative 1e-12) and positive definiteness (a Cholesky factorisation
 /// with pivots above a relative 1e-12, so nearly singular metrics are rejected too).
 pub(super) fn check_spd(m: &[Vec<f64>]) -> Result<(), MatrixError> {

@@ -21,6 +21,7 @@ use scope::{Scope, Symbol, VarKind};
 use super::{Ball, Bounds, InitialSet, Model, UnsafeSet, Variable};
 use crate::diagnostics::{has_errors, Diagnostic, Span};
 use crate::ir::{ExprId, Pool, Table};
+use crate::limits::{MAX_INPUTS, MAX_NOISES, MAX_STATES};
 use crate::syntax::ast::{Ident, Init, Item, Spec, VarDecl};
 
 /// Checks a parsed spec. `spec_dir` is the directory CSV paths are relative to.
@@ -136,10 +137,6 @@ struct Checker<'a> {
     auto_transforms: Vec<(usize, Span)>,
     constants: Vec<(String, f64)>,
 }
-
-/// Largest number of elements one family may have (a 10^6-state model is far beyond what the
-/// analyses can use, and this bounds memory on hostile input).
-const MAX_FAMILY: i64 = 1_000_000;
 
 impl Checker<'_> {
     /// Records an error and returns `None` so callers can `return self.fail(...)`.
@@ -261,7 +258,22 @@ impl Checker<'_> {
             VarKind::Noise => &self.noises,
         };
         let first = list.len() as u32;
+        let (what, max) = match kind {
+            VarKind::State => ("states", MAX_STATES),
+            VarKind::Input => ("inputs", MAX_INPUTS),
+            VarKind::Noise => ("noise channels", MAX_NOISES),
+        };
+        let room = max - list.len().min(max);
         let (sym, names) = match &d.family {
+            None if room == 0 => {
+                self.diags.push(Diagnostic::error(
+                    format!("too many {what}"),
+                    d.name.span.clone(),
+                    format!("a model has at most {max} {what}"),
+                ));
+                self.define(&d.name, Symbol::Poisoned);
+                return;
+            }
             None => (Symbol::Var(kind, first), vec![d.name.name.clone()]),
             Some(range) => {
                 let lo = self.integer(&range.lo, &[]);
@@ -270,16 +282,21 @@ impl Checker<'_> {
                     self.define(&d.name, Symbol::Poisoned);
                     return;
                 };
-                if hi < lo || hi - lo >= MAX_FAMILY {
-                    self.diags.push(Diagnostic::error(
+                let count = (i128::from(hi) - i128::from(lo) + 1).max(0);
+                if count == 0 || count > room as i128 {
+                    let diag = Diagnostic::error(
                         format!(
-                            "the family `{}[{lo}..{hi}]` has {} elements",
-                            d.name.name,
-                            (hi - lo + 1).max(0)
+                            "the family `{}[{lo}..{hi}]` has {count} elements",
+                            d.name.name
                         ),
                         range.span.clone(),
-                        format!("must have between 1 and {MAX_FAMILY} elements"),
-                    ));
+                        if count == 0 {
+                            "must have at least 1 element".to_string()
+                        } else {
+                            format!("a model has at most {max} {what}")
+                        },
+                    );
+                    self.diags.push(diag);
                     self.define(&d.name, Symbol::Poisoned);
                     return;
                 }
@@ -387,7 +404,9 @@ impl Checker<'_> {
                 );
             }
         }
-        if self.states.is_empty() {
+        // A declaration with errors (a family too large) was already reported.
+        let declared = spec.items.iter().any(|i| matches!(i, Item::State(_)));
+        if self.states.is_empty() && !declared {
             let span = spec.model.as_ref().map_or(0..0, |m| m.span.clone());
             self.diags.push(
                 Diagnostic::error(
