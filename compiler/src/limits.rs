@@ -29,4 +29,4 @@ pub const MAX_INPUTS: usize = 2_000;
 pub const MAX_NOISES: usize = 2_000;
 
 /// Most report steps (`horizon / step`) of one analysis.
-pub const MAX_REPORT_STEPS: f64 = 1e6;
+pub const MAX_REPORT_STEPS: f64 = 1e5;
