@@ -140,7 +140,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         .then(|| interval::deterministic(run, spec.inclusion).ok())
         .flatten();
     let radii = Radii::new(run, &det, header.kappa);
-    let rate = header.rate.clone();
+    let rate = header.rate;
     let rates_proved = header.rigorous[0].clone();
     let ball = assemble_with(run, det, header, local, radii.clone());
     let Some((det, mut header)) = boxes else {
