@@ -132,7 +132,9 @@ fn runs_writes_and_skips_interval() {
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(v["analysis"], "main");
     let csv = std::fs::read_to_string(dir.join("main.csv")).unwrap();
-    assert!(csv.starts_with("t,x,det_radius,r_t,psi,c,sigma,prs_radius\n"));
+    // The ball is cut by the interval box of the same run (method.md 8.7): the CSV carries
+    // the intersection's bounding box after the ball's radii.
+    assert!(csv.starts_with("t,x,det_radius,r_t,psi,c,sigma,prs_radius,prs_x_lo,prs_x_hi\n"));
     assert_eq!(csv.lines().count(), 12);
     assert!(!dir.join("boxes.json").exists());
     std::fs::remove_dir_all(&dir).unwrap();
@@ -230,7 +232,7 @@ fn results_render() {
     };
     let (c_ball, c_boxes) = (csv(&ball), csv(&boxes));
     assert!(
-        c_ball.starts_with("t,x,det_radius,r_t,psi,c,sigma,prs_radius\n0,1,"),
+        c_ball.starts_with("t,x,det_radius,r_t,psi,c,sigma,prs_radius,prs_x_lo,prs_x_hi\n0,1,"),
         "{c_ball}"
     );
     assert!(

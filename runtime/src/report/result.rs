@@ -787,7 +787,7 @@ pub fn summary(prs: &Prs) -> String {
         (None, None) => prs.radius_rule.rule.name().to_string(),
     };
     // With several metrics each set is at delta / K.
-    let delta_each = prs.delta / (1 + prs.also.len()) as f64;
+    let delta_each = prs.delta / metrics(prs) as f64;
     let _ = writeln!(
         s,
         "  radius rule: {rule}, kappa(n = {}, delta = {}) = {:.6}",
@@ -980,20 +980,43 @@ fn guarantee_sentence(prs: &Prs) -> String {
 
 /// The table of the summary for box sets: per column of [`box_columns`] the range `[lo, hi]`,
 /// and `r_t`.
+/// The number of metrics of a result: its own and those of its members of the same method
+/// (the others are the interval boxes a contraction run is cut by, at the same delta).
+fn metrics(prs: &Prs) -> usize {
+    1 + prs.also.iter().filter(|m| m.method == prs.method).count()
+}
+
 /// The further metrics of an intersection result, and its bounding boxes.
 fn summary_metrics(prs: &Prs, s: &mut String) {
     if prs.also.is_empty() {
         return;
     }
-    let k = 1 + prs.also.len();
-    let _ = writeln!(
-        s,
-        "  several metrics: the PRS is the intersection of the sets of {k} metrics, each at \
-         delta / {k} = {:e} (the tables below the first metric's; the boxes, margins and \
-         verdicts the intersection's)",
-        prs.delta / k as f64
-    );
-    for (j, m) in prs.also.iter().enumerate() {
+    let k = metrics(prs);
+    if k > 1 {
+        let _ = writeln!(
+            s,
+            "  several metrics: the PRS is the intersection of the sets of {k} metrics, each at \
+             delta / {k} = {:e} (the tables below the first metric's; the boxes, margins and \
+             verdicts the intersection's)",
+            prs.delta / k as f64
+        );
+    }
+    let boxes = prs.also.len() + 1 - k;
+    if boxes > 0 {
+        let _ = writeln!(
+            s,
+            "  cut by the interval box: the PRS is the intersection of each metric's ball with \
+             the interval method's box of the same run, widened by the same r_t, at the same \
+             delta ({boxes} box{}; the boxes, margins and verdicts below are the intersection's)",
+            if boxes == 1 { "" } else { "es" }
+        );
+    }
+    for (j, m) in prs
+        .also
+        .iter()
+        .filter(|m| m.method == prs.method)
+        .enumerate()
+    {
         let n = m.n().max(1);
         let rows: Vec<String> = m
             .constants
