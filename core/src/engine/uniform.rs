@@ -224,16 +224,16 @@ mod tests {
     use super::*;
     use crate::kappa::kappa_amgf;
 
-    /// At each epoch's threshold the tube's radius is the pointwise one at delta / K; between
-    /// thresholds it is larger than the pointwise one at delta, by a bounded factor.
+    /// Found by the fuzz campaign (tests/fuzz/findings/run-panic.sde): `horizon = 100000` on an
+    /// unstable model, whose scale overflows to infinity.
     #[test]
     fn an_infinite_scale_gets_the_most_epochs_without_overflow() {
-        // Found by the fuzz campaign (tests/fuzz/findings/run-panic.sde): `horizon = 100000`
-        // on an unstable model, whose scale overflows to infinity.
         let tube = Tube::new(2, 1e-3, 1e-2, f64::INFINITY);
         assert_eq!(tube.epochs.len(), MAX_EPOCHS);
     }
 
+    /// At each epoch's threshold the tube's radius is the pointwise one at delta / K; between
+    /// thresholds it is larger than the pointwise one at delta, by a bounded factor.
     #[test]
     fn the_tube_meets_the_pointwise_radius_at_the_thresholds() {
         let (n, delta) = (2, 1e-3);
