@@ -4,6 +4,7 @@
 //! `parallel` feature, for Monte Carlo).
 
 pub mod chi2;
+pub mod decimal;
 pub mod engine;
 pub mod func;
 pub mod interval;

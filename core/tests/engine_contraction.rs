@@ -735,6 +735,14 @@ fn errors() {
         Err(RunError::Invalid(_))
     ));
     an.spec.delta = 1e-3;
+    // A subnormal report step (the horizon 1e-320 with the default step): refused, where the
+    // validated integrator's steps used to shrink to zero and never end.
+    let mut tiny = an.clone();
+    (tiny.spec.horizon, tiny.spec.step) = (1e-320, 1e-322);
+    match engine::run(&sys, &inf, &tiny) {
+        Err(RunError::Invalid(m)) => assert!(m.contains("at least 1e-100"), "{m}"),
+        other => panic!("expected Invalid, got {other:?}"),
+    }
     let mut bad = an.clone();
     bad.constants.as_mut().unwrap().metric = vec![1.0, 2.0, 2.0, 1.0];
     assert!(matches!(

@@ -3,6 +3,7 @@
 //! zero for an exact solution): on validated steps by default (`defect.rs`), or one
 //! unvalidated RK4 or Euler step per report step when the spec asks for it.
 
+use crate::decimal::time;
 use super::assemble::{
     assemble_with, constants_used, rate_used, Deterministic, Header, Piece, Radii,
 };
@@ -251,7 +252,7 @@ fn nominal_steps(
         RunError::NonFinite(format!(
             "the nominal trajectory is not finite at t = {} ({} integration, step {}; the \
              default validated integrator reports where and why a step fails)",
-            grid[k],
+            time(grid[k]),
             spec.integrator.name(),
             spec.step
         ))

@@ -11,6 +11,7 @@
 //! `p([a, b])`, so `d(s) in p'(m) - f(p(m), u, [a, b]) + (p''([a, b]) - J p'([a, b])) [a - m, b - m]`:
 //! a small first term (the Hermite error), and a second that shrinks with the piece.
 
+use crate::decimal::time;
 use super::hermite::Cubic;
 use super::radius::BoxRadius;
 use super::RunError;
@@ -54,15 +55,18 @@ impl StepBudget {
         let (what, hint) = (self.what, self.hint);
         if self.total >= MAX_STEPS {
             return Err(RunError::NonFinite(format!(
-                "{what} needs more than {MAX_STEPS} validated steps before t = {t} ({hint})"
+                "{what} needs more than {MAX_STEPS} validated steps before t = {} ({hint})",
+                time(t)
             )));
         }
         if self.in_interval >= MAX_STEPS_PER_REPORT {
             return Err(RunError::NonFinite(format!(
                 "{what} needs more than {MAX_STEPS_PER_REPORT} validated steps in the report \
-                 interval [{}, {}] (at t = {t}): it grows without bound there, or is too stiff \
+                 interval [{}, {}] (at t = {}): it grows without bound there, or is too stiff \
                  for this report step ({hint})",
-                window[0], window[1]
+                time(window[0]),
+                time(window[1]),
+                time(t)
             )));
         }
         self.total += 1;
@@ -181,9 +185,10 @@ impl<'a> Nominal<'a> {
             h = 0.5 * h_used;
             if h < min_h {
                 return Err(RunError::NonFinite(format!(
-                    "the nominal trajectory cannot be validated at t = {t}: the step shrank \
+                    "the nominal trajectory cannot be validated at t = {}: the step shrank \
                      below {min_h:e} without bounding the defect (the drift is too large or \
-                     not smooth here: a shorter horizon or a smaller report step may help)"
+                     not smooth here: a shorter horizon or a smaller report step may help)",
+                    time(t)
                 )));
             }
         }
@@ -239,8 +244,9 @@ impl<'a> Nominal<'a> {
         if let Some(domain) = self.domain {
             if let Some(i) = (0..n).find(|&i| lo[i] < domain[i].lo || hi[i] > domain[i].hi) {
                 return Err(RunError::Invalid(format!(
-                    "the nominal trajectory leaves the domain in state {i} near t = {t}: the \
-                     constants hold only in the domain (enlarge it, or shorten the horizon)"
+                    "the nominal trajectory leaves the domain in state {i} near t = {}: the \
+                     constants hold only in the domain (enlarge it, or shorten the horizon)",
+                    time(t)
                 )));
             }
         }

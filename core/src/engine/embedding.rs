@@ -10,6 +10,7 @@
 //! evaluations of the drift and of the non-zero Jacobian entries: time proportional to the
 //! size of the expressions, not to `n^2`.
 
+use crate::decimal::time;
 use super::defect::{StepBudget, MIN_STEP};
 use super::hermite::Cubic;
 use super::nominal::rk4_step;
@@ -287,11 +288,12 @@ impl<'a> Embedding<'a> {
             h = shrink * used;
             if h < min_h {
                 return Err(RunError::NonFinite(format!(
-                    "the embedding system cannot be validated at t = {t}: the step would have \
+                    "the embedding system cannot be validated at t = {}: the step would have \
                      to be shorter than {min_h:e} (a millionth of the report step), with the \
                      box {wmax:e} wide and growing without bound there (try the other \
                      inclusion, a coordinate transform, the contraction method or a shorter \
-                     horizon)"
+                     horizon)",
+                    time(t)
                 )));
             }
         }

@@ -26,6 +26,7 @@
 //! integrated numerically (RK4 or Euler, no remainder bound), so the box is an enclosure only
 //! up to the time-discretisation error. The result says so.
 
+use crate::decimal::time;
 use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::embedding::{BoxStep, Embedding};
 use super::transform::{self, Frame};
@@ -311,7 +312,7 @@ fn boxes(
                     "the embedding system's box is not finite at t = {} (the {} inclusion \
                      diverged with {} integration, step {}; try the validated integrator, the \
                      other inclusion or a coordinate transform)",
-                    grid[k],
+                    time(grid[k]),
                     inclusion.name(),
                     spec.integrator.name(),
                     spec.step

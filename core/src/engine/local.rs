@@ -17,6 +17,7 @@
 //! scaled by the input box's half-widths. Where the compiler's global constants hold on the
 //! region (no domain, or the region inside it), the smaller of the two is used.
 
+use crate::decimal::time;
 use super::linalg::{self, lambda_max, product, symmetric_part};
 use super::uniform::{Scale, Tube};
 use super::{Run, RunError};
@@ -401,9 +402,10 @@ impl<'a> Certifier<'a> {
             })
             .unwrap_or_default();
         RunError::NonFinite(format!(
-            "the local rates cannot be certified at t = {t0}: no region around the tube holds \
+            "the local rates cannot be certified at t = {}: no region around the tube holds \
              the tube its own rates give (last region tried: {}){entry}. A shorter horizon, a \
              smaller initial set or less noise may help",
+            time(t0),
             region.join(", ")
         ))
     }

@@ -3,6 +3,7 @@
 //! follow their per-step recursions with it (Proposition 2 and eq. Psi with piecewise-constant
 //! rates).
 
+use crate::decimal::time;
 use super::{Run, RunError};
 use crate::model::ModelInfo;
 use crate::simulate::{self, InputMode};
@@ -51,7 +52,8 @@ pub(crate) fn empirical(
             let x = &path[k * n..(k + 1) * n];
             if x.iter().any(|v| !v.is_finite()) {
                 return Err(RunError::NonFinite(format!(
-                    "a sample path of the empirical rate estimate is not finite at t = {t}"
+                    "a sample path of the empirical rate estimate is not finite at t = {}",
+                    time(t)
                 )));
             }
             sys.drift(x, u_center, t, &mut fx);
@@ -84,7 +86,7 @@ pub(crate) fn empirical(
         return Err(RunError::NonFinite(format!(
             "no finite empirical rate at t = {} (every sample equals the nominal, or a drift is \
              not finite)",
-            grid[k]
+            time(grid[k])
         )));
     }
     Ok(rates)

@@ -7,7 +7,7 @@ use super::Checker;
 use crate::analysis::{choose_transform, jacobian_at, MAX_AUTO_STATES};
 use crate::diagnostics::{Diagnostic, Span};
 use crate::ir::ExprId;
-use crate::limits::MAX_REPORT_STEPS;
+use crate::limits::{MAX_REPORT_STEPS, MIN_REPORT_STEP};
 use crate::model::{
     Analysis, AnalysisSpec, Bounds, Guarantee, Inclusion, Integrator, Method,
     MetricChoice as Metric, RadiusRule, Rate, Transform,
@@ -343,24 +343,29 @@ impl Checker<'_> {
 
     /// Whether `horizon / step` is within [`MAX_REPORT_STEPS`] (reported at `step`, or at
     /// `horizon` when the step is the default): every report step is kept in the result.
+    /// Also whether the step is at least [`MIN_REPORT_STEP`].
     fn report_steps(&mut self, f: &Fields, horizon: f64, step: f64) -> bool {
         let steps = horizon / step;
-        if steps <= MAX_REPORT_STEPS {
+        let (message, label, help) = if step < MIN_REPORT_STEP {
+            (
+                format!("the report step is {step:e}; at least {MIN_REPORT_STEP:e}"),
+                "report step too short",
+                "the integrators subdivide a report step down to a millionth of it, which must \
+                 stay a normal floating-point number: change the unit of time",
+            )
+        } else if steps > MAX_REPORT_STEPS {
+            (
+                format!("{steps:.3e} report steps (horizon / step); at most {MAX_REPORT_STEPS:e}"),
+                "too many report steps",
+                "every report step is kept in the result: use a larger step or a shorter horizon",
+            )
+        } else {
             return true;
-        }
+        };
         let Some((e, _)) = f.get("step").or_else(|| f.get("horizon")) else {
             return true; // unreachable: the horizon is given when it is positive
         };
-        self.diags.push(
-            Diagnostic::error(
-                format!("{steps:.3e} report steps (horizon / step); at most {MAX_REPORT_STEPS:e}"),
-                e.span.clone(),
-                "too many report steps",
-            )
-            .with_help(
-                "every report step is kept in the result: use a larger step or a shorter horizon",
-            ),
-        );
+        self.diags.push(Diagnostic::error(message, e.span.clone(), label).with_help(help));
         false
     }
 
