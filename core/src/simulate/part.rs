@@ -154,7 +154,7 @@ impl Part {
         if run.paths == 0 || self.shard.count == 0 || self.shard.index >= self.shard.count {
             return Some(format!("shard {} of {} paths", self.shard, run.paths));
         }
-        if !(run.confidence > 0.0 && run.confidence < 1.0) || !(run.delta > 0.0) {
+        if !(run.confidence > 0.0 && run.confidence < 1.0 && run.delta > 0.0) {
             return Some(format!(
                 "confidence {} or delta {} out of range",
                 run.confidence, run.delta
