@@ -114,14 +114,19 @@ run=("$spec" --analysis "$analysis" --paths "$paths" --seed "$seed")
 "$reachc" simulate "$spec" --analysis "$analysis" --paths 1 -q -o "$work/warm" >/dev/null
 
 echo "== unsharded: reachc simulate ${run[*]}"
+# Exit status 1 is a failed coverage check (the report is written): compared all the same.
 start=$(date +%s%N)
-"$reachc" simulate "${run[@]}" -q -o "$work/whole"
+status=0
+"$reachc" simulate "${run[@]}" -q -o "$work/whole" || status=$?
 unsharded=$((($(date +%s%N) - start) / 1000000))
+[ $status -le 1 ] || exit $status
 
 echo "== $shards shards through Slurm (a job array and the dependent merge)"
 start=$(date +%s%N)
-scripts/slurm/submit.sh --wait "$shards" "$work/sharded" "${run[@]}"
+merged=0
+scripts/slurm/submit.sh --wait "$shards" "$work/sharded" "${run[@]}" || merged=$?
 sharded=$((($(date +%s%N) - start) / 1000000))
+[ $merged -eq $status ] || { echo "merge exit status $merged, unsharded $status" >&2; exit 1; }
 cat "$work/sharded/logs/merge.out"
 [ "$(ls "$work/sharded/parts" | wc -l)" -eq "$shards" ]
 cmp "$work/whole/$analysis.sim.json" "$work/sharded/$analysis.sim.json"

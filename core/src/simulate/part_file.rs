@@ -1,5 +1,5 @@
 //! The part file: a [`Part`] as bytes, every float as its IEEE bits, so that a part read back
-//! is the part written, bit for bit (docs/simulation-shards.md describes the layout).
+//! is the part written, bit for bit (docs/results.md, "The part file", describes the layout).
 //!
 //! Layout (little endian): the magic line `reachc simulate part\n`, the format version (`u32`),
 //! the payload, and an FNV-1a 64-bit checksum of everything before it. Strings are a `u64`
