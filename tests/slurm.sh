@@ -128,6 +128,13 @@ scripts/slurm/submit.sh --wait "$shards" "$work/sharded" "${run[@]}" || merged=$
 sharded=$((($(date +%s%N) - start) / 1000000))
 [ $merged -eq $status ] || { echo "merge exit status $merged, unsharded $status" >&2; exit 1; }
 cat "$work/sharded/logs/merge.out"
+echo "== the shards (their own time lines, and Slurm's start and end times)"
+for log in "$work"/sharded/logs/shard-*.out; do
+    echo "$(basename "$log" .out): $(grep -h 'time:' "$log" | sed 's/^ *//')"
+done
+scontrol show job -o | while read -r line; do
+    echo "$(grep -o '^JobId=[0-9]*\|ArrayTaskId=[0-9]*\|JobName=[^ ]*\|SubmitTime=[^ ]*\|StartTime=[^ ]*\|EndTime=[^ ]*' <<<"$line" | tr '\n' ' ')"
+done
 [ "$(ls "$work/sharded/parts" | wc -l)" -eq "$shards" ]
 cmp "$work/whole/$analysis.sim.json" "$work/sharded/$analysis.sim.json"
 echo "wall time: unsharded ${unsharded} ms, $shards shards through Slurm ${sharded} ms" \

@@ -159,13 +159,16 @@ fn rate(per_sec: f64) -> String {
 struct Bars {
     multi: MultiProgress,
     current: Option<(String, ProgressBar)>,
+    /// The shard simulated, if any (named in the bars' messages).
+    shard: Option<Shard>,
 }
 
 impl Bars {
-    fn new() -> Self {
+    fn new(shard: Option<Shard>) -> Self {
         Bars {
             multi: MultiProgress::new(),
             current: None,
+            shard,
         }
     }
 
@@ -183,7 +186,11 @@ impl Bars {
                 });
                 bar.set_style(style.progress_chars("=> "));
             }
-            bar.set_message(format!("simulating `{analysis}`"));
+            let shard = self
+                .shard
+                .map(|s| format!(", shard {s}"))
+                .unwrap_or_default();
+            bar.set_message(format!("simulating `{analysis}`{shard}"));
             self.current = Some((analysis.to_string(), bar));
         }
         if let Some((_, bar)) = &self.current {
@@ -241,7 +248,7 @@ pub fn run_simulate(
     let code = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
-            let mut bars = Bars::new();
+            let mut bars = Bars::new(opts.shard);
             let mut progress = |a: &str, done: u64, total: u64| bars.update(a, done, total);
             reachc_runtime::app::simulate(
                 &interp,
@@ -256,15 +263,20 @@ pub fn run_simulate(
             let binary = compiled_binary(&mut loaded, color, sim.quiet)?;
             // With a bar, the binary's `reachc-progress` lines drive it.
             opts.progress = show_bar;
-            run_binary(&binary, &opts.to_args(), show_bar)?
+            run_binary(&binary, &opts.to_args(), show_bar, opts.shard)?
         }
     };
     spec_exit(code)
 }
 
-/// Runs the generated binary's `simulate` mode; with a bar, its `reachc-progress` lines drive
-/// the bar and its other output is printed around it.
-fn run_binary(binary: &Path, args: &[String], show_bar: bool) -> Result<u8, u8> {
+/// Runs the generated binary's `simulate` mode (of `shard`, if any); with a bar, its
+/// `reachc-progress` lines drive the bar and its other output is printed around it.
+fn run_binary(
+    binary: &Path,
+    args: &[String],
+    show_bar: bool,
+    shard: Option<Shard>,
+) -> Result<u8, u8> {
     let cannot_run = |e: std::io::Error| {
         eprintln!("error: cannot run {}: {e}", binary.display());
         EXIT_USAGE
@@ -280,7 +292,7 @@ fn run_binary(binary: &Path, args: &[String], show_bar: bool) -> Result<u8, u8> 
         .stderr(Stdio::piped())
         .spawn()
         .map_err(cannot_run)?;
-    let mut bars = Bars::new();
+    let mut bars = Bars::new(shard);
     let (stdout, stderr) = (child.stdout.take(), child.stderr.take());
     std::thread::scope(|scope| {
         // The summaries go to stdout: print them above the bar, from their own thread so that
