@@ -3,7 +3,8 @@
 # packages) if missing, starts munged, slurmctld and slurmd for a one-node cluster on localhost
 # (everything in a temporary directory, ports 16817/16818), builds reachc (release), runs the
 # same simulation unsharded and as a job array of K shards plus the dependent merge
-# (scripts/slurm/submit.sh), and checks that the reports are byte for byte the same. Stops
+# (scripts/slurm/submit.sh), and checks that the reports are byte for byte the same (a failed
+# coverage check, exit status 1, is compared too: both runs must agree on it). Stops
 # every daemon it started and removes the directory on exit, also on failure. Runs as root
 # (apt-get, SlurmUser=root); idempotent, by hand or from .ci/run.
 #
@@ -123,10 +124,23 @@ unsharded=$((($(date +%s%N) - start) / 1000000))
 
 echo "== $shards shards through Slurm (a job array and the dependent merge)"
 start=$(date +%s%N)
-merged=0
-scripts/slurm/submit.sh --wait "$shards" "$work/sharded" "${run[@]}" || merged=$?
+submitted=$(scripts/slurm/submit.sh "$shards" "$work/sharded" "${run[@]}")
+echo "$submitted"
+merge_job=$(sed -n 's/^merge: job \([0-9]*\).*/\1/p' <<<"$submitted")
+# Polled every 0.2 s (`sbatch --wait` backs off to seconds between polls).
+deadline=$((SECONDS + 3600))
+while :; do
+    job=$(scontrol show job -o "$merge_job")
+    case $(grep -o 'JobState=[A-Z_]*' <<<"$job") in
+        JobState=PENDING | JobState=RUNNING | JobState=CONFIGURING | JobState=COMPLETING) ;;
+        *) break ;;
+    esac
+    [ $SECONDS -lt $deadline ] || { echo "the merge did not end within an hour" >&2; exit 1; }
+    sleep 0.2
+done
 sharded=$((($(date +%s%N) - start) / 1000000))
-[ $merged -eq $status ] || { echo "merge exit status $merged, unsharded $status" >&2; exit 1; }
+merged=$(grep -o 'ExitCode=[0-9]*' <<<"$job" | cut -d= -f2)
+[ "$merged" = "$status" ] || { echo "merge: $job (unsharded exit status $status)" >&2; exit 1; }
 cat "$work/sharded/logs/merge.out"
 echo "== the shards (their own time lines, and Slurm's start and end times)"
 for log in "$work"/sharded/logs/shard-*.out; do
