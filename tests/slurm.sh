@@ -4,7 +4,8 @@
 # (everything in a temporary directory, ports 16817/16818), builds reachc (release), runs the
 # same simulation unsharded and as a job array of K shards plus the dependent merge
 # (scripts/slurm/submit.sh), and checks that the reports are byte for byte the same (a failed
-# coverage check, exit status 1, is compared too: both runs must agree on it). Stops
+# coverage check, exit status 1, is compared too: both runs must agree on it), and, up to 10^6
+# paths, the same as the interpreter backend's unsharded report. Stops
 # every daemon it started and removes the directory on exit, also on failure. Runs as root
 # (apt-get, SlurmUser=root); idempotent, by hand or from .ci/run.
 #
@@ -151,6 +152,11 @@ scontrol show job -o | while read -r line; do
 done
 [ "$(ls "$work/sharded/parts" | wc -l)" -eq "$shards" ]
 cmp "$work/whole/$analysis.sim.json" "$work/sharded/$analysis.sim.json"
+if [ "$paths" -le 1000000 ]; then
+    # The compiled shards' report is also the interpreter's (the backends agree to the bit).
+    "$reachc" simulate "${run[@]}" --backend interp -q -o "$work/interp" || [ $? -eq 1 ]
+    cmp "$work/sharded/$analysis.sim.json" "$work/interp/$analysis.sim.json"
+fi
 echo "wall time: unsharded ${unsharded} ms, $shards shards through Slurm ${sharded} ms" \
     "(submission to merged report)"
 echo "ok: the merged report of $shards shards is the unsharded one, byte for byte"
