@@ -9,7 +9,7 @@
 use crate::app::{commit, report_file, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use crate::output::Files;
 use crate::report;
-use reachc_core::simulate::{Merger, Part};
+use reachc_core::simulate::{Merger, Part, SimReport};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -54,7 +54,7 @@ pub fn merge_files(
 }
 
 /// The reports of the parts, one per analysis (in name order), or what is wrong.
-fn merge_reports(parts: &[PathBuf]) -> Result<Vec<reachc_core::simulate::SimReport>, String> {
+fn merge_reports(parts: &[PathBuf]) -> Result<Vec<SimReport>, String> {
     if parts.is_empty() {
         return Err("no part files given".into());
     }
