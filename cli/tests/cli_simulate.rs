@@ -166,3 +166,164 @@ fn simulate_linear_checks_the_uniform_tube() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A scratch directory for one test (emptied first).
+fn scratch(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("reachc-cli-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `reachc simulate SPEC --backend interp --analysis uniform --paths 1000 ARGS`.
+fn simulate_linear(spec: &str, args: &[&str]) -> std::process::Output {
+    let base = [
+        "simulate",
+        spec,
+        "--backend",
+        "interp",
+        "--analysis",
+        "uniform",
+        "--paths",
+        "1000",
+        "--delta",
+        "0.05",
+    ];
+    let o = reachc(&[&base[..], args].concat());
+    assert_eq!(o.status.code(), Some(0), "{args:?}: {o:?}");
+    o
+}
+
+/// The parts of `K` shards of the linear example's uniform analysis, in `dir/parts-K`.
+fn shards(dir: &std::path::Path, k: u64, more: &[&str]) -> Vec<String> {
+    let parts = dir.join(format!("parts-{k}{}", more.join("")));
+    (0..k)
+        .map(|i| {
+            let shard = format!("{i}/{k}");
+            let o = simulate_linear(
+                &spec("linear.sde"),
+                &[&["--shard", &shard, "-o", parts.to_str().unwrap()], more].concat(),
+            );
+            let out = String::from_utf8_lossy(&o.stdout);
+            let (lo, hi) = (i * 1000 / k, (i + 1) * 1000 / k);
+            assert!(
+                out.contains(&format!(
+                    "simulated `uniform`, shard {shard}: paths {lo}..{hi} of 1000"
+                )),
+                "{out}"
+            );
+            let file = parts.join(format!("uniform.shard-{i}-of-{k}.part"));
+            assert!(out.contains(&format!("wrote {}", file.display())), "{out}");
+            file.display().to_string()
+        })
+        .collect()
+}
+
+#[test]
+fn merged_shards_are_the_unsharded_report_byte_for_byte() {
+    let dir = scratch("shards");
+    let whole = dir.join("whole");
+    simulate_linear(&spec("linear.sde"), &["-q", "-o", whole.to_str().unwrap()]);
+    let want = std::fs::read(whole.join("uniform.sim.json")).unwrap();
+    for k in [1, 3, 4, 7] {
+        let mut parts = shards(&dir, k, &[]);
+        parts.reverse();
+        let merged = dir.join(format!("merged-{k}"));
+        let args = [
+            &["simulate", "merge"][..],
+            &parts.iter().map(String::as_str).collect::<Vec<_>>(),
+            &["-o", merged.to_str().unwrap()],
+        ]
+        .concat();
+        let o = reachc(&args);
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{o:?}");
+        assert!(out.contains("coverage: PASS"), "{out}");
+        assert!(
+            std::fs::read(merged.join("uniform.sim.json")).unwrap() == want,
+            "{k} shards: the merged report differs"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn merge_refuses_parts_that_do_not_belong_together() {
+    let dir = scratch("bad-shards");
+    let parts = shards(&dir, 3, &[]);
+    let seed = shards(&dir, 3, &["--seed", "9"]);
+    let paths = {
+        let p = dir.join("paths");
+        let shard = [
+            "--shard",
+            "1/3",
+            "--paths",
+            "999",
+            "-o",
+            p.to_str().unwrap(),
+        ];
+        let o = reachc(
+            &[
+                &[
+                    "simulate",
+                    &spec("linear.sde"),
+                    "--backend",
+                    "interp",
+                    "--analysis",
+                    "uniform",
+                    "--delta",
+                    "0.05",
+                ][..],
+                &shard,
+            ]
+            .concat(),
+        );
+        assert_eq!(o.status.code(), Some(0), "{o:?}");
+        p.join("uniform.shard-1-of-3.part").display().to_string()
+    };
+    // The same spec with one more comment: another SHA-256.
+    let other_spec = dir.join("linear.sde");
+    let source = std::fs::read_to_string(spec("linear.sde")).unwrap();
+    std::fs::write(&other_spec, source + "// a copy\n").unwrap();
+    let other = {
+        let p = dir.join("other");
+        simulate_linear(
+            other_spec.to_str().unwrap(),
+            &["--shard", "1/3", "-o", p.to_str().unwrap()],
+        );
+        p.join("uniform.shard-1-of-3.part").display().to_string()
+    };
+    let json = dir.join("report.sim.json");
+    std::fs::write(&json, "{}\n").unwrap();
+    let truncated = dir.join("truncated.part");
+    let bytes = std::fs::read(&parts[1]).unwrap();
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    let (json, truncated) = (json.display().to_string(), truncated.display().to_string());
+    let missing = dir.join("nope.part").display().to_string();
+    let (p0, p1, p2) = (parts[0].as_str(), parts[1].as_str(), parts[2].as_str());
+    for (files, message) in [
+        (vec![p0, p2], "error: analysis `uniform`: missing shard 1/3 (have 2 of 3)".to_string()),
+        (vec![p0, p1, p1, p2], format!("error: `{p1}` and `{p1}` are both shard 1/3")),
+        (
+            vec![p0, &seed[1], p2],
+            format!("error: `{}` and `{p0}` are not parts of the same simulation: seed 9 there, 0 in the first part", seed[1]),
+        ),
+        (
+            vec![p0, &paths, p2],
+            format!("error: `{paths}` and `{p0}` are not parts of the same simulation: paths 999 there, 1000 in the first part"),
+        ),
+        (vec![p0, &other, p2], format!("error: `{other}` and `{p0}` are parts of different specs")),
+        (vec![p0, &json, p2], format!("error: {json}: not a reachc simulate part file")),
+        (vec![p0, &truncated, p2], format!("error: {truncated}: corrupt or truncated")),
+        (vec![p0, &missing], format!("error: cannot read {missing}: ")),
+    ] {
+        let out = dir.join("merged");
+        let o = reachc(&[&["simulate", "merge", "-o", out.to_str().unwrap()][..], &files].concat());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{files:?}: {err}");
+        assert!(err.starts_with(&message), "{files:?}: {err}");
+        assert!(err.trim_end().ends_with("(nothing written)"), "{err}");
+        assert!(!out.exists());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

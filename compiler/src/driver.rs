@@ -59,6 +59,16 @@ pub struct Loaded {
     pub warnings: Vec<Diagnostic>,
 }
 
+impl Loaded {
+    /// The SHA-256 of the spec's source, in hex: its identity in the parts of a sharded
+    /// `reachc simulate` (parts of different sources do not merge).
+    pub fn source_hash(&self) -> String {
+        let mut h = crate::package::sha256::Sha256::new();
+        h.update(self.source.as_bytes());
+        h.finish_hex()
+    }
+}
+
 /// Parses and checks spec text; CSV paths are resolved against `dir`.
 /// Syntax errors stop before checking (a partial tree would give misleading follow-up errors).
 pub fn check_source(source: &str, dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {

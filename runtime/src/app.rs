@@ -18,7 +18,7 @@ use crate::output::Files;
 use crate::report;
 use reachc_core::engine::RunError;
 use reachc_core::model::ModelInfo;
-use reachc_core::simulate::{self, InputMode, SimError};
+use reachc_core::simulate::{self, InputMode, Shard, SimError, SimReport};
 use reachc_core::{Reach, System};
 use std::io::Write;
 use std::path::PathBuf;
@@ -41,11 +41,13 @@ const USAGE: &str = "usage: <model> [--analysis NAME] [-o DIR] [--quiet] [--deny
 pub const SIMULATE_USAGE: &str =
     "usage: <model> simulate --paths N [--analysis NAME] [--seed S] [--dt H]
          [--delta D] [--inputs random|corners|centre] [--hold T] [--confidence C]
-         [--threads T] [-o DIR] [--quiet] [--progress]
+         [--threads T] [--shard I/K [--spec-hash H]] [-o DIR] [--quiet] [--progress]
   Euler-Maruyama sample paths checked against each analysis' delta-PRS; writes
   DIR/<analysis>.sim.json. Exit status 0 when every coverage check passes, 1 when one fails
   (the reports are written) or an analysis cannot be simulated (nothing is written), 2 on
-  usage or I/O errors.
+  usage or I/O errors. With --shard, only shard I of K of the paths, and instead of the
+  reports the exact statistics DIR/<analysis>.shard-I-of-K.part (exit status 0 when written),
+  for `reachc simulate merge`.
   --paths N          number of sample paths (required)
   --analysis NAME    check only this analysis (default: all)
   --seed S           random seed (default 0); the same seed gives the same results
@@ -56,6 +58,8 @@ pub const SIMULATE_USAGE: &str =
   --hold T           hold time of the piecewise-constant inputs (default: the analysis' step)
   --confidence C     level of the Clopper-Pearson bounds and of the check (default 0.999)
   --threads T        worker threads (default: all cores); results do not depend on it
+  --shard I/K        run only the paths [floor(I N / K), floor((I + 1) N / K)) (0-based I)
+  --spec-hash H      the spec's identity recorded in the parts (reachc passes its SHA-256)
   -o, --out DIR      output directory (default: reachc-out)
   -q, --quiet        do not print the summaries
   --progress         write `reachc-progress <analysis> <done> <total>` lines to stderr";
@@ -114,6 +118,12 @@ pub struct SimulateOptions {
     pub progress: bool,
     /// Recompute each PRS at this delta instead of the analysis' own.
     pub delta: Option<f64>,
+    /// Run only this shard of the paths and write its part (`<analysis>.shard-I-of-K.part`)
+    /// instead of the report.
+    pub shard: Option<Shard>,
+    /// The spec's identity written into parts (`reachc` passes the SHA-256 of the spec's
+    /// source); parts merge only with parts of the same.
+    pub spec_hash: Option<String>,
     /// The simulation itself.
     pub sim: simulate::Options,
 }
@@ -126,6 +136,8 @@ impl Default for SimulateOptions {
             quiet: false,
             progress: false,
             delta: None,
+            shard: None,
+            spec_hash: None,
             sim: simulate::Options::default(),
         }
     }
@@ -230,6 +242,8 @@ fn parse_simulate(args: &[String]) -> Result<Command, String> {
                 }
                 a.delta = Some(d);
             }
+            "--shard" => a.shard = Some(Shard::parse(value()?)?),
+            "--spec-hash" => a.spec_hash = Some(value()?.to_string()),
             "--threads" => {
                 let t: usize = number(flag, value()?)?;
                 if t == 0 {
@@ -298,6 +312,8 @@ impl SimulateOptions {
         opt("--hold", s.hold.map(|v| v.to_string()));
         opt("--confidence", Some(s.confidence.to_string()));
         opt("--threads", s.threads.map(|v| v.to_string()));
+        opt("--shard", self.shard.map(|v| v.to_string()));
+        opt("--spec-hash", self.spec_hash.clone());
         opt("-o", Some(self.out_dir.display().to_string()));
         if self.quiet {
             args.push("--quiet".into());
@@ -458,6 +474,35 @@ fn select<'a>(
     Some(found)
 }
 
+/// What one analysis' simulation gave: the report, or a shard's part.
+enum Simulated {
+    Report(SimReport),
+    Part(simulate::Part),
+}
+
+/// `time: ... s for ... path-steps (... path-steps/s, N threads)`.
+fn timing(secs: f64, path_steps: f64, threads: usize) -> String {
+    format!(
+        "time: {secs:.3} s for {path_steps:.3e} path-steps ({:.3e} path-steps/s, {})",
+        path_steps / secs,
+        report::count(threads as u64, "thread")
+    )
+}
+
+/// The file of a report: `DIR/<analysis>.sim.json` and its bytes (what `simulate` and
+/// `reachc simulate merge` write).
+pub fn report_file(dir: &std::path::Path, sim: &SimReport) -> (PathBuf, Vec<u8>) {
+    (
+        dir.join(format!("{}.sim.json", sim.analysis)),
+        (report::simulation::to_json(sim) + "\n").into(),
+    )
+}
+
+/// The name of a shard's part file: `<analysis>.shard-I-of-K.part`.
+pub fn part_file_name(analysis: &str, shard: Shard) -> String {
+    format!("{analysis}.shard-{}-of-{}.part", shard.index, shard.count)
+}
+
 /// A progress callback: `(analysis, paths done, paths in all)`.
 pub type Progress<'a> = dyn FnMut(&str, u64, u64) + 'a;
 
@@ -468,6 +513,9 @@ pub type Progress<'a> = dyn FnMut(&str, u64, u64) + 'a;
 /// [`EXIT_USAGE`] for a usage error or files that cannot be written. Analyses without a PRS (no constants, unsupported
 /// transform) are skipped with a message. `progress(analysis, done, total)` is called after each
 /// batch of paths; without it, `opts.progress` writes `reachc-progress` lines to `err` instead.
+/// With `opts.shard`, only that shard's paths run and `DIR/<analysis>.shard-I-of-K.part` is
+/// written instead of each report ([`part_file_name`]; no verdict: [`EXIT_OK`] when written),
+/// for [`crate::merge::merge_files`].
 pub fn simulate<S: System + Sync>(
     sys: &S,
     info: &ModelInfo,
@@ -511,9 +559,16 @@ pub fn simulate<S: System + Sync>(
                 }
                 None => {}
             };
-            simulate::simulate(sys, info, &result, &opts.sim, &mut report_progress)
+            match opts.shard {
+                Some(shard) => {
+                    simulate::run_part(sys, info, &result, &opts.sim, shard, &mut report_progress)
+                        .map(Simulated::Part)
+                }
+                None => simulate::simulate(sys, info, &result, &opts.sim, &mut report_progress)
+                    .map(Simulated::Report),
+            }
         };
-        let sim = match simulated {
+        let simulated = match simulated {
             Ok(r) => r,
             Err(SimError::Usage(m)) => {
                 let _ = writeln!(err, "error: {m}");
@@ -526,20 +581,39 @@ pub fn simulate<S: System + Sync>(
             }
         };
         let secs = started.elapsed().as_secs_f64();
-        if !opts.quiet {
-            let path_steps = sim.paths as f64 * sim.steps_per_path as f64;
-            let _ = write!(out, "{}", report::simulation::summary(&sim));
-            let _ = writeln!(
-                out,
-                "  time: {secs:.3} s for {path_steps:.3e} path-steps ({:.3e} path-steps/s, {})\n",
-                path_steps / secs,
-                report::count(simulate::thread_count(opts.sim.threads) as u64, "thread")
-            );
-        }
-        let file = opts.out_dir.join(format!("{}.sim.json", sim.analysis));
-        files.add(file, (report::simulation::to_json(&sim) + "\n").into());
-        if !sim.passed() {
-            coverage_failed = true;
+        let threads = simulate::thread_count(opts.sim.threads);
+        match simulated {
+            Simulated::Report(sim) => {
+                if !opts.quiet {
+                    let _ = write!(out, "{}", report::simulation::summary(&sim));
+                    let path_steps = sim.paths as f64 * sim.steps_per_path as f64;
+                    let _ = writeln!(out, "  {}\n", timing(secs, path_steps, threads));
+                }
+                coverage_failed |= !sim.passed();
+                let (path, bytes) = report_file(&opts.out_dir, &sim);
+                files.add(path, bytes);
+            }
+            Simulated::Part(mut part) => {
+                part.run.spec_hash = opts.spec_hash.clone().unwrap_or_default();
+                let paths = part.shard.paths(part.run.paths);
+                if !opts.quiet {
+                    let path_steps =
+                        (paths.end - paths.start) as f64 * part.run.steps_per_path as f64;
+                    let _ = writeln!(
+                        out,
+                        "simulated `{name}`, shard {}: paths {}..{} of {}\n  {}",
+                        part.shard,
+                        paths.start,
+                        paths.end,
+                        part.run.paths,
+                        timing(secs, path_steps, threads)
+                    );
+                }
+                files.add(
+                    opts.out_dir.join(part_file_name(name, part.shard)),
+                    part.to_bytes(),
+                );
+            }
         }
     }
     if failed {
@@ -580,6 +654,8 @@ mod tests {
             quiet: false,
             progress: true,
             delta: Some(0.1 + 0.2),
+            shard: Some(Shard { index: 3, count: 8 }),
+            spec_hash: Some("0a1b".into()),
             sim: simulate::Options {
                 paths: 12345,
                 seed: u64::MAX,
@@ -597,6 +673,11 @@ mod tests {
     fn usage_errors_name_the_problem() {
         let e = Command::parse(&strings(&["simulate", "--seed", "1"])).unwrap_err();
         assert_eq!(e.message, "--paths N is required");
+        let e = Command::parse(&strings(&["simulate", "--paths", "9", "--shard", "4/4"]));
+        assert_eq!(
+            e.unwrap_err().message,
+            "shard 4/4: the index must be below the number of shards (0-based)"
+        );
         let e = Command::parse(&strings(&["--out"])).unwrap_err();
         assert_eq!(e.message, "--out needs a value");
         assert_eq!(

@@ -75,6 +75,8 @@ pub use reachc_core::{Bounds, InputPlan, Interval, ModelInfo, Prs, Reach, System
 pub mod app;
 mod include;
 #[cfg(feature = "app")]
+pub mod merge;
+#[cfg(feature = "app")]
 pub mod output;
 #[cfg(feature = "report")]
 pub mod report;

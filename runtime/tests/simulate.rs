@@ -5,6 +5,7 @@
 use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::engine;
 use reachc_runtime::interval::Interval;
+use reachc_runtime::merge::merge_files;
 use reachc_runtime::model::*;
 use reachc_runtime::report::simulation::{summary, to_json};
 use reachc_runtime::simulate::{self, InputMode, Options, SimReport};
@@ -561,5 +562,83 @@ fn simulate_command_line() {
     let (code, out, _) = cli(&good, &["simulate", "--help"]);
     assert_eq!(code, EXIT_OK);
     assert!(out.contains("--paths N"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `simulate --shard I/K` for every shard, then `merge_files`: the unsharded run's reports,
+/// byte for byte, for 1 shard, 3 (not dividing the paths) and 8; two analyses (a uniform and a
+/// pointwise one), so the parts are grouped by analysis.
+#[test]
+fn shards_merge_into_the_unsharded_reports() {
+    let dir = std::env::temp_dir().join(format!("reachc-simulate-shards-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut info = info(&LINEAR, 0.0, 0.0, 0.0, 0.05, 1.0);
+    let mut pointwise = info.analyses[0].clone();
+    pointwise.spec.name = "pointwise".into();
+    pointwise.spec.guarantee = Guarantee::Pointwise;
+    info.analyses.push(pointwise);
+    let run = [
+        "simulate", "--paths", "1000", "--seed", "4", "--dt", "0.005",
+    ];
+    let whole = dir.join("whole");
+    let (code, _, err) = cli(
+        &info,
+        &[&run[..], &["-q", "-o", whole.to_str().unwrap()]].concat(),
+    );
+    assert_eq!(code, EXIT_OK, "{err}");
+    for k in [1, 3, 8] {
+        let parts = dir.join(format!("parts-{k}"));
+        for i in 0..k {
+            let shard = format!("{i}/{k}");
+            let args = [
+                "--shard",
+                &shard,
+                "--spec-hash",
+                "abc",
+                "-o",
+                parts.to_str().unwrap(),
+            ];
+            let (code, out, err) = cli(&info, &[&run[..], &args].concat());
+            assert_eq!(code, EXIT_OK, "{err}");
+            let (lo, hi) = (i * 1000 / k, (i + 1) * 1000 / k);
+            assert!(
+                out.contains(&format!(
+                    "simulated `main`, shard {shard}: paths {lo}..{hi} of 1000"
+                )),
+                "{out}"
+            );
+            assert!(
+                out.contains(&format!("main.shard-{i}-of-{k}.part")),
+                "{out}"
+            );
+        }
+        let mut files: Vec<_> = std::fs::read_dir(&parts)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        assert_eq!(files.len(), 2 * k);
+        let merged = dir.join(format!("merged-{k}"));
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let code = merge_files(&files, &merged, false, &mut out, &mut err);
+        let out = String::from_utf8(out).unwrap();
+        assert_eq!(code, EXIT_OK, "{}", String::from_utf8_lossy(&err));
+        assert!(out.contains("coverage: PASS"), "{out}");
+        for name in ["main.sim.json", "pointwise.sim.json"] {
+            let read = |d: &std::path::Path| std::fs::read(d.join(name)).unwrap();
+            assert!(read(&merged) == read(&whole), "{k} shards: {name} differs");
+        }
+        if k == 1 {
+            continue;
+        }
+        // A shard missing: an input error naming it, nothing written.
+        let (mut out, mut err) = (Vec::new(), Vec::new());
+        let missing = dir.join(format!("missing-{k}"));
+        let code = merge_files(&files[1..], &missing, true, &mut out, &mut err);
+        let err = String::from_utf8(err).unwrap();
+        assert_eq!(code, EXIT_USAGE);
+        assert!(err.contains("analysis `main`: missing shard 0/"), "{err}");
+        assert!(!missing.exists());
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -85,20 +85,9 @@ pub enum Command {
         quiet: bool,
     },
     /// Monte Carlo check of the analyses: Euler-Maruyama sample paths against each delta-PRS;
-    /// writes ANALYSIS.sim.json. Exit code 1 when a coverage check fails.
-    Simulate {
-        /// The .sde spec.
-        spec: PathBuf,
-        /// What to simulate and how.
-        #[command(flatten)]
-        sim: simulate::SimulateArgs,
-        /// Generated and compiled code, or the IR interpreter (no cargo needed).
-        #[arg(long, value_enum, default_value = "compiled")]
-        backend: run::Backend,
-        /// Directory for ANALYSIS.sim.json (default: reachc-out).
-        #[arg(short, long)]
-        out: Option<PathBuf>,
-    },
+    /// writes ANALYSIS.sim.json. Exit code 1 when a coverage check fails. With --shard I/K,
+    /// only that shard's paths and a part file; `reachc simulate merge` makes the reports.
+    Simulate(simulate::SimulateCommand),
     /// Draw a result of `reachc run` (ANALYSIS.json): its sets in a 2-D projection with sample
     /// paths and unsafe sets (given the spec), and its radii against time; SVG and PNG.
     Plot(plot::PlotArgs),
@@ -143,12 +132,7 @@ fn run(command: Command) -> Result<(), u8> {
             deny_unsafe,
             quiet,
         } => run::run_spec(&spec, analysis, backend, out, &plot, (deny_unsafe, quiet)),
-        Command::Simulate {
-            spec,
-            sim,
-            backend,
-            out,
-        } => simulate::run_simulate(&spec, &sim, backend, out),
+        Command::Simulate(cmd) => simulate::run_command(cmd),
         Command::Plot(args) => plot::run_plot(&args),
         Command::Check { spec } => {
             let loaded = load_reporting(&spec)?;

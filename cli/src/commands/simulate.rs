@@ -13,7 +13,48 @@ use indicatif::{MultiProgress, ProgressBar, ProgressState, ProgressStyle};
 use super::run::{compiled_binary, exit_code, interpreter, Backend};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
 use reachc_runtime::app::{SimulateOptions, DEFAULT_OUT_DIR};
-use reachc_runtime::simulate::{self, InputMode};
+use reachc_runtime::simulate::{self, InputMode, Shard};
+
+/// `reachc simulate SPEC ...`, or `reachc simulate merge PART...`.
+#[derive(clap::Args, Debug)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct SimulateCommand {
+    /// Merge the parts of a sharded run instead.
+    #[command(subcommand)]
+    pub merge: Option<MergeCommand>,
+    /// The .sde spec.
+    #[arg(required = true)]
+    pub spec: Option<PathBuf>,
+    /// What to simulate and how.
+    #[command(flatten)]
+    pub sim: SimulateArgs,
+    /// Generated and compiled code, or the IR interpreter (no cargo needed).
+    #[arg(long, value_enum, default_value = "compiled")]
+    pub backend: Backend,
+    /// Directory for ANALYSIS.sim.json, or the parts with --shard (default: reachc-out).
+    #[arg(short, long)]
+    pub out: Option<PathBuf>,
+}
+
+/// The subcommand of `reachc simulate`.
+#[derive(clap::Subcommand, Debug)]
+pub enum MergeCommand {
+    /// Merge the part files of a sharded run (`reachc simulate SPEC --shard I/K`, every I) into
+    /// the ANALYSIS.sim.json an unsharded run writes, byte for byte. Exit code 1 when a coverage
+    /// check fails, 2 when the parts do not belong together, one is missing, repeated,
+    /// unreadable or not a part file (nothing is written then).
+    Merge {
+        /// The part files (ANALYSIS.shard-I-of-K.part), of one or more analyses.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Directory for ANALYSIS.sim.json (default: reachc-out).
+        #[arg(short, long)]
+        out: Option<PathBuf>,
+        /// Do not print the summaries.
+        #[arg(short, long)]
+        quiet: bool,
+    },
+}
 
 /// The options passed on to the simulation (the runtime's `simulate` command line).
 #[derive(clap::Args, Debug)]
@@ -21,9 +62,13 @@ pub struct SimulateArgs {
     /// Check only this analysis (default: all).
     #[arg(long)]
     pub analysis: Option<String>,
-    /// Number of sample paths.
-    #[arg(long)]
-    pub paths: u64,
+    /// Number of sample paths (of all shards).
+    #[arg(long, required = true)]
+    pub paths: Option<u64>,
+    /// Run only shard I of K (0-based): the paths [floor(I N / K), floor((I + 1) N / K)), the
+    /// same as in an unsharded run; writes OUT/ANALYSIS.shard-I-of-K.part instead of reports.
+    #[arg(long, value_name = "I/K", value_parser = Shard::parse)]
+    pub shard: Option<Shard>,
     /// Random seed; the same seed gives the same results, whatever the number of threads.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -63,8 +108,9 @@ pub enum Inputs {
 }
 
 impl SimulateArgs {
-    /// The runtime's options for these arguments, writing to `out`.
-    fn options(&self, out: Option<PathBuf>) -> SimulateOptions {
+    /// The runtime's options for these arguments, writing to `out`, for the spec whose source
+    /// has the SHA-256 `spec_hash`.
+    fn options(&self, out: Option<PathBuf>, spec_hash: String) -> SimulateOptions {
         let inputs = match self.inputs {
             Inputs::Random => InputMode::Random,
             Inputs::Corners => InputMode::Corners,
@@ -76,8 +122,11 @@ impl SimulateArgs {
             quiet: self.quiet,
             progress: false,
             delta: self.delta,
+            shard: self.shard,
+            spec_hash: self.shard.map(|_| spec_hash),
             sim: simulate::Options {
-                paths: self.paths,
+                // Required by clap unless merging.
+                paths: self.paths.unwrap_or_default(),
                 seed: self.seed,
                 dt: self.dt,
                 inputs,
@@ -110,13 +159,16 @@ fn rate(per_sec: f64) -> String {
 struct Bars {
     multi: MultiProgress,
     current: Option<(String, ProgressBar)>,
+    /// The shard simulated, if any (named in the bars' messages).
+    shard: Option<Shard>,
 }
 
 impl Bars {
-    fn new() -> Self {
+    fn new(shard: Option<Shard>) -> Self {
         Bars {
             multi: MultiProgress::new(),
             current: None,
+            shard,
         }
     }
 
@@ -134,7 +186,11 @@ impl Bars {
                 });
                 bar.set_style(style.progress_chars("=> "));
             }
-            bar.set_message(format!("simulating `{analysis}`"));
+            let shard = self
+                .shard
+                .map(|s| format!(", shard {s}"))
+                .unwrap_or_default();
+            bar.set_message(format!("simulating `{analysis}`{shard}"));
             self.current = Some((analysis.to_string(), bar));
         }
         if let Some((_, bar)) = &self.current {
@@ -147,8 +203,38 @@ impl Bars {
     }
 }
 
-/// Runs `reachc simulate`. Exit codes: 0 every coverage check passed, 1 one failed (or spec
-/// errors, or an analysis that could not run), 2 usage, I/O or cargo failures.
+/// Runs `reachc simulate` or `reachc simulate merge`.
+pub fn run_command(cmd: SimulateCommand) -> Result<(), u8> {
+    match (cmd.merge, cmd.spec) {
+        (Some(MergeCommand::Merge { parts, out, quiet }), _) => {
+            let out = out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR));
+            let code = reachc_runtime::merge::merge_files(
+                &parts,
+                &out,
+                quiet,
+                &mut std::io::stdout().lock(),
+                &mut std::io::stderr().lock(),
+            );
+            spec_exit(code)
+        }
+        (None, Some(spec)) => run_simulate(&spec, &cmd.sim, cmd.backend, cmd.out),
+        // clap requires the spec without a subcommand.
+        (None, None) => Err(EXIT_USAGE),
+    }
+}
+
+/// The CLI's result for a runtime exit code (1, a failed check, is the CLI's spec-error code).
+fn spec_exit(code: u8) -> Result<(), u8> {
+    match code {
+        0 => Ok(()),
+        1 => Err(EXIT_SPEC),
+        c => Err(c),
+    }
+}
+
+/// Runs `reachc simulate`. Exit codes: 0 every coverage check passed (or, with a shard, its
+/// part was written), 1 one failed (or spec errors, or an analysis that could not run), 2
+/// usage, I/O or cargo failures.
 pub fn run_simulate(
     spec: &Path,
     sim: &SimulateArgs,
@@ -158,11 +244,11 @@ pub fn run_simulate(
     let color = std::io::stderr().is_terminal();
     let show_bar = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
-    let mut opts = sim.options(out);
+    let mut opts = sim.options(out, loaded.source_hash());
     let code = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
-            let mut bars = Bars::new();
+            let mut bars = Bars::new(opts.shard);
             let mut progress = |a: &str, done: u64, total: u64| bars.update(a, done, total);
             reachc_runtime::app::simulate(
                 &interp,
@@ -177,19 +263,20 @@ pub fn run_simulate(
             let binary = compiled_binary(&mut loaded, color, sim.quiet)?;
             // With a bar, the binary's `reachc-progress` lines drive it.
             opts.progress = show_bar;
-            run_binary(&binary, &opts.to_args(), show_bar)?
+            run_binary(&binary, &opts.to_args(), show_bar, opts.shard)?
         }
     };
-    match code {
-        0 => Ok(()),
-        1 => Err(EXIT_SPEC),
-        c => Err(c),
-    }
+    spec_exit(code)
 }
 
-/// Runs the generated binary's `simulate` mode; with a bar, its `reachc-progress` lines drive
-/// the bar and its other output is printed around it.
-fn run_binary(binary: &Path, args: &[String], show_bar: bool) -> Result<u8, u8> {
+/// Runs the generated binary's `simulate` mode (of `shard`, if any); with a bar, its
+/// `reachc-progress` lines drive the bar and its other output is printed around it.
+fn run_binary(
+    binary: &Path,
+    args: &[String],
+    show_bar: bool,
+    shard: Option<Shard>,
+) -> Result<u8, u8> {
     let cannot_run = |e: std::io::Error| {
         eprintln!("error: cannot run {}: {e}", binary.display());
         EXIT_USAGE
@@ -205,7 +292,7 @@ fn run_binary(binary: &Path, args: &[String], show_bar: bool) -> Result<u8, u8> 
         .stderr(Stdio::piped())
         .spawn()
         .map_err(cannot_run)?;
-    let mut bars = Bars::new();
+    let mut bars = Bars::new(shard);
     let (stdout, stderr) = (child.stdout.take(), child.stderr.take());
     std::thread::scope(|scope| {
         // The summaries go to stdout: print them above the bar, from their own thread so that

@@ -33,32 +33,42 @@ mod avx512;
 mod binomial;
 mod initial;
 mod inputs;
+mod merge;
 mod noise;
 mod normal;
+mod part;
+mod part_file;
 mod paths;
 mod prs;
 mod regions;
 mod report;
 mod rng;
 mod sample;
+mod shard;
 mod topk;
 mod workers;
 
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
 pub use inputs::InputMode;
+pub use merge::{merge, MergeError, Merger};
+pub use part::{Part, PartStats, RunInfo, StepInfo};
+pub use part_file::{FORMAT_VERSION, MAGIC};
 pub use report::{
     Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SimReport, SimStep,
     TubeReport, UnsafeHits,
 };
 pub use sample::{sample_paths, sample_substeps, Substeps, MAX_SAMPLE_PATHS};
+pub use shard::Shard;
 pub use workers::thread_count;
 
 use crate::model::{Guarantee, ModelInfo};
 use crate::prs::{Prs, UnsafeKind};
 use crate::system::System;
 use paths::{ChunkStats, Plan, Span};
-use std::collections::BTreeMap;
 use std::fmt;
+
+/// The version of reachc that simulates (recorded in parts: only parts of one version merge).
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// Paths per chunk (the unit of parallel work).
 const CHUNK: u64 = 256;
@@ -125,6 +135,9 @@ impl std::error::Error for SimError {}
 /// of `info` computed by [`engine::run`](crate::engine::run)). `progress(done, total)` is called
 /// after each batch of paths, on the calling thread. The paths run on a pool of
 /// `opts.threads` threads, or on the current rayon pool.
+///
+/// This is [`run_part`] of all the paths ([`Shard::WHOLE`]) merged alone ([`merge`]): the
+/// parts of a sharded run merge into this very report.
 pub fn simulate<S: System + Sync + ?Sized>(
     sys: &S,
     info: &ModelInfo,
@@ -132,11 +145,32 @@ pub fn simulate<S: System + Sync + ?Sized>(
     opts: &Options,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<SimReport, SimError> {
+    let part = run_part(sys, info, result, opts, Shard::WHOLE, progress)?;
+    merge([(String::new(), part)]).map_err(|e| SimError::Invalid(e.0))
+}
+
+/// Simulates the paths of `shard` (of `opts.paths`) and returns their exact statistics, with
+/// what the report needs besides them ([`Part`]; its `run.spec_hash` is empty: the caller
+/// knows the spec). `progress(done, total)` counts the shard's paths.
+pub fn run_part<S: System + Sync + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+    shard: Shard,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Part, SimError> {
     let plan = make_plan(sys, info, result, opts)?;
     let steps = plan.times.len();
     let n_paths = opts.paths;
+    if shard.count == 0 || shard.index >= shard.count || shard.count > n_paths {
+        return Err(SimError::Usage(format!(
+            "shard {shard} of {n_paths} paths: the index must be below the number of shards, \
+             which must be at most the number of paths"
+        )));
+    }
     // j-th largest = ceil((1 - delta) N)-th smallest; the slack keeps delta * N = 1000 (say)
-    // from rounding down to 999.
+    // from rounding down to 999. N is the whole run's: every part keeps the same j.
     let j = ((result.delta * n_paths as f64 * (1.0 + 1e-12)).floor() as u64 + 1).min(n_paths);
     let quantile_bytes = 16 * j * steps as u64;
     if quantile_bytes > QUANTILE_BYTES {
@@ -156,16 +190,18 @@ pub fn simulate<S: System + Sync + ?Sized>(
     let workers = workers::Workers::new(opts.threads)?;
     let mut topk = topk::TopK::new(steps, usize::try_from(j).unwrap_or(usize::MAX));
     let mut total = ChunkStats::new(steps, plan.unsafe_sets.len());
+    let range = shard.paths(n_paths);
     let mut done = 0;
-    while done < n_paths {
+    let mine = range.end - range.start;
+    while done < mine {
         // Small batches first: the thresholds are -inf until a step has `j` values, and every
         // path-step is a candidate until then; doubling keeps the number of batches
         // logarithmic.
-        let end = (done + done.clamp(4 * CHUNK, batch)).min(n_paths);
+        let end = (done + done.clamp(4 * CHUNK, batch)).min(mine);
         let thresholds = topk.thresholds().to_vec();
-        let chunks: Vec<(u64, u64)> = (done..end)
+        let chunks: Vec<(u64, u64)> = (range.start + done..range.start + end)
             .step_by(CHUNK as usize)
-            .map(|s| (s, (s + CHUNK).min(end)))
+            .map(|s| (s, (s + CHUNK).min(range.start + end)))
             .collect();
         let stats = workers.map(chunks, |(s, e)| plan.run_chunk(s..e, &thresholds));
         for c in &stats {
@@ -176,9 +212,69 @@ pub fn simulate<S: System + Sync + ?Sized>(
         }
         topk.tighten();
         done = end;
-        progress(done, n_paths);
+        progress(done, mine);
     }
-    Ok(report(&plan, info, result, opts, j, &total, &mut topk))
+    Ok(Part {
+        run: run_info(&plan, info, result, opts, j),
+        shard,
+        stats: PartStats::of(total),
+        top: topk.into_largest(),
+    })
+}
+
+/// What every part of a run shares: the result's radii, the options, the sampling.
+fn run_info<S: System + ?Sized>(
+    plan: &Plan<'_, S>,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+    j: u64,
+) -> RunInfo {
+    RunInfo {
+        version: VERSION.to_string(),
+        spec_hash: String::new(),
+        model: result.model.clone(),
+        analysis: result.analysis.clone(),
+        method: result.method,
+        delta: result.delta,
+        guarantee: result.guarantee,
+        step: result.step,
+        paths: opts.paths,
+        seed: opts.seed,
+        dt_option: opts.dt,
+        inputs: opts.inputs,
+        hold_option: opts.hold,
+        confidence: opts.confidence,
+        dt: plan.spans.iter().map(|s| s.h).fold(0.0, f64::max),
+        steps_per_path: plan.steps_per_path(),
+        initial_states: plan.initial.describe(),
+        noise: plan.noise.describe(),
+        has_inputs: !info.input_box.is_empty(),
+        tube: plan.tube.is_some(),
+        has_domain: info.has_domain,
+        unsafe_sets: info
+            .unsafe_sets
+            .iter()
+            .map(|u| (u.name.clone(), UnsafeKind::of(&u.shape)))
+            .collect(),
+        quantile_rank: j,
+        steps: result
+            .steps
+            .iter()
+            .map(|s| StepInfo {
+                t: s.t,
+                r_t: s.r_t,
+                prs_radius: s.prs_radius,
+            })
+            .collect(),
+        digest: part_file::checksum(
+            format!(
+                "{result:?} {:?} {:?} {:?}",
+                info.input_box, info.domain, info.unsafe_sets
+            )
+            .as_bytes(),
+        ),
+    }
 }
 
 /// Checks the options and data and prepares what the workers share.
@@ -300,139 +396,6 @@ fn make_plan<'a, S: System + ?Sized>(
     })
 }
 
-/// Quantiles, Clopper-Pearson bounds and the verdict from the merged statistics.
-fn report<S: System + ?Sized>(
-    plan: &Plan<'_, S>,
-    info: &ModelInfo,
-    result: &Prs,
-    opts: &Options,
-    j: u64,
-    total: &ChunkStats,
-    topk: &mut topk::TopK,
-) -> SimReport {
-    let n_paths = opts.paths;
-    let frac = |k: u64| k as f64 / n_paths as f64;
-    let alpha = 1.0 - opts.confidence;
-    let alpha_step = alpha / plan.times.len() as f64;
-    // Many steps share a count (often 0): compute each bound once.
-    let mut upper_cache = BTreeMap::new();
-    let mut upper = |k: u64| {
-        *upper_cache
-            .entry(k)
-            .or_insert_with(|| binomial::upper_bound(k, n_paths, alpha))
-    };
-    let steps: Vec<SimStep> = result
-        .steps
-        .iter()
-        .enumerate()
-        .map(|(k, st)| {
-            // The buffers hold squared distances (sqrt is monotone: same order statistics).
-            let (q2, max2) = topk.result(k).unwrap_or((f64::NAN, f64::NAN));
-            let (quantile, max) = (q2.sqrt(), max2.sqrt());
-            let outside = total.outside[k];
-            SimStep {
-                t: st.t,
-                r_t: st.r_t,
-                prs_radius: st.prs_radius,
-                quantile,
-                max,
-                outside,
-                fraction: frac(outside),
-                cp_upper: upper(outside),
-                left_tube: plan.tube.is_some().then_some(total.left_tube[k]),
-            }
-        })
-        .collect();
-    // The lower bound grows with the count: the step with the most violations decides, and the
-    // failing steps are those above the smallest failing count.
-    let worst_step = (0..steps.len())
-        .max_by(|&a, &b| steps[a].outside.cmp(&steps[b].outside).then(b.cmp(&a)))
-        .unwrap_or(0);
-    let (worst_t, worst_outside) = (steps[worst_step].t, steps[worst_step].outside);
-    let worst_cp_lower = binomial::lower_bound(worst_outside, n_paths, alpha_step);
-    let mut lower_cache = BTreeMap::new();
-    let failing_steps = steps
-        .iter()
-        .filter(|s| {
-            *lower_cache.entry(s.outside).or_insert_with(|| {
-                binomial::lower_bound(s.outside, n_paths, alpha_step) > result.delta
-            })
-        })
-        .count();
-    let pointwise_passed = failing_steps == 0;
-    let tube = plan.tube.as_ref().map(|_| {
-        let outside = total.outside_tube;
-        TubeReport {
-            outside,
-            fraction: frac(outside),
-            cp_upper: binomial::upper_bound(outside, n_paths, alpha),
-            cp_lower: binomial::lower_bound(outside, n_paths, alpha),
-            checks_per_path: plan.steps_per_path() + 1,
-        }
-    });
-    let (passed, decided_by) = match &tube {
-        Some(t) => (t.cp_lower <= result.delta, Guarantee::Uniform),
-        None => (pointwise_passed, Guarantee::Pointwise),
-    };
-    let hold = (!info.input_box.is_empty() && opts.inputs != InputMode::Centre)
-        .then(|| opts.hold.unwrap_or(result.step));
-    let dt = plan.spans.iter().map(|s| s.h).fold(0.0, f64::max);
-    SimReport {
-        model: result.model.clone(),
-        analysis: result.analysis.clone(),
-        method: result.method,
-        delta: result.delta,
-        guarantee: result.guarantee,
-        paths: n_paths,
-        seed: opts.seed,
-        dt,
-        steps_per_path: plan.steps_per_path(),
-        initial_states: plan.initial.describe(),
-        inputs: InputsReport {
-            mode: opts.inputs,
-            hold,
-            any: !info.input_box.is_empty(),
-            hold_shown: hold.unwrap_or(result.step),
-        },
-        noise: plan.noise.describe(),
-        quantile_rank: j,
-        steps,
-        confidence: opts.confidence,
-        horizon: HorizonReport {
-            outside_any: total.outside_any,
-            fraction: frac(total.outside_any),
-            cp_upper: binomial::upper_bound(total.outside_any, n_paths, alpha),
-        },
-        tube,
-        unsafe_sets: info
-            .unsafe_sets
-            .iter()
-            .enumerate()
-            .map(|(i, u)| UnsafeHits {
-                name: u.name.clone(),
-                kind: UnsafeKind::of(&u.shape),
-                hits: total.unsafe_hits[i],
-                fraction: frac(total.unsafe_hits[i]),
-                first_hit_t: Some(total.first_hit[i]).filter(|t| t.is_finite()),
-            })
-            .collect(),
-        left_domain: info.has_domain.then_some(total.left_domain),
-        diverged: total.diverged,
-        verdict: Coverage {
-            passed,
-            decided_by,
-            pointwise_passed,
-            alpha,
-            alpha_per_step: alpha_step,
-            failing_steps,
-            worst_step,
-            worst_t,
-            worst_outside,
-            worst_cp_lower,
-        },
-    }
-}
-
 /// Whether the processor has AVX2, BMI1 and BMI2 (see `Plan::avx2`).
 fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -452,8 +415,8 @@ mod tests {
     use crate::model::*;
 
     /// `dx = (-x + b u) dt + 0.3 dW` per state, two states and one input (unused if `b = 0`).
-    struct Sys {
-        b: f64,
+    pub(super) struct Sys {
+        pub(super) b: f64,
     }
 
     impl System for Sys {
@@ -516,7 +479,7 @@ mod tests {
 
     /// With `b != 0`: an input in `[-0.5, 0.5]` and an unsafe half-space `x1 >= 0.4`; the
     /// identity metric.
-    fn info(b: f64) -> ModelInfo {
+    pub(super) fn info(b: f64) -> ModelInfo {
         info_in(b, vec![1.0, 0.0, 0.0, 1.0])
     }
 
@@ -643,7 +606,7 @@ mod tests {
 
     /// `r` with the radius of every span after `t = 0` scaled by `factor`: a tube too narrow
     /// between report times (the PRS at the report times is unchanged).
-    fn narrow(r: &Prs, factor: f64) -> Prs {
+    pub(super) fn narrow(r: &Prs, factor: f64) -> Prs {
         let mut r = r.clone();
         for st in &mut r.steps[1..] {
             st.span.radius *= factor;

@@ -63,6 +63,20 @@ impl TopK {
         }
     }
 
+    /// Per step, the `j` largest values (all of them if fewer were pushed), largest first: what
+    /// another `TopK` of the same `j` needs to give the same results after more values.
+    pub(crate) fn into_largest(self) -> Vec<Vec<f64>> {
+        let j = self.j;
+        self.bufs
+            .into_iter()
+            .map(|mut buf| {
+                buf.sort_unstable_by(descending);
+                buf.truncate(j);
+                buf
+            })
+            .collect()
+    }
+
     /// `(j-th largest, largest)` of step `k`, or `None` if fewer than `j` values were pushed.
     pub(crate) fn result(&mut self, k: usize) -> Option<(f64, f64)> {
         let buf = &mut self.bufs[k];
@@ -110,5 +124,29 @@ mod tests {
             assert!(fwd.bufs[0].len() < 2 * j);
         }
         assert_eq!(TopK::new(1, 5).result(0), None);
+    }
+
+    /// The `j` largest of two halves, pushed into a third buffer, give the results of all values.
+    #[test]
+    fn the_largest_of_parts_merge_exactly() {
+        let values: Vec<f64> = (0..5_000u64)
+            .map(|i| ((i * 7919) % 5_003) as f64 * 0.25)
+            .collect();
+        for j in [1, 7, 2_400, 5_000] {
+            let mut all = TopK::new(1, j);
+            let mut merged = TopK::new(1, j);
+            for half in values.chunks(2_500) {
+                let mut part = TopK::new(1, j);
+                for &v in half {
+                    part.push(0, v);
+                    all.push(0, v);
+                }
+                let largest = part.into_largest();
+                assert_eq!(largest[0].len(), j.min(2_500));
+                assert!(largest[0].windows(2).all(|w| w[0] >= w[1]));
+                largest[0].iter().for_each(|&v| merged.push(0, v));
+            }
+            assert_eq!(merged.result(0), all.result(0), "j = {j}");
+        }
     }
 }

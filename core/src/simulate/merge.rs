@@ -1,0 +1,531 @@
+//! Parts into a report: [`Merger`] checks that parts belong together (the same run, every shard
+//! once), sums their counts, keeps the `j` largest distances of their union, and builds the
+//! [`SimReport`] (quantiles, Clopper-Pearson bounds, the verdict). An unsharded simulation is one
+//! part merged alone, so a merged report is the unsharded one to the bit.
+
+use super::binomial;
+use super::part::{Part, PartStats, RunInfo};
+use super::part_file::run_bytes;
+use super::report::{
+    Coverage, HorizonReport, InputsReport, SimReport, SimStep, TubeReport, UnsafeHits,
+};
+use super::shard::Shard;
+use super::topk::TopK;
+use super::{InputMode, QUANTILE_BYTES};
+use crate::model::Guarantee;
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// Why parts cannot be merged: a message naming the offending parts by their labels (file
+/// names, for `reachc simulate merge`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MergeError(pub String);
+
+impl fmt::Display for MergeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for MergeError {}
+
+/// The parts of one run, added one at a time (memory: the largest `j` distances per report
+/// time, twice at most, whatever the number of parts).
+pub struct Merger {
+    /// The first part's label and run, its bytes (what every other part must equal), shard
+    /// count.
+    first: Option<(String, RunInfo, Vec<u8>, u64)>,
+    /// The shards seen, with their parts' labels.
+    seen: BTreeMap<u64, String>,
+    stats: Option<PartStats>,
+    topk: Option<TopK>,
+}
+
+impl Default for Merger {
+    fn default() -> Self {
+        Merger::new()
+    }
+}
+
+impl Merger {
+    /// No parts yet.
+    pub fn new() -> Merger {
+        Merger {
+            first: None,
+            seen: BTreeMap::new(),
+            stats: None,
+            topk: None,
+        }
+    }
+
+    /// Adds the part `label` (how errors name it): refused when malformed, from another run
+    /// than the parts before it, or of a shard already added.
+    pub fn add(&mut self, label: &str, part: Part) -> Result<(), MergeError> {
+        let err = |m: String| Err(MergeError(m));
+        if let Some(why) = part.malformed() {
+            return err(format!("`{label}` is not a valid part: {why}"));
+        }
+        match &self.first {
+            None => {
+                let run = &part.run;
+                let steps = run.steps.len() as u64;
+                if run.quantile_rank.saturating_mul(16 * steps) > QUANTILE_BYTES {
+                    return err(format!(
+                        "`{label}`: exact quantiles of rank {} over {steps} report times need more \
+                         than {} GiB",
+                        run.quantile_rank,
+                        QUANTILE_BYTES >> 30
+                    ));
+                }
+                let j = usize::try_from(run.quantile_rank).unwrap_or(usize::MAX);
+                self.topk = Some(TopK::new(run.steps.len(), j));
+                self.first = Some((
+                    label.to_string(),
+                    run.clone(),
+                    run_bytes(run),
+                    part.shard.count,
+                ));
+            }
+            Some((first, run, bytes, count)) => {
+                if let Some(what) = difference(run, &part.run, bytes) {
+                    return err(format!(
+                        "`{label}` and `{first}` are not parts of the same simulation: {what}"
+                    ));
+                }
+                if part.shard.count != *count {
+                    return err(format!(
+                        "`{label}` is shard {} but `{first}` is one of {count} shards",
+                        part.shard
+                    ));
+                }
+            }
+        }
+        if let Some(other) = self.seen.get(&part.shard.index) {
+            return err(format!(
+                "`{label}` and `{other}` are both shard {}",
+                part.shard
+            ));
+        }
+        self.seen.insert(part.shard.index, label.to_string());
+        match &mut self.stats {
+            Some(s) => s.add(&part.stats),
+            None => self.stats = Some(part.stats),
+        }
+        if let Some(topk) = &mut self.topk {
+            for (k, top) in part.top.iter().enumerate() {
+                top.iter().for_each(|&d| topk.push(k, d));
+            }
+            topk.tighten();
+        }
+        Ok(())
+    }
+
+    /// The report of the parts added, when they are every shard of one run.
+    pub fn finish(self) -> Result<SimReport, MergeError> {
+        let (Some((_, run, _, count)), Some(stats), Some(mut topk)) =
+            (self.first, self.stats, self.topk)
+        else {
+            return Err(MergeError("no parts to merge".into()));
+        };
+        let missing: Vec<String> = (0..count)
+            .filter(|i| !self.seen.contains_key(i))
+            .take(10)
+            .map(|i| Shard { index: i, count }.to_string())
+            .collect();
+        if !missing.is_empty() {
+            let more = count - self.seen.len() as u64 - missing.len() as u64;
+            let more = if more > 0 {
+                format!(" and {more} more")
+            } else {
+                String::new()
+            };
+            return Err(MergeError(format!(
+                "missing shard{} {}{more} (have {} of {count})",
+                if missing.len() > 1 { "s" } else { "" },
+                missing.join(", "),
+                self.seen.len()
+            )));
+        }
+        Ok(report(&run, &stats, &mut topk))
+    }
+}
+
+/// Merges labelled parts (see [`Merger`]).
+pub fn merge(parts: impl IntoIterator<Item = (String, Part)>) -> Result<SimReport, MergeError> {
+    let mut m = Merger::new();
+    for (label, part) in parts {
+        m.add(&label, part)?;
+    }
+    m.finish()
+}
+
+/// What differs between two runs, `a` of bytes `a_bytes` (as a part file holds them): the first
+/// option that does, by name, or the analysis' result; `None` if they are the same to the bit.
+fn difference(a: &RunInfo, b: &RunInfo, a_bytes: &[u8]) -> Option<String> {
+    let named = [
+        ("reachc version", a.version.clone(), b.version.clone()),
+        ("spec (SHA-256)", a.spec_hash.clone(), b.spec_hash.clone()),
+        ("model", a.model.clone(), b.model.clone()),
+        ("analysis", a.analysis.clone(), b.analysis.clone()),
+        ("paths", a.paths.to_string(), b.paths.to_string()),
+        ("seed", a.seed.to_string(), b.seed.to_string()),
+        ("delta", format!("{:?}", a.delta), format!("{:?}", b.delta)),
+        (
+            "dt",
+            format!("{:?}", a.dt_option),
+            format!("{:?}", b.dt_option),
+        ),
+        ("inputs", a.inputs.name().into(), b.inputs.name().into()),
+        (
+            "hold",
+            format!("{:?}", a.hold_option),
+            format!("{:?}", b.hold_option),
+        ),
+        (
+            "confidence",
+            format!("{:?}", a.confidence),
+            format!("{:?}", b.confidence),
+        ),
+    ];
+    if let Some((what, x, y)) = named.into_iter().find(|(_, x, y)| x != y) {
+        return Some(format!("{what} {y} there, {x} in the first part"));
+    }
+    (run_bytes(b) != a_bytes)
+        .then(|| "the analysis' results or the sampling differ (same options)".to_string())
+}
+
+/// Quantiles, Clopper-Pearson bounds and the verdict from the merged statistics (`topk`: the
+/// largest `run.quantile_rank` squared distances of all paths at each report time).
+fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK) -> SimReport {
+    let n_paths = run.paths;
+    let frac = |k: u64| k as f64 / n_paths as f64;
+    let alpha = 1.0 - run.confidence;
+    let alpha_step = alpha / run.steps.len() as f64;
+    // Many steps share a count (often 0): compute each bound once.
+    let mut upper_cache = BTreeMap::new();
+    let mut upper = |k: u64| {
+        *upper_cache
+            .entry(k)
+            .or_insert_with(|| binomial::upper_bound(k, n_paths, alpha))
+    };
+    let steps: Vec<SimStep> = run
+        .steps
+        .iter()
+        .enumerate()
+        .map(|(k, st)| {
+            // The buffers hold squared distances (sqrt is monotone: same order statistics).
+            let (q2, max2) = topk.result(k).unwrap_or((f64::NAN, f64::NAN));
+            let (quantile, max) = (q2.sqrt(), max2.sqrt());
+            let outside = total.outside[k];
+            SimStep {
+                t: st.t,
+                r_t: st.r_t,
+                prs_radius: st.prs_radius,
+                quantile,
+                max,
+                outside,
+                fraction: frac(outside),
+                cp_upper: upper(outside),
+                left_tube: run.tube.then_some(total.left_tube[k]),
+            }
+        })
+        .collect();
+    // The lower bound grows with the count: the step with the most violations decides, and the
+    // failing steps are those above the smallest failing count.
+    let worst_step = (0..steps.len())
+        .max_by(|&a, &b| steps[a].outside.cmp(&steps[b].outside).then(b.cmp(&a)))
+        .unwrap_or(0);
+    let (worst_t, worst_outside) = (steps[worst_step].t, steps[worst_step].outside);
+    let worst_cp_lower = binomial::lower_bound(worst_outside, n_paths, alpha_step);
+    let mut lower_cache = BTreeMap::new();
+    let failing_steps = steps
+        .iter()
+        .filter(|s| {
+            *lower_cache.entry(s.outside).or_insert_with(|| {
+                binomial::lower_bound(s.outside, n_paths, alpha_step) > run.delta
+            })
+        })
+        .count();
+    let pointwise_passed = failing_steps == 0;
+    let tube = run.tube.then(|| {
+        let outside = total.outside_tube;
+        TubeReport {
+            outside,
+            fraction: frac(outside),
+            cp_upper: binomial::upper_bound(outside, n_paths, alpha),
+            cp_lower: binomial::lower_bound(outside, n_paths, alpha),
+            checks_per_path: run.steps_per_path + 1,
+        }
+    });
+    let (passed, decided_by) = match &tube {
+        Some(t) => (t.cp_lower <= run.delta, Guarantee::Uniform),
+        None => (pointwise_passed, Guarantee::Pointwise),
+    };
+    let hold = (run.has_inputs && run.inputs != InputMode::Centre)
+        .then(|| run.hold_option.unwrap_or(run.step));
+    SimReport {
+        model: run.model.clone(),
+        analysis: run.analysis.clone(),
+        method: run.method,
+        delta: run.delta,
+        guarantee: run.guarantee,
+        paths: n_paths,
+        seed: run.seed,
+        dt: run.dt,
+        steps_per_path: run.steps_per_path,
+        initial_states: run.initial_states,
+        inputs: InputsReport {
+            mode: run.inputs,
+            hold,
+            any: run.has_inputs,
+            hold_shown: hold.unwrap_or(run.step),
+        },
+        noise: run.noise,
+        quantile_rank: run.quantile_rank,
+        steps,
+        confidence: run.confidence,
+        horizon: HorizonReport {
+            outside_any: total.outside_any,
+            fraction: frac(total.outside_any),
+            cp_upper: binomial::upper_bound(total.outside_any, n_paths, alpha),
+        },
+        tube,
+        unsafe_sets: run
+            .unsafe_sets
+            .iter()
+            .enumerate()
+            .map(|(i, (name, kind))| UnsafeHits {
+                name: name.clone(),
+                kind: *kind,
+                hits: total.unsafe_hits[i],
+                fraction: frac(total.unsafe_hits[i]),
+                first_hit_t: Some(total.first_hit[i]).filter(|t| t.is_finite()),
+            })
+            .collect(),
+        left_domain: run.has_domain.then_some(total.left_domain),
+        diverged: total.diverged,
+        verdict: Coverage {
+            passed,
+            decided_by,
+            pointwise_passed,
+            alpha,
+            alpha_per_step: alpha_step,
+            failing_steps,
+            worst_step,
+            worst_t,
+            worst_outside,
+            worst_cp_lower,
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{info, narrow, Sys};
+    use super::super::{run_part, simulate, Options};
+    use super::*;
+    use crate::engine;
+    use crate::prs::Prs;
+
+    /// The parts of `r` for `shards` shards, each through its file's bytes.
+    fn parts(sys: &Sys, r: &Prs, opts: &Options, shards: u64) -> Vec<(String, Part)> {
+        let info = info(sys.b);
+        (0..shards)
+            .map(|i| {
+                let shard = Shard::new(i, shards).unwrap();
+                let part = run_part(sys, &info, r, opts, shard, &mut |_, _| {}).unwrap();
+                let bytes = part.to_bytes();
+                let read = Part::from_bytes(&bytes).unwrap();
+                assert_eq!(read, part);
+                assert_eq!(read.to_bytes(), bytes);
+                (format!("part{i}"), read)
+            })
+            .collect()
+    }
+
+    /// Shards merged, in any order, give the unsharded report to the bit: with inputs and an
+    /// unsafe set, for a uniform result (a narrowed tube: many paths leave it) and a pointwise
+    /// one; for 1 shard, shards dividing the paths and not, and shards of fewer paths than the
+    /// quantile's rank (j = 51 here).
+    #[test]
+    fn sharded_runs_merge_into_the_unsharded_report() {
+        for b in [0.0, 1.0] {
+            let (sys, info) = (Sys { b }, info(b));
+            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let mut pointwise = narrow(&r, 0.5);
+            pointwise.guarantee = Guarantee::Pointwise;
+            for r in [narrow(&r, 0.5), pointwise] {
+                let opts = Options {
+                    paths: 1_000,
+                    seed: 7,
+                    dt: Some(0.005),
+                    ..Options::default()
+                };
+                let whole = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+                assert_eq!(whole.quantile_rank, 51);
+                if r.guarantee == Guarantee::Uniform {
+                    assert!(whole.tube.as_ref().unwrap().outside > 30);
+                }
+                for k in [1, 2, 3, 7, 40] {
+                    let mut p = parts(&sys, &r, &opts, k);
+                    p.reverse();
+                    p.rotate_left(k as usize / 2);
+                    assert_eq!(merge(p).unwrap(), whole, "b = {b}, {k} shards");
+                }
+            }
+        }
+    }
+
+    fn merge_error(parts: Vec<(String, Part)>) -> String {
+        merge(parts).unwrap_err().0
+    }
+
+    /// Missing and repeated shards, parts of other runs (seed, paths, shard count, analysis
+    /// result) are refused, naming the parts.
+    #[test]
+    fn merge_refuses_parts_that_do_not_belong_together() {
+        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let opts = Options {
+            paths: 200,
+            ..Options::default()
+        };
+        let three = parts(&sys, &r, &opts, 3);
+        assert_eq!(
+            merge_error(vec![three[0].clone(), three[2].clone()]),
+            "missing shard 1/3 (have 2 of 3)"
+        );
+        assert_eq!(
+            merge_error(vec![three[0].clone()]),
+            "missing shards 1/3, 2/3 (have 1 of 3)"
+        );
+        let mut again = three[1].clone();
+        again.0 = "copy".into();
+        assert_eq!(
+            merge_error(vec![three[1].clone(), again]),
+            "`copy` and `part1` are both shard 1/3"
+        );
+        let other = |opts: &Options, r: &Prs, k: u64| parts(&sys, r, opts, k).remove(1);
+        let seed = other(
+            &Options {
+                seed: 1,
+                ..opts.clone()
+            },
+            &r,
+            3,
+        );
+        assert_eq!(
+            merge_error(vec![three[0].clone(), seed]),
+            "`part1` and `part0` are not parts of the same simulation: seed 1 there, 0 in the \
+             first part"
+        );
+        let paths = other(
+            &Options {
+                paths: 300,
+                ..opts.clone()
+            },
+            &r,
+            3,
+        );
+        assert!(merge_error(vec![three[0].clone(), paths])
+            .ends_with("paths 300 there, 200 in the first part"));
+        assert_eq!(
+            merge_error(vec![three[0].clone(), other(&opts, &r, 4)]),
+            "`part1` is shard 1/4 but `part0` is one of 3 shards"
+        );
+        assert!(
+            merge_error(vec![three[0].clone(), other(&opts, &narrow(&r, 0.5), 3)])
+                .ends_with("the analysis' results or the sampling differ (same options)")
+        );
+        let mut spec = three[1].clone();
+        spec.1.run.spec_hash = "abc".into();
+        assert!(merge_error(vec![three[0].clone(), spec])
+            .ends_with("spec (SHA-256) abc there,  in the first part"));
+        assert_eq!(merge_error(vec![]), "no parts to merge");
+    }
+
+    /// Parts that are not well formed are refused, not trusted: counts above the paths,
+    /// distances out of order or too few.
+    #[test]
+    fn malformed_parts_are_refused() {
+        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let opts = Options {
+            paths: 100,
+            ..Options::default()
+        };
+        let (_, part) = parts(&sys, &r, &opts, 2).remove(0);
+        for (what, change) in [
+            (
+                "counts",
+                &(|p: &mut Part| p.stats.diverged = 51) as &dyn Fn(&mut Part),
+            ),
+            ("counts", &|p| p.stats.outside_tube += 1),
+            ("not sorted", &|p| p.top[3].swap(0, 1)),
+            ("expected 6", &|p| {
+                p.top[2].pop();
+            }),
+            ("statistics", &|p| {
+                p.stats.outside.pop();
+            }),
+        ] {
+            let mut bad = part.clone();
+            change(&mut bad);
+            let e = merge_error(vec![("bad.part".into(), bad)]);
+            assert!(
+                e.starts_with("`bad.part` is not a valid part: ") && e.contains(what),
+                "{e}"
+            );
+        }
+    }
+
+    /// Bytes that are not a part file, truncated or corrupt ones, another format version: each
+    /// a message, never a panic.
+    #[test]
+    fn bad_part_files_are_refused() {
+        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let opts = Options {
+            paths: 50,
+            ..Options::default()
+        };
+        let bytes = parts(&sys, &r, &opts, 1).remove(0).1.to_bytes();
+        let read = |b: &[u8]| Part::from_bytes(b).unwrap_err();
+        assert!(read(b"{\"model\": 1}").starts_with("not a reachc simulate part file"));
+        assert!(read(&[]).starts_with("not a reachc simulate part file"));
+        for cut in [
+            MAGIC_LEN,
+            MAGIC_LEN + 4,
+            MAGIC_LEN + 9,
+            bytes.len() / 2,
+            bytes.len() - 1,
+        ] {
+            let e = read(&bytes[..cut]);
+            assert!(e.contains("truncated"), "{cut}: {e}");
+        }
+        let mut corrupt = bytes.clone();
+        corrupt[bytes.len() / 2] ^= 1;
+        assert_eq!(
+            read(&corrupt),
+            "corrupt or truncated: the checksum does not match"
+        );
+        let mut version = bytes.clone();
+        version[MAGIC_LEN] = 9;
+        assert_eq!(
+            read(&version),
+            "part file format version 9; this reachc reads version 1"
+        );
+        let mut longer = bytes.clone();
+        longer.extend_from_slice(&[0; 8]);
+        assert!(read(&longer).contains("checksum"), "{}", read(&longer));
+        // Every cut and every flipped byte: an error, never a panic.
+        for i in 0..bytes.len() {
+            assert!(Part::from_bytes(&bytes[..i]).is_err());
+            let mut b = bytes.clone();
+            b[i] ^= 0x80;
+            assert!(Part::from_bytes(&b).is_err(), "byte {i}");
+        }
+    }
+
+    const MAGIC_LEN: usize = crate::simulate::MAGIC.len();
+}
