@@ -3,7 +3,6 @@
 //! zero for an exact solution): on validated steps by default (`defect.rs`), or one
 //! unvalidated RK4 or Euler step per report step when the spec asks for it.
 
-use crate::decimal::time;
 use super::assemble::{
     assemble_with, constants_used, rate_used, Deterministic, Header, Piece, Radii,
 };
@@ -11,6 +10,7 @@ use super::defect::{Nominal, NominalStep};
 use super::intersect::intersect;
 use super::radius::expm1_over;
 use super::{interval, local, nominal, r1, radius, rates, Run, RunError};
+use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
 use crate::prs::{DetSet, Proved, Prs, Span, Unproved};

@@ -11,10 +11,10 @@
 //! `p([a, b])`, so `d(s) in p'(m) - f(p(m), u, [a, b]) + (p''([a, b]) - J p'([a, b])) [a - m, b - m]`:
 //! a small first term (the Hermite error), and a second that shrinks with the piece.
 
-use crate::decimal::time;
 use super::hermite::Cubic;
 use super::radius::BoxRadius;
 use super::RunError;
+use crate::decimal::time;
 use crate::interval::Interval;
 use crate::system::System;
 

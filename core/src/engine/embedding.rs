@@ -10,11 +10,11 @@
 //! evaluations of the drift and of the non-zero Jacobian entries: time proportional to the
 //! size of the expressions, not to `n^2`.
 
-use crate::decimal::time;
 use super::defect::{StepBudget, MIN_STEP};
 use super::hermite::Cubic;
 use super::nominal::rk4_step;
 use super::RunError;
+use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{Inclusion, Integrator};
 use crate::system::System;

@@ -26,11 +26,11 @@
 //! integrated numerically (RK4 or Euler, no remainder bound), so the box is an enclosure only
 //! up to the time-discretisation error. The result says so.
 
-use crate::decimal::time;
 use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::embedding::{BoxStep, Embedding};
 use super::transform::{self, Frame};
 use super::{hints, local, nominal, r1, radius, validate, Run, RunError};
+use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
 use crate::prs::{DetSet, Proved, Prs, R1Bound, Span, TransformUsed, Unproved};

@@ -17,10 +17,10 @@
 //! scaled by the input box's half-widths. Where the compiler's global constants hold on the
 //! region (no domain, or the region inside it), the smaller of the two is used.
 
-use crate::decimal::time;
 use super::linalg::{self, lambda_max, product, symmetric_part};
 use super::uniform::{Scale, Tube};
 use super::{Run, RunError};
+use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::Bounds;
 use crate::prs::RateRegion;

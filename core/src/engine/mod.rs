@@ -273,7 +273,10 @@ pub(crate) fn validate(
     // Shorter steps would subdivide into subnormal numbers, where `t + h == t` (the front
     // end's limit, `reachc_compiler::limits::MIN_REPORT_STEP`).
     if !(a.step >= 1e-100 && a.step.is_finite()) {
-        return bad(format!("step = {} must be finite and at least 1e-100", a.step));
+        return bad(format!(
+            "step = {} must be finite and at least 1e-100",
+            a.step
+        ));
     }
     if !(a.horizon >= 0.0 && a.horizon.is_finite()) {
         return bad(format!(

@@ -3,8 +3,8 @@
 //! follow their per-step recursions with it (Proposition 2 and eq. Psi with piecewise-constant
 //! rates).
 
-use crate::decimal::time;
 use super::{Run, RunError};
+use crate::decimal::time;
 use crate::model::ModelInfo;
 use crate::simulate::{self, InputMode};
 

@@ -365,7 +365,8 @@ impl Checker<'_> {
         let Some((e, _)) = f.get("step").or_else(|| f.get("horizon")) else {
             return true; // unreachable: the horizon is given when it is positive
         };
-        self.diags.push(Diagnostic::error(message, e.span.clone(), label).with_help(help));
+        self.diags
+            .push(Diagnostic::error(message, e.span.clone(), label).with_help(help));
         false
     }
 
