@@ -233,13 +233,10 @@ enum Shape {
 }
 
 impl Shape {
-    /// The shape of every step of `result` (the sets of one result all have one shape).
+    /// The shape of every step of `result`'s own set (the sets of one result all have one
+    /// shape; the members of an intersection, `result.also`, have shapes of their own).
     fn of(result: &Prs) -> Shape {
         let n = result.states.len();
-        // An intersection of several metrics' sets: no shortcut of one metric's set decides.
-        if !result.also.is_empty() {
-            return Shape::Other;
-        }
         let all = |f: fn(&DetSet) -> bool| result.steps.iter().all(|s| f(&s.det));
         // The contraction method's set at t = 0 may be the initial box inside its P-ball: the
         // ball's shortcuts then hold for "outside" only (see `Membership::ball`).
@@ -280,9 +277,99 @@ impl Shape {
     }
 }
 
-/// Decides PRS membership at each report step of `result`.
+/// Decides PRS membership at each report step of `result`: in its own set and in those of
+/// the members of an intersection (`result.also`, each with its own metric), every set with
+/// its own shortcuts.
 #[derive(Clone, Debug)]
 pub(crate) struct Membership<'a> {
+    own: OneSet<'a>,
+    /// The members, with their metrics.
+    also: Vec<(Metric, OneSet<'a>)>,
+}
+
+impl<'a> Membership<'a> {
+    /// For `result` (its steps), with `metric` built from its metric.
+    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Self {
+        let n = result.states.len();
+        let also = result
+            .also
+            .iter()
+            .map(|m| {
+                let metric = Metric::new(&m.constants.metric, n);
+                let set = OneSet::new(m, &metric);
+                (metric, set)
+            })
+            .collect();
+        Membership {
+            own: OneSet::new(result, metric),
+            also,
+        }
+    }
+
+    /// `Some(b)`: a squared distance `q < b` (from [`Metric::quad`]) means `x` is in the PRS of
+    /// step `k`, found with one comparison (what [`inside`](Self::inside) answers). `None` when
+    /// no such bound holds (an intersection, shapes other than the P-ball, metrics with
+    /// off-diagonal or negative terms: see [`inside_by_shortcut`](Self::inside_by_shortcut)).
+    pub(crate) fn inside_below(&self, k: usize) -> Option<f64> {
+        if self.also.is_empty() {
+            self.own.inside_below(k)
+        } else {
+            None
+        }
+    }
+
+    /// Whether [`inside_by_shortcut`](Self::inside_by_shortcut) can ever answer `true`.
+    pub(crate) fn has_shortcuts(&self) -> bool {
+        self.own.has_shortcuts() && self.also.iter().all(|(_, s)| s.has_shortcuts())
+    }
+
+    /// Whether `x` is, by the shortcuts alone, in the PRS of step `k` (then
+    /// [`inside`](Self::inside) is `true`; `false` says nothing). Arguments as for `inside`.
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[f64],
+        q: f64,
+        a: f64,
+    ) -> bool {
+        self.own.inside_by_shortcut(metric, k, x, q, a)
+            && self.also.iter().all(|(m, s)| {
+                let (q, a) = m.quad(x, s.centre(k));
+                s.inside_by_shortcut(m, k, x, q, a)
+            })
+    }
+
+    /// Whether the finite state `x` is in the PRS of step `k`, given the centre `c = x*_k` and
+    /// `(q, a) = metric.quad(x, c)`: in every member's set (`Prs::contains_at`'s answer, each
+    /// set decided by its shortcuts where they hold).
+    #[inline]
+    pub(crate) fn inside(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[f64],
+        c: &[f64],
+        q: f64,
+        a: f64,
+    ) -> bool {
+        self.own.inside(metric, k, x, c, q, a)
+            && self.also.iter().all(|(m, s)| {
+                let c = s.centre(k);
+                let (q, a) = m.quad(x, c);
+                // As `record` does for the own metric: rounding can make `q` slightly negative
+                // only with off-diagonal terms.
+                let q = if a == q { q } else { q.max(0.0) };
+                s.inside(m, k, x, c, q, a)
+            })
+    }
+}
+
+/// Decides membership in one metric's set at each report step (a result's own set, or one
+/// member of an intersection).
+#[derive(Clone, Debug)]
+struct OneSet<'a> {
     result: &'a Prs,
     shape: Shape,
     /// Squared PRS radius per step.
@@ -298,9 +385,9 @@ pub(crate) struct Membership<'a> {
     ball: Vec<bool>,
 }
 
-impl<'a> Membership<'a> {
-    /// For `result` (its steps), with `metric` built from its metric.
-    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Self {
+impl<'a> OneSet<'a> {
+    /// For `result`'s own set, with `metric` built from its metric.
+    fn new(result: &'a Prs, metric: &Metric) -> Self {
         let n = result.states.len();
         let shape = Shape::of(result);
         let r2: Vec<f64> = result
@@ -324,7 +411,7 @@ impl<'a> Membership<'a> {
             .iter()
             .map(|s| matches!(s.det, DetSet::Ball { .. }))
             .collect();
-        Membership {
+        OneSet {
             result,
             shape,
             r2,
@@ -340,7 +427,7 @@ impl<'a> Membership<'a> {
     /// step `k`, found with one comparison (what [`inside`](Self::inside) answers). `None` when
     /// no such bound holds (shapes other than the P-ball, metrics with off-diagonal or negative
     /// terms: see [`inside_by_shortcut`](Self::inside_by_shortcut)).
-    pub(crate) fn inside_below(&self, k: usize) -> Option<f64> {
+    fn inside_below(&self, k: usize) -> Option<f64> {
         match self.shape {
             Shape::PBall if self.nonneg && self.ball[k] => Some(self.q_in[k]),
             Shape::PBall if self.nonneg => Some(f64::NEG_INFINITY),
@@ -348,8 +435,13 @@ impl<'a> Membership<'a> {
         }
     }
 
+    /// The centre `x*_k` of step `k`, around which [`Metric::quad`] measures for this set.
+    fn centre(&self, k: usize) -> &'a [f64] {
+        self.result.steps[k].nominal()
+    }
+
     /// Whether [`inside_by_shortcut`](Self::inside_by_shortcut) can ever answer `true`.
-    pub(crate) fn has_shortcuts(&self) -> bool {
+    fn has_shortcuts(&self) -> bool {
         !matches!(self.shape, Shape::Other)
     }
 
@@ -373,14 +465,7 @@ impl<'a> Membership<'a> {
     /// Whether `x` is, by one of the shortcuts alone, in the PRS of step `k` (then
     /// [`inside`](Self::inside) is `true`; `false` says nothing). Arguments as for `inside`.
     #[inline(always)]
-    pub(crate) fn inside_by_shortcut(
-        &self,
-        metric: &Metric,
-        k: usize,
-        x: &[f64],
-        q: f64,
-        a: f64,
-    ) -> bool {
+    fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64], q: f64, a: f64) -> bool {
         let (clearly_out, clearly_in) = self.clearly(metric, k, q, a);
         match &self.shape {
             Shape::PBall => clearly_in,
@@ -428,15 +513,7 @@ impl<'a> Membership<'a> {
     /// Whether `x` is in the PRS of step `k`, given the centre `c = x*_k` and
     /// `(q, a) = metric.quad(x, c)`.
     #[inline]
-    pub(crate) fn inside(
-        &self,
-        metric: &Metric,
-        k: usize,
-        x: &[f64],
-        c: &[f64],
-        q: f64,
-        a: f64,
-    ) -> bool {
+    fn inside(&self, metric: &Metric, k: usize, x: &[f64], c: &[f64], q: f64, a: f64) -> bool {
         let (clearly_out, clearly_in) = self.clearly(metric, k, q, a);
         match &self.shape {
             Shape::PBall => {
@@ -467,7 +544,7 @@ impl<'a> Membership<'a> {
             }
             Shape::Other => {}
         }
-        self.result.contains_at(k, x)
+        self.result.own_contains_at(k, x)
     }
 }
 
@@ -478,6 +555,80 @@ impl<'a> Membership<'a> {
 /// [`Step::span`]: crate::prs::Step::span
 #[derive(Clone, Debug)]
 pub(crate) struct Tube<'a> {
+    own: OneSpan<'a>,
+    /// The spans of the members of an intersection (`result.also`), with their metrics: a
+    /// state is in the tube when it is in every member's span.
+    also: Vec<(Metric, OneSpan<'a>)>,
+}
+
+impl<'a> Tube<'a> {
+    /// The tube of `result`'s spans, with `metric` built from its metric; `Err` when a span is
+    /// malformed (a corner of the wrong length, NaN, `lo > hi`, a negative or NaN radius).
+    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Result<Tube<'a>, String> {
+        let n = result.states.len();
+        let also = result
+            .also
+            .iter()
+            .map(|m| {
+                let metric = Metric::new(&m.constants.metric, n);
+                let span = OneSpan::new(m, &metric)?;
+                Ok((metric, span))
+            })
+            .collect::<Result<_, String>>()?;
+        Ok(Tube {
+            own: OneSpan::new(result, metric)?,
+            also,
+        })
+    }
+
+    /// The box and the "clearly inside" bound of step `k` for the caller's own
+    /// [`diag_quad_to_box`] (non-negative diagonal metrics): `(lo, hi, q_in)`. With the members
+    /// of an intersection the own span's distance proves nothing alone: `q_in` is `-inf`, and
+    /// every state goes to [`inside_slow`](Self::inside_slow).
+    #[inline(always)]
+    pub(crate) fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
+        let (lo, hi, q_in) = self.own.diag_bounds(k);
+        let q_in = if self.also.is_empty() {
+            q_in
+        } else {
+            f64::NEG_INFINITY
+        };
+        (lo, hi, q_in)
+    }
+
+    /// Whether `x` is, by the "inside" shortcuts alone, in the span of step `k` of every member
+    /// (then [`inside`](Self::inside) is `true`; `false` says nothing). Alone and with a
+    /// non-negative diagonal metric, the same as `diag_quad_to_box(w, x, lo, hi) < q_in` with
+    /// [`diag_bounds`](Self::diag_bounds).
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        self.own.inside_by_shortcut(metric, k, x)
+            && self.also.iter().all(|(m, s)| s.inside_by_shortcut(m, k, x))
+    }
+
+    /// Whether `x` lies in the span of step `k`: the shortcuts, then [`Prs::span_contains`];
+    /// `true` only if certainly.
+    #[cfg(test)]
+    pub(crate) fn inside(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        self.inside_by_shortcut(metric, k, x) || self.inside_slow(metric, k, x)
+    }
+
+    /// [`inside`](Self::inside) for a state the shortcut did not find inside (the same answer
+    /// then): [`Prs::span_contains`]'s, member by member, each decided by its own shortcuts
+    /// where they hold.
+    #[cold]
+    #[inline(never)]
+    pub(crate) fn inside_slow(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        if !x.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        self.own.decide(metric, k, x) && self.also.iter().all(|(m, s)| s.decide(m, k, x))
+    }
+}
+
+/// The spans of one metric's set (a result's own, or one member of an intersection).
+#[derive(Clone, Debug)]
+struct OneSpan<'a> {
     result: &'a Prs,
     n: usize,
     /// Per report step, the span's box, flat (`n` per step).
@@ -495,18 +646,15 @@ pub(crate) struct Tube<'a> {
     centre: Vec<f64>,
     outer2: Vec<f64>,
     nonneg: bool,
-    /// The result is one metric's set (no intersection with others): a point of its span is
-    /// in the PRS, so the "inside" shortcuts decide.
-    alone: bool,
 }
 
-impl<'a> Tube<'a> {
-    /// The tube of `result`'s spans, with `metric` built from its metric; `Err` when a span is
-    /// malformed (a corner of the wrong length, NaN, `lo > hi`, a negative or NaN radius).
-    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Result<Tube<'a>, String> {
+impl<'a> OneSpan<'a> {
+    /// The spans of `result`'s own set, with `metric` built from its metric; `Err` as for
+    /// [`Tube::new`].
+    fn new(result: &'a Prs, metric: &Metric) -> Result<OneSpan<'a>, String> {
         let n = result.states.len();
         let steps = result.steps.len();
-        let mut tube = Tube {
+        let mut tube = OneSpan {
             result,
             n,
             lo: Vec::with_capacity(n * steps),
@@ -517,7 +665,6 @@ impl<'a> Tube<'a> {
             centre: Vec::with_capacity(n * steps),
             outer2: Vec::with_capacity(steps),
             nonneg: metric.nonneg,
-            alone: result.also.is_empty(),
         };
         let eps16 = 16.0 * f64::EPSILON;
         for (k, st) in result.steps.iter().enumerate() {
@@ -541,11 +688,7 @@ impl<'a> Tube<'a> {
             // As in `Membership::new`: the error bound solved for q once per step.
             let r2 = s.radius * s.radius;
             tube.r2.push(r2);
-            tube.q_in.push(if tube.alone {
-                r2 * (1.0 - eps16) / (1.0 + metric.gamma)
-            } else {
-                f64::NEG_INFINITY
-            });
+            tube.q_in.push(r2 * (1.0 - eps16) / (1.0 + metric.gamma));
             tube.q_out.push(r2 * (1.0 + eps16) / (1.0 - metric.gamma));
             // A ball around the box's centre holding the span: radius + b, with
             // b^2 <= sum_ij |P_ij| h_i h_j and h_i >= |y_i - c_i| over the box, all rounded up.
@@ -579,10 +722,9 @@ impl<'a> Tube<'a> {
         Ok(tube)
     }
 
-    /// The box and the "clearly inside" bound of step `k` for the caller's own
-    /// [`diag_quad_to_box`] (non-negative diagonal metrics): `(lo, hi, q_in)`.
+    /// The box and the "clearly inside" bound of step `k`: `(lo, hi, q_in)`.
     #[inline(always)]
-    pub(crate) fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
+    fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
         let n = self.n;
         (&self.lo[k * n..][..n], &self.hi[k * n..][..n], self.q_in[k])
     }
@@ -594,38 +736,28 @@ impl<'a> Tube<'a> {
         metric.quad_by(|i| x[i] - clamp(x[i], lo[i], hi[i]))
     }
 
-    /// Whether `x` is, by the "inside" shortcut alone, in the span of step `k` (then
-    /// [`inside`](Self::inside) is `true`; `false` says nothing). With a non-negative diagonal
-    /// metric, the same as `diag_quad_to_box(w, x, lo, hi) < q_in` with
-    /// [`diag_bounds`](Self::diag_bounds).
+    /// Whether `x` is, by the "inside" shortcut alone, in the span of step `k` (`false` says
+    /// nothing).
     #[inline(always)]
-    pub(crate) fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+    fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
         let (q, a) = self.quad_to_box(metric, k, x);
         if self.nonneg {
             q < self.q_in[k]
         } else {
-            self.alone && q + (metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k]) < self.r2[k]
+            q + (metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k]) < self.r2[k]
         }
     }
 
-    /// Whether `x` lies in the span of step `k`: the shortcuts, then [`Prs::span_contains`];
-    /// `true` only if certainly.
-    #[cfg(test)]
-    pub(crate) fn inside(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
-        self.inside_by_shortcut(metric, k, x) || self.inside_slow(metric, k, x)
-    }
-
-    /// [`inside`](Self::inside) for a state not inside by the shortcut (the same answer then).
-    #[cold]
-    #[inline(never)]
-    pub(crate) fn inside_slow(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
-        if !x.iter().all(|v| v.is_finite()) {
-            return false;
+    /// Whether the finite state `x` lies in the span of step `k` ([`Prs::own_span_contains`]'s
+    /// answer): the shortcuts, then that test.
+    fn decide(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        if self.inside_by_shortcut(metric, k, x) {
+            return true;
         }
         // In the box (which the span holds): the states at t = 0 of an interval analysis,
         // whose span there is the initial box with radius 0.
         let (lo, hi, _) = self.diag_bounds(k);
-        if self.alone && (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
+        if (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
             return true;
         }
         let clearly_out = if self.nonneg {
@@ -636,7 +768,7 @@ impl<'a> Tube<'a> {
             let o2 = self.outer2[k];
             q - (metric.gamma * a + 8.0 * f64::EPSILON * o2) > o2
         };
-        !clearly_out && self.result.span_contains(k, x)
+        !clearly_out && self.result.own_span_contains(k, x)
     }
 }
 
@@ -713,7 +845,9 @@ mod tests {
         }
     }
 
-    fn result(method: Method, metric: Vec<f64>) -> Prs {
+    /// The result of `method` with `metric`; `members`: with the members of its intersection
+    /// (a contraction run's interval box, method.md 8.7), else its own set alone.
+    fn result(method: Method, metric: Vec<f64>, members: bool) -> Prs {
         let info = ModelInfo {
             name: "m".into(),
             states: vec!["x".into(), "y".into()],
@@ -743,16 +877,18 @@ mod tests {
             constants: Ok(Constants::given(&info, metric, -0.2, 0.5, 0.0)),
         };
         let mut r = engine::run(&Sys, &info, &analysis).unwrap();
-        // The set alone: a contraction run's interval box (method.md 8.7) turns the
-        // shortcuts off, and is tested with the other intersections.
-        r.also.clear();
+        if members {
+            assert!(!r.also.is_empty(), "{method:?}: an intersection");
+        } else {
+            r.also.clear();
+        }
         r
     }
 
     /// The interval method's box result turned into a parallelotope `{x : lo <= T x <= hi}`
     /// inside each box (the pendulum's `T`), so that the box's enclosing P-ball still holds it.
     fn parallelotope(metric: Vec<f64>) -> Prs {
-        let mut r = result(Method::Interval, metric);
+        let mut r = result(Method::Interval, metric, false);
         let t = [[1.0, 0.2], [1.0, 0.0]];
         r.transform = Some(TransformUsed {
             matrix: t.concat(),
@@ -836,8 +972,8 @@ mod tests {
     #[test]
     fn the_tube_agrees_with_span_contains() {
         let mut rng = PathRng::new(7, 0);
-        for (method, metric) in methods_and_metrics() {
-            let r = result(method, metric);
+        for (method, metric, members) in methods_and_metrics() {
+            let r = result(method, metric, members);
             let m = Metric::new(&r.constants.metric, 2);
             let tube = Tube::new(&r, &m).unwrap();
             let (mut shortcut, mut inside, mut points) = (0, 0, 0);
@@ -893,13 +1029,17 @@ mod tests {
         }
     }
 
-    /// Both methods, each with the identity and a skewed metric.
-    fn methods_and_metrics() -> [(Method, Vec<f64>); 4] {
+    /// Both methods, each with the identity and a skewed metric; the contraction method's
+    /// set alone and as the intersection with its interval box (`true`).
+    fn methods_and_metrics() -> [(Method, Vec<f64>, bool); 6] {
+        let (identity, skewed) = (vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]);
         [
-            (Method::Contraction, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Contraction, vec![2.0, 0.7, 0.7, 1.0]),
-            (Method::Interval, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Interval, vec![2.0, 0.7, 0.7, 1.0]),
+            (Method::Contraction, identity.clone(), false),
+            (Method::Contraction, skewed.clone(), false),
+            (Method::Contraction, identity.clone(), true),
+            (Method::Contraction, skewed.clone(), true),
+            (Method::Interval, identity, false),
+            (Method::Interval, skewed, false),
         ]
     }
 
@@ -908,8 +1048,8 @@ mod tests {
     #[test]
     fn shortcuts_agree_with_contains() {
         let mut rng = PathRng::new(5, 0);
-        for (method, metric) in methods_and_metrics() {
-            let r = result(method, metric);
+        for (method, metric, members) in methods_and_metrics() {
+            let r = result(method, metric, members);
             let m = Metric::new(&r.constants.metric, 2);
             let mem = Membership::new(&r, &m);
             for (k, st) in r.steps.iter().enumerate() {
