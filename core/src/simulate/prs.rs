@@ -335,10 +335,10 @@ impl<'a> Membership<'a> {
         a: f64,
     ) -> bool {
         self.own.inside_by_shortcut(metric, k, x, q, a)
-            && self.also.iter().all(|(m, s)| {
-                let (q, a) = m.quad(x, s.centre(k));
-                s.inside_by_shortcut(m, k, x, q, a)
-            })
+            && self
+                .also
+                .iter()
+                .all(|(m, s)| s.inside_by_shortcut_with(m, k, x, || m.quad(x, s.centre(k))))
     }
 
     /// Whether the finite state `x` is in the PRS of step `k`, given the centre `c = x*_k` and
@@ -466,13 +466,28 @@ impl<'a> OneSet<'a> {
     /// [`inside`](Self::inside) is `true`; `false` says nothing). Arguments as for `inside`.
     #[inline(always)]
     fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64], q: f64, a: f64) -> bool {
-        let (clearly_out, clearly_in) = self.clearly(metric, k, q, a);
+        self.inside_by_shortcut_with(metric, k, x, || (q, a))
+    }
+
+    /// [`inside_by_shortcut`](Self::inside_by_shortcut) with `(q, a)` computed only if the
+    /// shape needs it: a box or a parallelotope is in the PRS, so a state in it is inside
+    /// whatever its distance to `x*_k` (for [`Membership`]'s members, which would compute the
+    /// distance in their own metric for nothing).
+    #[inline(always)]
+    fn inside_by_shortcut_with(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[f64],
+        quad: impl FnOnce() -> (f64, f64),
+    ) -> bool {
         match &self.shape {
-            Shape::PBall => clearly_in,
-            Shape::Box { lo, hi } => !clearly_out && self.in_box(lo, hi, k, x),
-            Shape::Parallelotope { t, lo, hi } => {
-                !clearly_out && self.in_parallelotope(t, lo, hi, k, x)
+            Shape::PBall => {
+                let (q, a) = quad();
+                self.clearly(metric, k, q, a).1
             }
+            Shape::Box { lo, hi } => self.in_box(lo, hi, k, x),
+            Shape::Parallelotope { t, lo, hi } => self.in_parallelotope(t, lo, hi, k, x),
             Shape::Other => false,
         }
     }
@@ -740,6 +755,13 @@ impl<'a> OneSpan<'a> {
     /// nothing).
     #[inline(always)]
     fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        // In the box (which the span holds): most states of an interval box's span, and the
+        // states at t = 0 of an interval analysis, whose span there is the initial box with
+        // radius 0.
+        let (lo, hi, _) = self.diag_bounds(k);
+        if (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
+            return true;
+        }
         let (q, a) = self.quad_to_box(metric, k, x);
         if self.nonneg {
             q < self.q_in[k]
@@ -752,12 +774,6 @@ impl<'a> OneSpan<'a> {
     /// answer): the shortcuts, then that test.
     fn decide(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
         if self.inside_by_shortcut(metric, k, x) {
-            return true;
-        }
-        // In the box (which the span holds): the states at t = 0 of an interval analysis,
-        // whose span there is the initial box with radius 0.
-        let (lo, hi, _) = self.diag_bounds(k);
-        if (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
             return true;
         }
         let clearly_out = if self.nonneg {
