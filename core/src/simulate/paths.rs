@@ -263,6 +263,8 @@ struct Step<'a> {
     report: Option<Report<'a>>,
     /// The block's number of paths.
     lanes: usize,
+    /// The first path the scalar loops step (those before ran in vector lanes).
+    first: usize,
 }
 
 impl<S: System + ?Sized> Plan<'_, S> {
@@ -367,6 +369,18 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 unsafe { self.additive_x8(dim, x, paths, quiet, thresholds, st) };
             }
         }
+        // Other models with constant noise: eight paths at a time in `constant_x8`.
+        #[cfg(target_arch = "x86_64")]
+        if start == 0 && self.avx512 && self.lanes_take_constant(n) {
+            start = lanes / 8 * 8;
+            let groups =
+                l.x.chunks_exact_mut(8 * nn)
+                    .zip(l.paths.chunks_exact_mut(8));
+            for (x, paths) in groups.take(lanes / 8) {
+                // SAFETY: `avx512` says the processor has the extensions.
+                unsafe { self.constant_x8(dim, x, paths, l.quiet.as_deref(), thresholds, st) };
+            }
+        }
         // The paths the lanes did not take, if any.
         let spans = if start < lanes { &self.spans[..] } else { &[] };
         for (k, span) in (1..).zip(spans) {
@@ -395,6 +409,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     span,
                     report,
                     lanes,
+                    first: start,
                 };
                 let (x, paths) = (&mut l.x[start * nn..], &mut l.paths[start..lanes]);
                 let tube = self.tube.is_some();
@@ -423,6 +438,17 @@ impl<S: System + ?Sized> Plan<'_, S> {
             st.left_domain += u64::from(path.left_domain);
             st.diverged += u64::from(!path.alive);
         }
+    }
+
+    /// Whether [`constant_x8`](Self::constant_x8) takes a model with `n` states: constant
+    /// noise, no inputs, unsafe sets or domain, at most [`SMALL`] states and channels.
+    fn lanes_take_constant(&self, n: usize) -> bool {
+        n <= SMALL
+            && self.sys.m() <= SMALL
+            && self.sys.p() == 0
+            && self.unsafe_sets.is_empty()
+            && self.domain.is_none()
+            && self.noise.is_constant()
     }
 
     /// One Euler-Maruyama step of the block's paths, then (at a report time) their records. A
@@ -457,7 +483,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
             l.x.chunks_exact_mut(n.max(1))
                 .zip(&mut l.paths)
                 .take(step.lanes)
-                .enumerate();
+                .enumerate()
+                .skip(step.first);
         for (a, (x, path)) in lane_data {
             if !path.alive {
                 if let Some(rep) = step.report {
@@ -492,24 +519,42 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 self.check_sets(step.t_end, x, hit, &mut path.left_domain, st);
             }
             self.check_tube(step.k, x, path, st);
-            let Some(rep) = step.report else { continue };
-            let (q, a) = if n <= SMALL {
-                quad_small(&upper, x, rep.c)
-            } else {
-                metric.quad(x, rep.c)
-            };
-            // Most states are inside the PRS by a shortcut and not quantile candidates.
-            let quiet = match rep.quiet {
-                Some(b) => q < b,
-                None => {
-                    shortcuts
-                        && q < rep.thr
-                        && self.membership.inside_by_shortcut(metric, rep.k, x, q, a)
-                }
-            };
-            if !quiet {
-                self.record(rep.k, x, (q, a), rep.thr, st, path);
+            if let Some(rep) = &step.report {
+                self.report(rep, &upper, shortcuts, x, path, st);
             }
+        }
+    }
+
+    /// The record of `path`'s state `x` at the report step `rep`, unless a shortcut finds it
+    /// quiet (inside the PRS and not a quantile candidate). `upper` is [`Metric::upper`],
+    /// `shortcuts` [`Membership::has_shortcuts`].
+    #[inline(always)]
+    fn report(
+        &self,
+        rep: &Report<'_>,
+        upper: &[f64; SMALL * SMALL],
+        shortcuts: bool,
+        x: &[f64],
+        path: &mut Path,
+        st: &mut ChunkStats,
+    ) {
+        let metric = &self.metric;
+        let (q, a) = if x.len() <= SMALL {
+            quad_small(upper, x, rep.c)
+        } else {
+            metric.quad(x, rep.c)
+        };
+        // Most states are inside the PRS by a shortcut and not quantile candidates.
+        let quiet = match rep.quiet {
+            Some(b) => q < b,
+            None => {
+                shortcuts
+                    && q < rep.thr
+                    && self.membership.inside_by_shortcut(metric, rep.k, x, q, a)
+            }
+        };
+        if !quiet {
+            self.record(rep.k, x, (q, a), rep.thr, st, path);
         }
     }
 
@@ -666,6 +711,74 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 }
                 if path.left_tube {
                     pending &= !(1 << a);
+                }
+            }
+        }
+    }
+
+    /// [`step_lanes`](Self::step_lanes) for eight paths (`paths`, states `x`) of a model with
+    /// constant noise (any structure), no inputs, no unsafe sets or domain and at most
+    /// [`SMALL`] states and channels, through every span: the normals, the drift (by
+    /// [`System::drift_x8`]) and the update in the lanes of AVX-512 registers, with the same
+    /// draws and IEEE operations per lane as `step_lanes`, so the same states; each state then
+    /// goes through the same scalar tube check and record as there. `quiet` is
+    /// [`Lanes::quiet`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn constant_x8<D: Dim>(
+        &self,
+        dim: D,
+        x: &mut [f64],
+        paths: &mut [Path],
+        quiet: Option<&[f64]>,
+        thresholds: &[f64],
+        st: &mut ChunkStats,
+    ) {
+        use crate::lanes::X8;
+        let (n, m) = (dim.get(), self.sys.m());
+        let mut live = 0u8;
+        for (a, path) in paths.iter().enumerate() {
+            live |= u8::from(path.alive) << a;
+        }
+        let (shortcuts, upper) = (self.membership.has_shortcuts(), self.metric.upper());
+        let mut group = super::avx512::Group8::new(n, x, std::array::from_fn(|a| paths[a].rng));
+        let (mut f, mut z) = ([X8::splat(0.0); SMALL], [X8::splat(0.0); SMALL]);
+        for (k, span) in (1..).zip(&self.spans) {
+            for i in 0..span.steps {
+                let t = span.t0 + f64::from(i) * span.h;
+                // A path draws its m normals in channel order (the drift draws nothing).
+                for zj in &mut z[..m] {
+                    *zj = group.normal(self.zig, live);
+                }
+                let mut xs = group.states();
+                self.sys.drift_x8(&xs[..n], t, &mut f[..n]);
+                self.noise
+                    .apply_x8(&mut xs[..n], &f[..n], span.h, span.sqrt_h, &mut z[..m]);
+                group.set_states(&xs);
+                let report = (i + 1 == span.steps).then(|| Report {
+                    k,
+                    c: &self.nominal[k * n..][..n],
+                    thr: thresholds[k],
+                    quiet: quiet.map(|q| q[k]),
+                });
+                if self.tube.is_none() && report.is_none() {
+                    continue;
+                }
+                for (a, path) in paths.iter_mut().enumerate() {
+                    if !path.alive {
+                        if report.is_some() {
+                            st.ended(k);
+                        }
+                        continue;
+                    }
+                    let xa: [f64; SMALL] = std::array::from_fn(|j| xs[j].0[a]);
+                    self.check_tube(k, &xa[..n], path, st);
+                    if let Some(rep) = &report {
+                        self.report(rep, &upper, shortcuts, &xa[..n], path, st);
+                        if !path.alive {
+                            live &= !(1 << a);
+                        }
+                    }
                 }
             }
         }
