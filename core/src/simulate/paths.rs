@@ -934,3 +934,159 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{make_plan, Options};
+    use super::*;
+    use crate::engine;
+    use crate::interval::Interval;
+    use crate::model::*;
+
+    /// The pendulum of specs/pendulum.sde: one noise channel on the second state (constant
+    /// `G` that is not diagonal), a drift with `sin`.
+    struct Pendulum;
+
+    impl System for Pendulum {
+        fn n(&self) -> usize {
+            2
+        }
+        fn p(&self) -> usize {
+            0
+        }
+        fn m(&self) -> usize {
+            1
+        }
+        fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+            out[0] = x[1];
+            out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
+        }
+        fn drift_interval(
+            &self,
+            x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            o: &mut [Interval],
+        ) {
+            let p = Interval::point;
+            o[0] = x[1];
+            o[1] = p(10.0) * x[0].sin() - p(20.0) * x[0] - p(20.0) * x[1];
+        }
+        fn jac_x(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+            out.copy_from_slice(&[0.0, 1.0, 10.0 * x[0].cos() - 20.0, -20.0]);
+        }
+        fn jac_x_interval(
+            &self,
+            x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            o: &mut [Interval],
+        ) {
+            let p = Interval::point;
+            o.copy_from_slice(&[p(0.0), p(1.0), p(10.0) * x[0].cos() - p(20.0), p(-20.0)]);
+        }
+        fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
+        fn jac_u_interval(
+            &self,
+            _x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            _o: &mut [Interval],
+        ) {
+        }
+        fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
+            out.copy_from_slice(&[0.0, 0.1]);
+        }
+        fn diffusion_interval(&self, _x: &[Interval], _t: Interval, o: &mut [Interval]) {
+            o.copy_from_slice(&[Interval::ZERO, Interval::point(0.1)]);
+        }
+    }
+
+    /// The pendulum's model; its analysis `method` with the paper's (full) metric.
+    fn pendulum(method: Method) -> ModelInfo {
+        let a = std::f64::consts::PI / 10.0;
+        let mut info = ModelInfo {
+            name: "pendulum".into(),
+            states: vec!["theta".into(), "omega".into()],
+            inputs: vec![],
+            noises: vec!["w".into()],
+            input_box: vec![],
+            initial: InitialSet {
+                boxes: vec![Some(Bounds::new(-a, a)), Some(Bounds::new(-0.2, 0.2))],
+                balls: vec![],
+            },
+            domain: vec![Bounds::ENTIRE; 2],
+            has_domain: false,
+            affine: false,
+            unsafe_sets: vec![],
+            analyses: vec![],
+        };
+        let constants = Constants::given(&info, vec![35.68, 2.21, 2.21, 1.27], -0.5, 0.12, 0.0);
+        info.analyses.push(Analysis {
+            spec: AnalysisSpec {
+                name: "a".into(),
+                method,
+                delta: 1e-3,
+                horizon: 1.0,
+                step: 0.02,
+                ..AnalysisSpec::default()
+            },
+            constants: Ok(constants),
+        });
+        info
+    }
+
+    /// Eight paths in lanes (`constant_x8`; 203 paths, the last three in the scalar loops) against the scalar loops, path by path: a constant
+    /// `G` that is not diagonal, a full metric, the contraction method's intersection with its
+    /// interval box (time-uniform: the tube at every step; and pointwise) and the interval
+    /// method's box, with and without quantile candidates, and with sets narrowed so that
+    /// paths leave them. The records, counts and tube exits are the same.
+    #[test]
+    fn lanes_with_constant_noise_do_not_change_the_paths() {
+        if !super::super::avx512::available() {
+            eprintln!("no AVX-512: nothing to compare");
+            return;
+        }
+        let sorted = |mut s: ChunkStats| {
+            // The lanes record a group's steps in turn, the scalar loops a step's paths.
+            s.candidates
+                .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+            s
+        };
+        let mut outside = 0;
+        for method in [Method::Contraction, Method::Interval] {
+            for guarantee in [Guarantee::Uniform, Guarantee::Pointwise] {
+                let info = pendulum(method);
+                let mut r = engine::run(&Pendulum, &info, &info.analyses[0]).unwrap();
+                r.guarantee = guarantee;
+                if method == Method::Contraction {
+                    assert!(!r.also.is_empty(), "an intersection");
+                }
+                for narrow in [false, true] {
+                    if narrow {
+                        // Radii and spans at a third: some paths leave the sets.
+                        for st in &mut r.steps {
+                            st.prs_radius /= 3.0;
+                            st.span.radius /= 3.0;
+                        }
+                    }
+                    let opts = Options::default();
+                    let mut plan = make_plan(&Pendulum, &info, &r, &opts).unwrap();
+                    assert!(plan.lanes_take_constant(2) && plan.noise.diagonal().is_none());
+                    for threshold in [f64::NEG_INFINITY, 0.5] {
+                        let thresholds = vec![threshold; plan.times.len()];
+                        plan.avx512 = true;
+                        let lanes = sorted(plan.run_chunk(0..203, &thresholds));
+                        plan.avx512 = false;
+                        let scalar = sorted(plan.run_chunk(0..203, &thresholds));
+                        let case = format!("{method:?} {guarantee:?} narrow {narrow} {threshold}");
+                        assert_eq!(lanes, scalar, "{case}");
+                        outside += scalar.outside_any + scalar.outside_tube;
+                    }
+                }
+            }
+        }
+        // Not vacuous: the narrowed sets are left.
+        assert!(outside > 100, "{outside}");
+    }
+}
