@@ -6,12 +6,14 @@
 //! [`super::rng`]); the statistics are counts, minima and candidate lists, whose merge does not
 //! depend on the order, so the results are the same for any thread count.
 //!
-//! Three loops run the steps: `additive_lanes` for the common case (constant diagonal noise,
+//! Four loops run the steps: `additive_lanes` for the common case (constant diagonal noise,
 //! no inputs, no unsafe sets or domain, a small model with a non-negative diagonal metric),
 //! with every per-step constant in a register; `additive_x8`, the same eight paths at a time
-//! in AVX-512 lanes where the processor has them; and `step_lanes` for everything else. All
-//! compute the same operations in the same order as [`sample_paths`](super::sample_paths), so
-//! the paths are the same whichever loop runs them.
+//! in AVX-512 lanes where the processor has them; `constant_x8`, eight paths in lanes for the
+//! other small models with constant noise and no inputs, unsafe sets or domain (the states in
+//! lanes, their checks and records in the scalar code); and `step_lanes` for everything else.
+//! All compute the same operations in the same order as [`sample_paths`](super::sample_paths),
+//! so the paths are the same whichever loop runs them.
 //!
 //! For a time-uniform result every loop also checks each path's state after every Euler step
 //! of report interval `k` against the tube over that interval ([`Tube`], the span `k` of the
@@ -1036,11 +1038,12 @@ mod tests {
         info
     }
 
-    /// Eight paths in lanes (`constant_x8`; 203 paths, the last three in the scalar loops) against the scalar loops, path by path: a constant
-    /// `G` that is not diagonal, a full metric, the contraction method's intersection with its
-    /// interval box (time-uniform: the tube at every step; and pointwise) and the interval
-    /// method's box, with and without quantile candidates, and with sets narrowed so that
-    /// paths leave them. The records, counts and tube exits are the same.
+    /// Eight paths in lanes (`constant_x8`; of 203 paths, the last three in the scalar loops)
+    /// against the scalar loops, path by path: a constant `G` that is not diagonal, a full
+    /// metric, the contraction method's intersection with its interval box (time-uniform: the
+    /// tube at every step; and pointwise) and the interval method's box, with and without
+    /// quantile candidates, and with sets narrowed so that paths leave them. The records,
+    /// counts and tube exits are the same.
     #[test]
     fn lanes_with_constant_noise_do_not_change_the_paths() {
         if !super::super::avx512::available() {

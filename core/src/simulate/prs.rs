@@ -30,6 +30,9 @@
 //!   upper bound of the box's P-radius around `c` (the span lies in the ball `B_P(c, radius +
 //!   b)`).
 //!
+//! The PRS of an intersection (several metrics' sets, `Prs::also`) is decided set by set,
+//! each with its own metric's shortcuts, and so is its tube.
+//!
 //! A non-finite state is outside, a state in the box inside (the span at `t = 0` of an interval
 //! analysis has radius 0); everything else goes to `span_contains`. Every shortcut is
 //! sound on its own (an "inside" is proved by a point of the box), so a state is never counted
