@@ -293,16 +293,8 @@ pub(crate) struct Membership<'a> {
 impl<'a> Membership<'a> {
     /// For `result` (its steps), with `metric` built from its metric.
     pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Self {
-        let n = result.states.len();
-        let also = result
-            .also
-            .iter()
-            .map(|m| {
-                let metric = Metric::new(&m.constants.metric, n);
-                let set = OneSet::new(m, &metric);
-                (metric, set)
-            })
-            .collect();
+        let also = members(result, |m, metric| Ok(OneSet::new(m, metric)))
+            .expect("building a member's set never fails");
         Membership {
             own: OneSet::new(result, metric),
             also,
@@ -367,6 +359,24 @@ impl<'a> Membership<'a> {
                 s.inside(m, k, x, c, q, a)
             })
     }
+}
+
+/// The members of `result`'s intersection (`result.also`), each with its metric and what
+/// `make` builds of it and that metric.
+fn members<'a, T>(
+    result: &'a Prs,
+    make: impl Fn(&'a Prs, &Metric) -> Result<T, String>,
+) -> Result<Vec<(Metric, T)>, String> {
+    let n = result.states.len();
+    result
+        .also
+        .iter()
+        .map(|m| {
+            let metric = Metric::new(&m.constants.metric, n);
+            let part = make(m, &metric)?;
+            Ok((metric, part))
+        })
+        .collect()
 }
 
 /// Decides membership in one metric's set at each report step (a result's own set, or one
@@ -583,16 +593,7 @@ impl<'a> Tube<'a> {
     /// The tube of `result`'s spans, with `metric` built from its metric; `Err` when a span is
     /// malformed (a corner of the wrong length, NaN, `lo > hi`, a negative or NaN radius).
     pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Result<Tube<'a>, String> {
-        let n = result.states.len();
-        let also = result
-            .also
-            .iter()
-            .map(|m| {
-                let metric = Metric::new(&m.constants.metric, n);
-                let span = OneSpan::new(m, &metric)?;
-                Ok((metric, span))
-            })
-            .collect::<Result<_, String>>()?;
+        let also = members(result, OneSpan::new)?;
         Ok(Tube {
             own: OneSpan::new(result, metric)?,
             also,
