@@ -522,30 +522,30 @@ impl<S: System + ?Sized> Plan<'_, S> {
             }
             self.check_tube(step.k, x, path, st);
             if let Some(rep) = &step.report {
-                self.report(rep, &upper, shortcuts, x, path, st);
+                let qa = if n <= SMALL {
+                    quad_small(&upper, x, rep.c)
+                } else {
+                    metric.quad(x, rep.c)
+                };
+                self.report(rep, qa, shortcuts, x, path, st);
             }
         }
     }
 
-    /// The record of `path`'s state `x` at the report step `rep`, unless a shortcut finds it
-    /// quiet (inside the PRS and not a quantile candidate). `upper` is [`Metric::upper`],
-    /// `shortcuts` [`Membership::has_shortcuts`].
+    /// The record of `path`'s state `x` at the report step `rep`, given `(q, a) =
+    /// metric.quad(x, x*_k)`, unless a shortcut finds it quiet (inside the PRS and not a
+    /// quantile candidate). `shortcuts` is [`Membership::has_shortcuts`].
     #[inline(always)]
     fn report(
         &self,
         rep: &Report<'_>,
-        upper: &[f64; SMALL * SMALL],
+        (q, a): (f64, f64),
         shortcuts: bool,
         x: &[f64],
         path: &mut Path,
         st: &mut ChunkStats,
     ) {
         let metric = &self.metric;
-        let (q, a) = if x.len() <= SMALL {
-            quad_small(upper, x, rep.c)
-        } else {
-            metric.quad(x, rep.c)
-        };
         // Most states are inside the PRS by a shortcut and not quantile candidates.
         let quiet = match rep.quiet {
             Some(b) => q < b,
@@ -763,9 +763,16 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     thr: thresholds[k],
                     quiet: quiet.map(|q| q[k]),
                 });
-                if self.tube.is_none() && report.is_none() {
-                    continue;
-                }
+                // The tube's shortcut and the distances in the lanes; the rest per lane.
+                let inside = match &self.tube {
+                    Some(tube) => tube.inside_by_shortcut_x8(&self.metric, k, &xs[..n]),
+                    None => 0xff,
+                };
+                let (q, qa) = match &report {
+                    Some(rep) => quad_small(&upper, &xs[..n], rep.c),
+                    None if inside == 0xff => continue,
+                    None => (X8::splat(0.0), X8::splat(0.0)),
+                };
                 for (a, path) in paths.iter_mut().enumerate() {
                     if !path.alive {
                         if report.is_some() {
@@ -773,10 +780,16 @@ impl<S: System + ?Sized> Plan<'_, S> {
                         }
                         continue;
                     }
+                    if report.is_none() && inside >> a & 1 == 1 {
+                        continue;
+                    }
                     let xa: [f64; SMALL] = std::array::from_fn(|j| xs[j].0[a]);
-                    self.check_tube(k, &xa[..n], path, st);
+                    if inside >> a & 1 == 0 && !path.left_tube {
+                        self.tube_slow(k, &xa[..n], path, st);
+                    }
                     if let Some(rep) = &report {
-                        self.report(rep, &upper, shortcuts, &xa[..n], path, st);
+                        let qa = (q.0[a], qa.0[a]);
+                        self.report(rep, qa, shortcuts, &xa[..n], path, st);
                         if !path.alive {
                             live &= !(1 << a);
                         }

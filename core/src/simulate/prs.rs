@@ -40,6 +40,7 @@
 
 use super::paths::SMALL;
 use crate::interval::Interval;
+use crate::lanes::{Real, X8};
 use crate::prs::{DetSet, Prs};
 
 /// The quadratic form `d' P d` as a list of terms.
@@ -128,23 +129,24 @@ impl Metric {
 
     /// [`quad`](Self::quad) of the difference `d(i)` (`d(i) = x_i - c_i` gives `quad(x, c)`),
     /// the terms in the same order.
+    /// Generic over [`Real`]: one path's `f64` or eight paths' lanes, the same operations.
     #[inline(always)]
-    fn quad_by(&self, d: impl Fn(usize) -> f64) -> (f64, f64) {
+    fn quad_by<T: Real>(&self, d: impl Fn(usize) -> T) -> (T, T) {
         if self.nonneg {
             let q = (0..self.diag.len())
                 .map(|i| {
                     let d = d(i);
-                    self.diag[i] * d * d
+                    T::from(self.diag[i]) * d * d
                 })
                 .reduce(|q, t| q + t)
-                .unwrap_or(0.0);
+                .unwrap_or(T::from(0.0));
             return (q, q);
         }
-        let (mut q, mut a) = (0.0, 0.0);
+        let (mut q, mut a) = (T::from(0.0), T::from(0.0));
         for &(i, j, w) in &self.terms {
-            let t = w * d(i) * d(j);
-            q += t;
-            a += t.abs();
+            let t = T::from(w) * d(i) * d(j);
+            q = q + t;
+            a = a + t.abs();
         }
         (q, a)
     }
@@ -198,18 +200,19 @@ pub(crate) fn diag_quad(w: &[f64], x: &[f64], c: &[f64]) -> f64 {
 /// [`Metric::quad`] for at most [`SMALL`] states (`x.len()`), with `w` from [`Metric::upper`]:
 /// the same terms in the same order, plus the zero ones, which add `+-0` to finite sums (and
 /// cannot make a non-finite sum finite), so `(q, a)` is `quad`'s to the bit when finite and
-/// non-finite when it is. Fixed-size weights let a small model's loops unroll.
+/// non-finite when it is. Fixed-size weights let a small model's loops unroll. Generic over
+/// [`Real`]: one path's `f64` or eight paths' lanes, the same operations.
 #[inline(always)]
-pub(crate) fn quad_small(w: &[f64; SMALL * SMALL], x: &[f64], c: &[f64]) -> (f64, f64) {
+pub(crate) fn quad_small<T: Real>(w: &[f64; SMALL * SMALL], x: &[T], c: &[f64]) -> (T, T) {
     let n = x.len().min(SMALL);
     let (x, c) = (&x[..n], &c[..n]);
-    let (mut q, mut a) = (0.0, 0.0);
+    let (mut q, mut a) = (T::from(0.0), T::from(0.0));
     for i in 0..n {
-        let di = x[i] - c[i];
+        let di = x[i] - T::from(c[i]);
         for j in i..n {
-            let t = w[i * SMALL + j] * di * (x[j] - c[j]);
-            q += t;
-            a += t.abs();
+            let t = T::from(w[i * SMALL + j]) * di * (x[j] - T::from(c[j]));
+            q = q + t;
+            a = a + t.abs();
         }
     }
     (q, a)
@@ -632,6 +635,17 @@ impl<'a> Tube<'a> {
         self.inside_by_shortcut(metric, k, x) || self.inside_slow(metric, k, x)
     }
 
+    /// [`inside_by_shortcut`](Self::inside_by_shortcut) of eight states in lanes (state `i` of
+    /// path `l` in lane `l` of `x[i]`): bit `l` set when lane `l` is inside by the shortcuts,
+    /// the same answer as for that state alone.
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
+        self.also.iter().fold(
+            self.own.inside_by_shortcut_x8(metric, k, x),
+            |mask, (m, s)| mask & s.inside_by_shortcut_x8(m, k, x),
+        )
+    }
+
     /// [`inside`](Self::inside) for a state the shortcut did not find inside (the same answer
     /// then): [`Prs::span_contains`]'s, member by member, each decided by its own shortcuts
     /// where they hold.
@@ -748,25 +762,49 @@ impl<'a> OneSpan<'a> {
         (&self.lo[k * n..][..n], &self.hi[k * n..][..n], self.q_in[k])
     }
 
-    /// `(q, a)` of [`Metric::quad`] for `x` and its clamp into the box of step `k`.
+    /// `(q, a)` of [`Metric::quad`] for `x` and its clamp into the box of step `k` (one path,
+    /// or eight in lanes).
     #[inline(always)]
-    fn quad_to_box(&self, metric: &Metric, k: usize, x: &[f64]) -> (f64, f64) {
+    fn quad_to_box<T: Real>(&self, metric: &Metric, k: usize, x: &[T]) -> (T, T) {
         let (lo, hi, _) = self.diag_bounds(k);
-        metric.quad_by(|i| x[i] - clamp(x[i], lo[i], hi[i]))
+        metric.quad_by(|i| x[i] - x[i].clamp_with(|v| clamp(v, lo[i], hi[i])))
     }
 
     /// Whether `x` is, by the "inside" shortcut alone, in the span of step `k` (`false` says
     /// nothing).
     #[inline(always)]
     fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
-        // In the box (which the span holds): most states of an interval box's span, and the
-        // states at t = 0 of an interval analysis, whose span there is the initial box with
-        // radius 0.
-        let (lo, hi, _) = self.diag_bounds(k);
-        if (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
-            return true;
+        self.in_box(k, x, |x| x) || {
+            let (q, a) = self.quad_to_box(metric, k, x);
+            self.close(metric, k, q, a)
         }
+    }
+
+    /// [`inside_by_shortcut`](Self::inside_by_shortcut) of eight states in lanes (state `i` of
+    /// lane `l` in lane `l` of `x[i]`): bit `l` set when lane `l` is inside, the same answer
+    /// as for that state alone.
+    #[inline(always)]
+    fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
         let (q, a) = self.quad_to_box(metric, k, x);
+        (0..8).fold(0, |mask, l| {
+            let inside = self.in_box(k, x, |x| x.0[l]) || self.close(metric, k, q.0[l], a.0[l]);
+            mask | u8::from(inside) << l
+        })
+    }
+
+    /// Whether the state `(at(x[i]))_i` is in the box of step `k` (which the span holds): most
+    /// states of an interval box's span, and the states at t = 0 of an interval analysis, whose
+    /// span there is the initial box with radius 0.
+    #[inline(always)]
+    fn in_box<T: Copy>(&self, k: usize, x: &[T], at: impl Fn(T) -> f64) -> bool {
+        let (lo, hi, _) = self.diag_bounds(k);
+        (0..self.n).all(|i| lo[i] <= at(x[i]) && at(x[i]) <= hi[i])
+    }
+
+    /// Whether `(q, a)` of [`quad_to_box`](Self::quad_to_box) clearly puts the state in the
+    /// span of step `k`.
+    #[inline(always)]
+    fn close(&self, metric: &Metric, k: usize, q: f64, a: f64) -> bool {
         if self.nonneg {
             q < self.q_in[k]
         } else {
