@@ -332,11 +332,16 @@ impl<'a> Membership<'a> {
         q: f64,
         a: f64,
     ) -> bool {
-        self.own.inside_by_shortcut(metric, k, x, q, a)
-            && self
-                .also
-                .iter()
-                .all(|(m, s)| s.inside_by_shortcut_with(m, k, x, || m.quad(x, s.centre(k))))
+        if !self.own.inside_by_shortcut(metric, k, x, q, a) {
+            return false;
+        }
+        // A loop rather than `all`, which might not be inlined into the hot loops.
+        for (m, s) in &self.also {
+            if !s.inside_by_shortcut_with(m, k, x, || m.quad(x, s.centre(k))) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Whether the finite state `x` is in the PRS of step `k`, given the centre `c = x*_k` and
@@ -536,9 +541,13 @@ impl<'a> OneSet<'a> {
     #[inline(always)]
     fn in_box(&self, lo: &[f64], hi: &[f64], k: usize, x: &[f64]) -> bool {
         let (lo, hi) = (&lo[k * self.n..][..self.n], &hi[k * self.n..][..self.n]);
-        x.iter()
-            .zip(lo.iter().zip(hi))
-            .all(|(v, (l, h))| l <= v && v <= h)
+        // A loop rather than `all`, which might not be inlined into the hot loops.
+        for ((v, l), h) in x.iter().zip(lo).zip(hi) {
+            if !(l <= v && v <= h) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Whether `x` is in the PRS of step `k`, given the centre `c = x*_k` and
@@ -640,10 +649,11 @@ impl<'a> Tube<'a> {
     /// the same answer as for that state alone.
     #[inline(always)]
     pub(crate) fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
-        self.also.iter().fold(
-            self.own.inside_by_shortcut_x8(metric, k, x),
-            |mask, (m, s)| mask & s.inside_by_shortcut_x8(m, k, x),
-        )
+        let mut mask = self.own.inside_by_shortcut_x8(metric, k, x);
+        for (m, s) in &self.also {
+            mask &= s.inside_by_shortcut_x8(m, k, x);
+        }
+        mask
     }
 
     /// [`inside`](Self::inside) for a state the shortcut did not find inside (the same answer
@@ -786,10 +796,14 @@ impl<'a> OneSpan<'a> {
     #[inline(always)]
     fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
         let (q, a) = self.quad_to_box(metric, k, x);
-        (0..8).fold(0, |mask, l| {
+        // Loops rather than iterator adapters, which might not be inlined into the vector
+        // loop (and would then work on the lanes one by one).
+        let mut mask = 0;
+        for l in 0..8 {
             let inside = self.in_box(k, x, |x| x.0[l]) || self.close(metric, k, q.0[l], a.0[l]);
-            mask | u8::from(inside) << l
-        })
+            mask |= u8::from(inside) << l;
+        }
+        mask
     }
 
     /// Whether the state `(at(x[i]))_i` is in the box of step `k` (which the span holds): most
@@ -798,7 +812,12 @@ impl<'a> OneSpan<'a> {
     #[inline(always)]
     fn in_box<T: Copy>(&self, k: usize, x: &[T], at: impl Fn(T) -> f64) -> bool {
         let (lo, hi, _) = self.diag_bounds(k);
-        (0..self.n).all(|i| lo[i] <= at(x[i]) && at(x[i]) <= hi[i])
+        for i in 0..self.n {
+            if !(lo[i] <= at(x[i]) && at(x[i]) <= hi[i]) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Whether `(q, a)` of [`quad_to_box`](Self::quad_to_box) clearly puts the state in the
