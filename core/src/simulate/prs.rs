@@ -523,18 +523,20 @@ impl<'a> OneSet<'a> {
         let n = self.n;
         let (lo, hi, x) = (&lo[k * n..][..n], &hi[k * n..][..n], &x[..n]);
         let rel = 16.0 * (n as f64 + 2.0) * f64::EPSILON;
-        t.chunks_exact(n)
-            .zip(lo.iter().zip(hi))
-            .all(|(row, (&a, &b))| {
-                let (mut y, mut s) = (0.0, 0.0);
-                for (tij, xj) in row.iter().zip(x) {
-                    let p = tij * xj;
-                    y += p;
-                    s += p.abs();
-                }
-                let margin = rel * s + f64::MIN_POSITIVE;
-                a <= y - margin && y + margin <= b
-            })
+        // Loops rather than `all`, which might not be inlined into the hot loops.
+        for ((row, &a), &b) in t.chunks_exact(n).zip(lo).zip(hi) {
+            let (mut y, mut s) = (0.0, 0.0);
+            for (tij, xj) in row.iter().zip(x) {
+                let p = tij * xj;
+                y += p;
+                s += p.abs();
+            }
+            let margin = rel * s + f64::MIN_POSITIVE;
+            if !(a <= y - margin && y + margin <= b) {
+                return false;
+            }
+        }
+        true
     }
 
     /// `x` in the box `[lo, hi]` of step `k`.
