@@ -33,6 +33,39 @@ impl X8 {
     }
 }
 
+/// The arithmetic `f64` and [`X8`] share, for code written once for one path and for eight
+/// (the same IEEE operations in the same order per lane).
+pub trait Real:
+    Copy + From<f64> + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+{
+    /// The absolute value (per lane).
+    fn abs(self) -> Self;
+    /// `v` moved into `[lo, hi]` by `clamp` (per lane).
+    fn clamp_with(self, clamp: impl Fn(f64) -> f64) -> Self;
+}
+
+impl Real for f64 {
+    #[inline(always)]
+    fn abs(self) -> f64 {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn clamp_with(self, clamp: impl Fn(f64) -> f64) -> f64 {
+        clamp(self)
+    }
+}
+
+impl Real for X8 {
+    #[inline(always)]
+    fn abs(self) -> X8 {
+        X8::abs(self)
+    }
+    #[inline(always)]
+    fn clamp_with(self, clamp: impl Fn(f64) -> f64) -> X8 {
+        self.map(clamp)
+    }
+}
+
 impl From<f64> for X8 {
     #[inline(always)]
     fn from(v: f64) -> X8 {

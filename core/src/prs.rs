@@ -601,7 +601,7 @@ impl Prs {
     }
 
     /// [`Prs::span_contains`] for this result's own metric.
-    fn own_span_contains(&self, k: usize, x: &[f64]) -> bool {
+    pub(crate) fn own_span_contains(&self, k: usize, x: &[f64]) -> bool {
         let span = &self.steps[k].span;
         assert_eq!(
             x.len(),
@@ -632,7 +632,7 @@ impl Prs {
     }
 
     /// [`Prs::contains_at`] for this result's own metric.
-    fn own_contains_at(&self, k: usize, x: &[f64]) -> bool {
+    pub(crate) fn own_contains_at(&self, k: usize, x: &[f64]) -> bool {
         let st = &self.steps[k];
         let n = self.n();
         assert_eq!(x.len(), n, "contains: x has the wrong dimension");

@@ -420,10 +420,15 @@ fn rows(m: &[f64], n: usize) -> Vec<Vec<f64>> {
 /// A point of the box `[lo, hi]` near the minimiser of `(y - x)' P (y - x)` (projected
 /// coordinate descent; the problem is convex, and any point of the box is a valid candidate, so
 /// a few sweeps suffice).
+///
+/// A sweep is a function of `y`'s bits alone: once one leaves them all unchanged, so would the
+/// rest of the 50, and the loop stops there with the same point (the Monte Carlo check calls
+/// this for every sample state near a set's boundary, most of which converge in a few sweeps).
 fn nearest_in_box(p: &[Vec<f64>], x: &[f64], lo: &[f64], hi: &[f64]) -> Vec<f64> {
     let n = x.len();
     let mut y: Vec<f64> = (0..n).map(|i| x[i].clamp(lo[i], hi[i])).collect();
     for _ in 0..50 {
+        let mut moved = false;
         for i in 0..n {
             if p[i][i] <= 0.0 {
                 continue;
@@ -434,8 +439,13 @@ fn nearest_in_box(p: &[Vec<f64>], x: &[f64], lo: &[f64], hi: &[f64]) -> Vec<f64>
                 .sum();
             let yi = x[i] - s / p[i][i];
             if yi.is_finite() {
-                y[i] = yi.clamp(lo[i], hi[i]);
+                let yi = yi.clamp(lo[i], hi[i]);
+                moved |= yi.to_bits() != y[i].to_bits();
+                y[i] = yi;
             }
+        }
+        if !moved {
+            break;
         }
     }
     y

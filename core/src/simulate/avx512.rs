@@ -147,6 +147,21 @@ impl Group8 {
         unsafe { std::mem::transmute(self.x) }
     }
 
+    /// Replaces the states (after [`Noise::apply_x8`](super::noise::Noise::apply_x8)).
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    pub(crate) fn set_states(&mut self, x: &[X8; SMALL]) {
+        // SAFETY: as in `to_pd`, per vector.
+        self.x = unsafe { std::mem::transmute::<[X8; SMALL], [__m512d; SMALL]>(*x) };
+    }
+
+    /// One standard normal per lane from the lanes' streams ([`Rng8::normal`]).
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    pub(crate) fn normal(&mut self, zig: &Ziggurat, live: u8) -> X8 {
+        self.rng.normal(zig, live)
+    }
+
     /// Path `l`'s state (by permutes: indexing into memory would keep the states out of
     /// registers in the whole loop).
     #[inline]

@@ -6,12 +6,14 @@
 //! [`super::rng`]); the statistics are counts, minima and candidate lists, whose merge does not
 //! depend on the order, so the results are the same for any thread count.
 //!
-//! Three loops run the steps: `additive_lanes` for the common case (constant diagonal noise,
+//! Four loops run the steps: `additive_lanes` for the common case (constant diagonal noise,
 //! no inputs, no unsafe sets or domain, a small model with a non-negative diagonal metric),
 //! with every per-step constant in a register; `additive_x8`, the same eight paths at a time
-//! in AVX-512 lanes where the processor has them; and `step_lanes` for everything else. All
-//! compute the same operations in the same order as [`sample_paths`](super::sample_paths), so
-//! the paths are the same whichever loop runs them.
+//! in AVX-512 lanes where the processor has them; `constant_x8`, eight paths in lanes for the
+//! other small models with constant noise and no inputs, unsafe sets or domain (the states in
+//! lanes, their checks and records in the scalar code); and `step_lanes` for everything else.
+//! All compute the same operations in the same order as [`sample_paths`](super::sample_paths),
+//! so the paths are the same whichever loop runs them.
 //!
 //! For a time-uniform result every loop also checks each path's state after every Euler step
 //! of report interval `k` against the tube over that interval ([`Tube`], the span `k` of the
@@ -263,6 +265,8 @@ struct Step<'a> {
     report: Option<Report<'a>>,
     /// The block's number of paths.
     lanes: usize,
+    /// The first path the scalar loops step (those before ran in vector lanes).
+    first: usize,
 }
 
 impl<S: System + ?Sized> Plan<'_, S> {
@@ -367,6 +371,18 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 unsafe { self.additive_x8(dim, x, paths, quiet, thresholds, st) };
             }
         }
+        // Other models with constant noise: eight paths at a time in `constant_x8`.
+        #[cfg(target_arch = "x86_64")]
+        if start == 0 && self.avx512 && self.lanes_take_constant(n) {
+            start = lanes / 8 * 8;
+            let groups =
+                l.x.chunks_exact_mut(8 * nn)
+                    .zip(l.paths.chunks_exact_mut(8));
+            for (x, paths) in groups.take(lanes / 8) {
+                // SAFETY: `avx512` says the processor has the extensions.
+                unsafe { self.constant_x8(dim, x, paths, l.quiet.as_deref(), thresholds, st) };
+            }
+        }
         // The paths the lanes did not take, if any.
         let spans = if start < lanes { &self.spans[..] } else { &[] };
         for (k, span) in (1..).zip(spans) {
@@ -395,6 +411,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     span,
                     report,
                     lanes,
+                    first: start,
                 };
                 let (x, paths) = (&mut l.x[start * nn..], &mut l.paths[start..lanes]);
                 let tube = self.tube.is_some();
@@ -423,6 +440,17 @@ impl<S: System + ?Sized> Plan<'_, S> {
             st.left_domain += u64::from(path.left_domain);
             st.diverged += u64::from(!path.alive);
         }
+    }
+
+    /// Whether [`constant_x8`](Self::constant_x8) takes a model with `n` states: constant
+    /// noise, no inputs, unsafe sets or domain, at most [`SMALL`] states and channels.
+    fn lanes_take_constant(&self, n: usize) -> bool {
+        n <= SMALL
+            && self.sys.m() <= SMALL
+            && self.sys.p() == 0
+            && self.unsafe_sets.is_empty()
+            && self.domain.is_none()
+            && self.noise.is_constant()
     }
 
     /// One Euler-Maruyama step of the block's paths, then (at a report time) their records. A
@@ -457,7 +485,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
             l.x.chunks_exact_mut(n.max(1))
                 .zip(&mut l.paths)
                 .take(step.lanes)
-                .enumerate();
+                .enumerate()
+                .skip(step.first);
         for (a, (x, path)) in lane_data {
             if !path.alive {
                 if let Some(rep) = step.report {
@@ -492,24 +521,42 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 self.check_sets(step.t_end, x, hit, &mut path.left_domain, st);
             }
             self.check_tube(step.k, x, path, st);
-            let Some(rep) = step.report else { continue };
-            let (q, a) = if n <= SMALL {
-                quad_small(&upper, x, rep.c)
-            } else {
-                metric.quad(x, rep.c)
-            };
-            // Most states are inside the PRS by a shortcut and not quantile candidates.
-            let quiet = match rep.quiet {
-                Some(b) => q < b,
-                None => {
-                    shortcuts
-                        && q < rep.thr
-                        && self.membership.inside_by_shortcut(metric, rep.k, x, q, a)
-                }
-            };
-            if !quiet {
-                self.record(rep.k, x, (q, a), rep.thr, st, path);
+            if let Some(rep) = &step.report {
+                let qa = if n <= SMALL {
+                    quad_small(&upper, x, rep.c)
+                } else {
+                    metric.quad(x, rep.c)
+                };
+                self.report(rep, qa, shortcuts, x, path, st);
             }
+        }
+    }
+
+    /// The record of `path`'s state `x` at the report step `rep`, given `(q, a) =
+    /// metric.quad(x, x*_k)`, unless a shortcut finds it quiet (inside the PRS and not a
+    /// quantile candidate). `shortcuts` is [`Membership::has_shortcuts`].
+    #[inline(always)]
+    fn report(
+        &self,
+        rep: &Report<'_>,
+        (q, a): (f64, f64),
+        shortcuts: bool,
+        x: &[f64],
+        path: &mut Path,
+        st: &mut ChunkStats,
+    ) {
+        let metric = &self.metric;
+        // Most states are inside the PRS by a shortcut and not quantile candidates.
+        let quiet = match rep.quiet {
+            Some(b) => q < b,
+            None => {
+                shortcuts
+                    && q < rep.thr
+                    && self.membership.inside_by_shortcut(metric, rep.k, x, q, a)
+            }
+        };
+        if !quiet {
+            self.record(rep.k, x, (q, a), rep.thr, st, path);
         }
     }
 
@@ -671,6 +718,87 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
     }
 
+    /// [`step_lanes`](Self::step_lanes) for eight paths (`paths`, states `x`) of a model with
+    /// constant noise (any structure), no inputs, no unsafe sets or domain and at most
+    /// [`SMALL`] states and channels, through every span: the normals, the drift (by
+    /// [`System::drift_x8`]) and the update in the lanes of AVX-512 registers, with the same
+    /// draws and IEEE operations per lane as `step_lanes`, so the same states; each state then
+    /// goes through the same scalar tube check and record as there. `quiet` is
+    /// [`Lanes::quiet`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    fn constant_x8<D: Dim>(
+        &self,
+        dim: D,
+        x: &mut [f64],
+        paths: &mut [Path],
+        quiet: Option<&[f64]>,
+        thresholds: &[f64],
+        st: &mut ChunkStats,
+    ) {
+        use crate::lanes::X8;
+        let (n, m) = (dim.get(), self.sys.m());
+        let mut live = 0u8;
+        for (a, path) in paths.iter().enumerate() {
+            live |= u8::from(path.alive) << a;
+        }
+        let (shortcuts, upper) = (self.membership.has_shortcuts(), self.metric.upper());
+        let mut group = super::avx512::Group8::new(n, x, std::array::from_fn(|a| paths[a].rng));
+        let (mut f, mut z) = ([X8::splat(0.0); SMALL], [X8::splat(0.0); SMALL]);
+        for (k, span) in (1..).zip(&self.spans) {
+            for i in 0..span.steps {
+                let t = span.t0 + f64::from(i) * span.h;
+                // A path draws its m normals in channel order (the drift draws nothing).
+                for zj in &mut z[..m] {
+                    *zj = group.normal(self.zig, live);
+                }
+                let mut xs = group.states();
+                self.sys.drift_x8(&xs[..n], t, &mut f[..n]);
+                self.noise
+                    .apply_x8(&mut xs[..n], &f[..n], span.h, span.sqrt_h, &mut z[..m]);
+                group.set_states(&xs);
+                let report = (i + 1 == span.steps).then(|| Report {
+                    k,
+                    c: &self.nominal[k * n..][..n],
+                    thr: thresholds[k],
+                    quiet: quiet.map(|q| q[k]),
+                });
+                // The tube's shortcut and the distances in the lanes; the rest per lane.
+                let inside = match &self.tube {
+                    Some(tube) => tube.inside_by_shortcut_x8(&self.metric, k, &xs[..n]),
+                    None => 0xff,
+                };
+                let (q, qa) = match &report {
+                    Some(rep) => quad_small(&upper, &xs[..n], rep.c),
+                    None if inside == 0xff => continue,
+                    None => (X8::splat(0.0), X8::splat(0.0)),
+                };
+                for (a, path) in paths.iter_mut().enumerate() {
+                    if !path.alive {
+                        if report.is_some() {
+                            st.ended(k);
+                        }
+                        continue;
+                    }
+                    if report.is_none() && inside >> a & 1 == 1 {
+                        continue;
+                    }
+                    let xa: [f64; SMALL] = std::array::from_fn(|j| xs[j].0[a]);
+                    if inside >> a & 1 == 0 && !path.left_tube {
+                        self.tube_slow(k, &xa[..n], path, st);
+                    }
+                    if let Some(rep) = &report {
+                        let qa = (q.0[a], qa.0[a]);
+                        self.report(rep, qa, shortcuts, &xa[..n], path, st);
+                        if !path.alive {
+                            live &= !(1 << a);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// [`step_lanes`](Self::step_lanes), compiled for the processor's extensions.
     #[inline(never)]
     fn general<D: Dim, const DIAG: bool>(
@@ -819,5 +947,162 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 *left_domain = true;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{make_plan, Options};
+    use super::*;
+    use crate::engine;
+    use crate::interval::Interval;
+    use crate::model::*;
+
+    /// The pendulum of specs/pendulum.sde: one noise channel on the second state (constant
+    /// `G` that is not diagonal), a drift with `sin`.
+    struct Pendulum;
+
+    impl System for Pendulum {
+        fn n(&self) -> usize {
+            2
+        }
+        fn p(&self) -> usize {
+            0
+        }
+        fn m(&self) -> usize {
+            1
+        }
+        fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+            out[0] = x[1];
+            out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
+        }
+        fn drift_interval(
+            &self,
+            x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            o: &mut [Interval],
+        ) {
+            let p = Interval::point;
+            o[0] = x[1];
+            o[1] = p(10.0) * x[0].sin() - p(20.0) * x[0] - p(20.0) * x[1];
+        }
+        fn jac_x(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+            out.copy_from_slice(&[0.0, 1.0, 10.0 * x[0].cos() - 20.0, -20.0]);
+        }
+        fn jac_x_interval(
+            &self,
+            x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            o: &mut [Interval],
+        ) {
+            let p = Interval::point;
+            o.copy_from_slice(&[p(0.0), p(1.0), p(10.0) * x[0].cos() - p(20.0), p(-20.0)]);
+        }
+        fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
+        fn jac_u_interval(
+            &self,
+            _x: &[Interval],
+            _u: &[Interval],
+            _t: Interval,
+            _o: &mut [Interval],
+        ) {
+        }
+        fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
+            out.copy_from_slice(&[0.0, 0.1]);
+        }
+        fn diffusion_interval(&self, _x: &[Interval], _t: Interval, o: &mut [Interval]) {
+            o.copy_from_slice(&[Interval::ZERO, Interval::point(0.1)]);
+        }
+    }
+
+    /// The pendulum's model; its analysis `method` with the paper's (full) metric.
+    fn pendulum(method: Method) -> ModelInfo {
+        let a = std::f64::consts::PI / 10.0;
+        let mut info = ModelInfo {
+            name: "pendulum".into(),
+            states: vec!["theta".into(), "omega".into()],
+            inputs: vec![],
+            noises: vec!["w".into()],
+            input_box: vec![],
+            initial: InitialSet {
+                boxes: vec![Some(Bounds::new(-a, a)), Some(Bounds::new(-0.2, 0.2))],
+                balls: vec![],
+            },
+            domain: vec![Bounds::ENTIRE; 2],
+            has_domain: false,
+            affine: false,
+            unsafe_sets: vec![],
+            analyses: vec![],
+        };
+        let constants = Constants::given(&info, vec![35.68, 2.21, 2.21, 1.27], -0.5, 0.12, 0.0);
+        info.analyses.push(Analysis {
+            spec: AnalysisSpec {
+                name: "a".into(),
+                method,
+                delta: 1e-3,
+                horizon: 1.0,
+                step: 0.02,
+                ..AnalysisSpec::default()
+            },
+            constants: Ok(constants),
+        });
+        info
+    }
+
+    /// Eight paths in lanes (`constant_x8`; of 203 paths, the last three in the scalar loops)
+    /// against the scalar loops, path by path: a constant `G` that is not diagonal, a full
+    /// metric, the contraction method's intersection with its interval box (time-uniform: the
+    /// tube at every step; and pointwise) and the interval method's box, with and without
+    /// quantile candidates, and with sets narrowed so that paths leave them. The records,
+    /// counts and tube exits are the same.
+    #[test]
+    fn lanes_with_constant_noise_do_not_change_the_paths() {
+        if !super::super::avx512::available() {
+            eprintln!("no AVX-512: nothing to compare");
+            return;
+        }
+        let sorted = |mut s: ChunkStats| {
+            // The lanes record a group's steps in turn, the scalar loops a step's paths.
+            s.candidates
+                .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+            s
+        };
+        let mut outside = 0;
+        for method in [Method::Contraction, Method::Interval] {
+            for guarantee in [Guarantee::Uniform, Guarantee::Pointwise] {
+                let info = pendulum(method);
+                let mut r = engine::run(&Pendulum, &info, &info.analyses[0]).unwrap();
+                r.guarantee = guarantee;
+                if method == Method::Contraction {
+                    assert!(!r.also.is_empty(), "an intersection");
+                }
+                for narrow in [false, true] {
+                    if narrow {
+                        // Radii and spans at a third: some paths leave the sets.
+                        for st in &mut r.steps {
+                            st.prs_radius /= 3.0;
+                            st.span.radius /= 3.0;
+                        }
+                    }
+                    let opts = Options::default();
+                    let mut plan = make_plan(&Pendulum, &info, &r, &opts).unwrap();
+                    assert!(plan.lanes_take_constant(2) && plan.noise.diagonal().is_none());
+                    for threshold in [f64::NEG_INFINITY, 0.5] {
+                        let thresholds = vec![threshold; plan.times.len()];
+                        plan.avx512 = true;
+                        let lanes = sorted(plan.run_chunk(0..203, &thresholds));
+                        plan.avx512 = false;
+                        let scalar = sorted(plan.run_chunk(0..203, &thresholds));
+                        let case = format!("{method:?} {guarantee:?} narrow {narrow} {threshold}");
+                        assert_eq!(lanes, scalar, "{case}");
+                        outside += scalar.outside_any + scalar.outside_tube;
+                    }
+                }
+            }
+        }
+        // Not vacuous: the narrowed sets are left.
+        assert!(outside > 100, "{outside}");
     }
 }

@@ -30,6 +30,9 @@
 //!   upper bound of the box's P-radius around `c` (the span lies in the ball `B_P(c, radius +
 //!   b)`).
 //!
+//! The PRS of an intersection (several metrics' sets, `Prs::also`) is decided set by set,
+//! each with its own metric's shortcuts, and so is its tube.
+//!
 //! A non-finite state is outside, a state in the box inside (the span at `t = 0` of an interval
 //! analysis has radius 0); everything else goes to `span_contains`. Every shortcut is
 //! sound on its own (an "inside" is proved by a point of the box), so a state is never counted
@@ -37,6 +40,7 @@
 
 use super::paths::SMALL;
 use crate::interval::Interval;
+use crate::lanes::{Real, X8};
 use crate::prs::{DetSet, Prs};
 
 /// The quadratic form `d' P d` as a list of terms.
@@ -125,23 +129,24 @@ impl Metric {
 
     /// [`quad`](Self::quad) of the difference `d(i)` (`d(i) = x_i - c_i` gives `quad(x, c)`),
     /// the terms in the same order.
+    /// Generic over [`Real`]: one path's `f64` or eight paths' lanes, the same operations.
     #[inline(always)]
-    fn quad_by(&self, d: impl Fn(usize) -> f64) -> (f64, f64) {
+    fn quad_by<T: Real>(&self, d: impl Fn(usize) -> T) -> (T, T) {
         if self.nonneg {
             let q = (0..self.diag.len())
                 .map(|i| {
                     let d = d(i);
-                    self.diag[i] * d * d
+                    T::from(self.diag[i]) * d * d
                 })
                 .reduce(|q, t| q + t)
-                .unwrap_or(0.0);
+                .unwrap_or(T::from(0.0));
             return (q, q);
         }
-        let (mut q, mut a) = (0.0, 0.0);
+        let (mut q, mut a) = (T::from(0.0), T::from(0.0));
         for &(i, j, w) in &self.terms {
-            let t = w * d(i) * d(j);
-            q += t;
-            a += t.abs();
+            let t = T::from(w) * d(i) * d(j);
+            q = q + t;
+            a = a + t.abs();
         }
         (q, a)
     }
@@ -195,18 +200,19 @@ pub(crate) fn diag_quad(w: &[f64], x: &[f64], c: &[f64]) -> f64 {
 /// [`Metric::quad`] for at most [`SMALL`] states (`x.len()`), with `w` from [`Metric::upper`]:
 /// the same terms in the same order, plus the zero ones, which add `+-0` to finite sums (and
 /// cannot make a non-finite sum finite), so `(q, a)` is `quad`'s to the bit when finite and
-/// non-finite when it is. Fixed-size weights let a small model's loops unroll.
+/// non-finite when it is. Fixed-size weights let a small model's loops unroll. Generic over
+/// [`Real`]: one path's `f64` or eight paths' lanes, the same operations.
 #[inline(always)]
-pub(crate) fn quad_small(w: &[f64; SMALL * SMALL], x: &[f64], c: &[f64]) -> (f64, f64) {
+pub(crate) fn quad_small<T: Real>(w: &[f64; SMALL * SMALL], x: &[T], c: &[f64]) -> (T, T) {
     let n = x.len().min(SMALL);
     let (x, c) = (&x[..n], &c[..n]);
-    let (mut q, mut a) = (0.0, 0.0);
+    let (mut q, mut a) = (T::from(0.0), T::from(0.0));
     for i in 0..n {
-        let di = x[i] - c[i];
+        let di = x[i] - T::from(c[i]);
         for j in i..n {
-            let t = w[i * SMALL + j] * di * (x[j] - c[j]);
-            q += t;
-            a += t.abs();
+            let t = T::from(w[i * SMALL + j]) * di * (x[j] - T::from(c[j]));
+            q = q + t;
+            a = a + t.abs();
         }
     }
     (q, a)
@@ -233,13 +239,10 @@ enum Shape {
 }
 
 impl Shape {
-    /// The shape of every step of `result` (the sets of one result all have one shape).
+    /// The shape of every step of `result`'s own set (the sets of one result all have one
+    /// shape; the members of an intersection, `result.also`, have shapes of their own).
     fn of(result: &Prs) -> Shape {
         let n = result.states.len();
-        // An intersection of several metrics' sets: no shortcut of one metric's set decides.
-        if !result.also.is_empty() {
-            return Shape::Other;
-        }
         let all = |f: fn(&DetSet) -> bool| result.steps.iter().all(|s| f(&s.det));
         // The contraction method's set at t = 0 may be the initial box inside its P-ball: the
         // ball's shortcuts then hold for "outside" only (see `Membership::ball`).
@@ -280,9 +283,114 @@ impl Shape {
     }
 }
 
-/// Decides PRS membership at each report step of `result`.
+/// Decides PRS membership at each report step of `result`: in its own set and in those of
+/// the members of an intersection (`result.also`, each with its own metric), every set with
+/// its own shortcuts.
 #[derive(Clone, Debug)]
 pub(crate) struct Membership<'a> {
+    own: OneSet<'a>,
+    /// The members, with their metrics.
+    also: Vec<(Metric, OneSet<'a>)>,
+}
+
+impl<'a> Membership<'a> {
+    /// For `result` (its steps), with `metric` built from its metric.
+    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Self {
+        let also = members(result, |m, metric| Ok(OneSet::new(m, metric)))
+            .expect("building a member's set never fails");
+        Membership {
+            own: OneSet::new(result, metric),
+            also,
+        }
+    }
+
+    /// `Some(b)`: a squared distance `q < b` (from [`Metric::quad`]) means `x` is in the PRS of
+    /// step `k`, found with one comparison (what [`inside`](Self::inside) answers). `None` when
+    /// no such bound holds (an intersection, shapes other than the P-ball, metrics with
+    /// off-diagonal or negative terms: see [`inside_by_shortcut`](Self::inside_by_shortcut)).
+    pub(crate) fn inside_below(&self, k: usize) -> Option<f64> {
+        if self.also.is_empty() {
+            self.own.inside_below(k)
+        } else {
+            None
+        }
+    }
+
+    /// Whether [`inside_by_shortcut`](Self::inside_by_shortcut) can ever answer `true`.
+    pub(crate) fn has_shortcuts(&self) -> bool {
+        self.own.has_shortcuts() && self.also.iter().all(|(_, s)| s.has_shortcuts())
+    }
+
+    /// Whether `x` is, by the shortcuts alone, in the PRS of step `k` (then
+    /// [`inside`](Self::inside) is `true`; `false` says nothing). Arguments as for `inside`.
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[f64],
+        q: f64,
+        a: f64,
+    ) -> bool {
+        if !self.own.inside_by_shortcut(metric, k, x, q, a) {
+            return false;
+        }
+        // A loop rather than `all`, which might not be inlined into the hot loops.
+        for (m, s) in &self.also {
+            if !s.inside_by_shortcut_with(m, k, x, || m.quad(x, s.centre(k))) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Whether the finite state `x` is in the PRS of step `k`, given the centre `c = x*_k` and
+    /// `(q, a) = metric.quad(x, c)`: in every member's set (`Prs::contains_at`'s answer, each
+    /// set decided by its shortcuts where they hold).
+    #[inline]
+    pub(crate) fn inside(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[f64],
+        c: &[f64],
+        q: f64,
+        a: f64,
+    ) -> bool {
+        self.own.inside(metric, k, x, c, q, a)
+            && self.also.iter().all(|(m, s)| {
+                let c = s.centre(k);
+                let (q, a) = m.quad(x, c);
+                // As `record` does for the own metric: rounding can make `q` slightly negative
+                // only with off-diagonal terms.
+                let q = if a == q { q } else { q.max(0.0) };
+                s.inside(m, k, x, c, q, a)
+            })
+    }
+}
+
+/// The members of `result`'s intersection (`result.also`), each with its metric and what
+/// `make` builds of it and that metric.
+fn members<'a, T>(
+    result: &'a Prs,
+    make: impl Fn(&'a Prs, &Metric) -> Result<T, String>,
+) -> Result<Vec<(Metric, T)>, String> {
+    let n = result.states.len();
+    result
+        .also
+        .iter()
+        .map(|m| {
+            let metric = Metric::new(&m.constants.metric, n);
+            let part = make(m, &metric)?;
+            Ok((metric, part))
+        })
+        .collect()
+}
+
+/// Decides membership in one metric's set at each report step (a result's own set, or one
+/// member of an intersection).
+#[derive(Clone, Debug)]
+struct OneSet<'a> {
     result: &'a Prs,
     shape: Shape,
     /// Squared PRS radius per step.
@@ -298,9 +406,9 @@ pub(crate) struct Membership<'a> {
     ball: Vec<bool>,
 }
 
-impl<'a> Membership<'a> {
-    /// For `result` (its steps), with `metric` built from its metric.
-    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Self {
+impl<'a> OneSet<'a> {
+    /// For `result`'s own set, with `metric` built from its metric.
+    fn new(result: &'a Prs, metric: &Metric) -> Self {
         let n = result.states.len();
         let shape = Shape::of(result);
         let r2: Vec<f64> = result
@@ -324,7 +432,7 @@ impl<'a> Membership<'a> {
             .iter()
             .map(|s| matches!(s.det, DetSet::Ball { .. }))
             .collect();
-        Membership {
+        OneSet {
             result,
             shape,
             r2,
@@ -340,7 +448,7 @@ impl<'a> Membership<'a> {
     /// step `k`, found with one comparison (what [`inside`](Self::inside) answers). `None` when
     /// no such bound holds (shapes other than the P-ball, metrics with off-diagonal or negative
     /// terms: see [`inside_by_shortcut`](Self::inside_by_shortcut)).
-    pub(crate) fn inside_below(&self, k: usize) -> Option<f64> {
+    fn inside_below(&self, k: usize) -> Option<f64> {
         match self.shape {
             Shape::PBall if self.nonneg && self.ball[k] => Some(self.q_in[k]),
             Shape::PBall if self.nonneg => Some(f64::NEG_INFINITY),
@@ -348,8 +456,13 @@ impl<'a> Membership<'a> {
         }
     }
 
+    /// The centre `x*_k` of step `k`, around which [`Metric::quad`] measures for this set.
+    fn centre(&self, k: usize) -> &'a [f64] {
+        self.result.steps[k].nominal()
+    }
+
     /// Whether [`inside_by_shortcut`](Self::inside_by_shortcut) can ever answer `true`.
-    pub(crate) fn has_shortcuts(&self) -> bool {
+    fn has_shortcuts(&self) -> bool {
         !matches!(self.shape, Shape::Other)
     }
 
@@ -373,21 +486,29 @@ impl<'a> Membership<'a> {
     /// Whether `x` is, by one of the shortcuts alone, in the PRS of step `k` (then
     /// [`inside`](Self::inside) is `true`; `false` says nothing). Arguments as for `inside`.
     #[inline(always)]
-    pub(crate) fn inside_by_shortcut(
+    fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64], q: f64, a: f64) -> bool {
+        self.inside_by_shortcut_with(metric, k, x, || (q, a))
+    }
+
+    /// [`inside_by_shortcut`](Self::inside_by_shortcut) with `(q, a)` computed only if the
+    /// shape needs it: a box or a parallelotope is in the PRS, so a state in it is inside
+    /// whatever its distance to `x*_k` (for [`Membership`]'s members, which would compute the
+    /// distance in their own metric for nothing).
+    #[inline(always)]
+    fn inside_by_shortcut_with(
         &self,
         metric: &Metric,
         k: usize,
         x: &[f64],
-        q: f64,
-        a: f64,
+        quad: impl FnOnce() -> (f64, f64),
     ) -> bool {
-        let (clearly_out, clearly_in) = self.clearly(metric, k, q, a);
         match &self.shape {
-            Shape::PBall => clearly_in,
-            Shape::Box { lo, hi } => !clearly_out && self.in_box(lo, hi, k, x),
-            Shape::Parallelotope { t, lo, hi } => {
-                !clearly_out && self.in_parallelotope(t, lo, hi, k, x)
+            Shape::PBall => {
+                let (q, a) = quad();
+                self.clearly(metric, k, q, a).1
             }
+            Shape::Box { lo, hi } => self.in_box(lo, hi, k, x),
+            Shape::Parallelotope { t, lo, hi } => self.in_parallelotope(t, lo, hi, k, x),
             Shape::Other => false,
         }
     }
@@ -402,41 +523,39 @@ impl<'a> Membership<'a> {
         let n = self.n;
         let (lo, hi, x) = (&lo[k * n..][..n], &hi[k * n..][..n], &x[..n]);
         let rel = 16.0 * (n as f64 + 2.0) * f64::EPSILON;
-        t.chunks_exact(n)
-            .zip(lo.iter().zip(hi))
-            .all(|(row, (&a, &b))| {
-                let (mut y, mut s) = (0.0, 0.0);
-                for (tij, xj) in row.iter().zip(x) {
-                    let p = tij * xj;
-                    y += p;
-                    s += p.abs();
-                }
-                let margin = rel * s + f64::MIN_POSITIVE;
-                a <= y - margin && y + margin <= b
-            })
+        // Loops rather than `all`, which might not be inlined into the hot loops.
+        for ((row, &a), &b) in t.chunks_exact(n).zip(lo).zip(hi) {
+            let (mut y, mut s) = (0.0, 0.0);
+            for (tij, xj) in row.iter().zip(x) {
+                let p = tij * xj;
+                y += p;
+                s += p.abs();
+            }
+            let margin = rel * s + f64::MIN_POSITIVE;
+            if !(a <= y - margin && y + margin <= b) {
+                return false;
+            }
+        }
+        true
     }
 
     /// `x` in the box `[lo, hi]` of step `k`.
     #[inline(always)]
     fn in_box(&self, lo: &[f64], hi: &[f64], k: usize, x: &[f64]) -> bool {
         let (lo, hi) = (&lo[k * self.n..][..self.n], &hi[k * self.n..][..self.n]);
-        x.iter()
-            .zip(lo.iter().zip(hi))
-            .all(|(v, (l, h))| l <= v && v <= h)
+        // A loop rather than `all`, which might not be inlined into the hot loops.
+        for ((v, l), h) in x.iter().zip(lo).zip(hi) {
+            if !(l <= v && v <= h) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Whether `x` is in the PRS of step `k`, given the centre `c = x*_k` and
     /// `(q, a) = metric.quad(x, c)`.
     #[inline]
-    pub(crate) fn inside(
-        &self,
-        metric: &Metric,
-        k: usize,
-        x: &[f64],
-        c: &[f64],
-        q: f64,
-        a: f64,
-    ) -> bool {
+    fn inside(&self, metric: &Metric, k: usize, x: &[f64], c: &[f64], q: f64, a: f64) -> bool {
         let (clearly_out, clearly_in) = self.clearly(metric, k, q, a);
         match &self.shape {
             Shape::PBall => {
@@ -467,7 +586,7 @@ impl<'a> Membership<'a> {
             }
             Shape::Other => {}
         }
-        self.result.contains_at(k, x)
+        self.result.own_contains_at(k, x)
     }
 }
 
@@ -478,6 +597,83 @@ impl<'a> Membership<'a> {
 /// [`Step::span`]: crate::prs::Step::span
 #[derive(Clone, Debug)]
 pub(crate) struct Tube<'a> {
+    own: OneSpan<'a>,
+    /// The spans of the members of an intersection (`result.also`), with their metrics: a
+    /// state is in the tube when it is in every member's span.
+    also: Vec<(Metric, OneSpan<'a>)>,
+}
+
+impl<'a> Tube<'a> {
+    /// The tube of `result`'s spans, with `metric` built from its metric; `Err` when a span is
+    /// malformed (a corner of the wrong length, NaN, `lo > hi`, a negative or NaN radius).
+    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Result<Tube<'a>, String> {
+        let also = members(result, OneSpan::new)?;
+        Ok(Tube {
+            own: OneSpan::new(result, metric)?,
+            also,
+        })
+    }
+
+    /// The box and the "clearly inside" bound of step `k` for the caller's own
+    /// [`diag_quad_to_box`] (non-negative diagonal metrics): `(lo, hi, q_in)`. With the members
+    /// of an intersection the own span's distance proves nothing alone: `q_in` is `-inf`, and
+    /// every state goes to [`inside_slow`](Self::inside_slow).
+    #[inline(always)]
+    pub(crate) fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
+        let (lo, hi, q_in) = self.own.diag_bounds(k);
+        let q_in = if self.also.is_empty() {
+            q_in
+        } else {
+            f64::NEG_INFINITY
+        };
+        (lo, hi, q_in)
+    }
+
+    /// Whether `x` is, by the "inside" shortcuts alone, in the span of step `k` of every member
+    /// (then [`inside`](Self::inside) is `true`; `false` says nothing). Alone and with a
+    /// non-negative diagonal metric, the same as `diag_quad_to_box(w, x, lo, hi) < q_in` with
+    /// [`diag_bounds`](Self::diag_bounds).
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        self.own.inside_by_shortcut(metric, k, x)
+            && self.also.iter().all(|(m, s)| s.inside_by_shortcut(m, k, x))
+    }
+
+    /// Whether `x` lies in the span of step `k`: the shortcuts, then [`Prs::span_contains`];
+    /// `true` only if certainly.
+    #[cfg(test)]
+    pub(crate) fn inside(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        self.inside_by_shortcut(metric, k, x) || self.inside_slow(metric, k, x)
+    }
+
+    /// [`inside_by_shortcut`](Self::inside_by_shortcut) of eight states in lanes (state `i` of
+    /// path `l` in lane `l` of `x[i]`): bit `l` set when lane `l` is inside by the shortcuts,
+    /// the same answer as for that state alone.
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
+        let mut mask = self.own.inside_by_shortcut_x8(metric, k, x);
+        for (m, s) in &self.also {
+            mask &= s.inside_by_shortcut_x8(m, k, x);
+        }
+        mask
+    }
+
+    /// [`inside`](Self::inside) for a state the shortcut did not find inside (the same answer
+    /// then): [`Prs::span_contains`]'s, member by member, each decided by its own shortcuts
+    /// where they hold.
+    #[cold]
+    #[inline(never)]
+    pub(crate) fn inside_slow(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        if !x.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        self.own.decide(metric, k, x) && self.also.iter().all(|(m, s)| s.decide(m, k, x))
+    }
+}
+
+/// The spans of one metric's set (a result's own, or one member of an intersection).
+#[derive(Clone, Debug)]
+struct OneSpan<'a> {
     result: &'a Prs,
     n: usize,
     /// Per report step, the span's box, flat (`n` per step).
@@ -495,18 +691,15 @@ pub(crate) struct Tube<'a> {
     centre: Vec<f64>,
     outer2: Vec<f64>,
     nonneg: bool,
-    /// The result is one metric's set (no intersection with others): a point of its span is
-    /// in the PRS, so the "inside" shortcuts decide.
-    alone: bool,
 }
 
-impl<'a> Tube<'a> {
-    /// The tube of `result`'s spans, with `metric` built from its metric; `Err` when a span is
-    /// malformed (a corner of the wrong length, NaN, `lo > hi`, a negative or NaN radius).
-    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Result<Tube<'a>, String> {
+impl<'a> OneSpan<'a> {
+    /// The spans of `result`'s own set, with `metric` built from its metric; `Err` as for
+    /// [`Tube::new`].
+    fn new(result: &'a Prs, metric: &Metric) -> Result<OneSpan<'a>, String> {
         let n = result.states.len();
         let steps = result.steps.len();
-        let mut tube = Tube {
+        let mut tube = OneSpan {
             result,
             n,
             lo: Vec::with_capacity(n * steps),
@@ -517,7 +710,6 @@ impl<'a> Tube<'a> {
             centre: Vec::with_capacity(n * steps),
             outer2: Vec::with_capacity(steps),
             nonneg: metric.nonneg,
-            alone: result.also.is_empty(),
         };
         let eps16 = 16.0 * f64::EPSILON;
         for (k, st) in result.steps.iter().enumerate() {
@@ -541,11 +733,7 @@ impl<'a> Tube<'a> {
             // As in `Membership::new`: the error bound solved for q once per step.
             let r2 = s.radius * s.radius;
             tube.r2.push(r2);
-            tube.q_in.push(if tube.alone {
-                r2 * (1.0 - eps16) / (1.0 + metric.gamma)
-            } else {
-                f64::NEG_INFINITY
-            });
+            tube.q_in.push(r2 * (1.0 - eps16) / (1.0 + metric.gamma));
             tube.q_out.push(r2 * (1.0 + eps16) / (1.0 - metric.gamma));
             // A ball around the box's centre holding the span: radius + b, with
             // b^2 <= sum_ij |P_ij| h_i h_j and h_i >= |y_i - c_i| over the box, all rounded up.
@@ -579,53 +767,76 @@ impl<'a> Tube<'a> {
         Ok(tube)
     }
 
-    /// The box and the "clearly inside" bound of step `k` for the caller's own
-    /// [`diag_quad_to_box`] (non-negative diagonal metrics): `(lo, hi, q_in)`.
+    /// The box and the "clearly inside" bound of step `k`: `(lo, hi, q_in)`.
     #[inline(always)]
-    pub(crate) fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
+    fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
         let n = self.n;
         (&self.lo[k * n..][..n], &self.hi[k * n..][..n], self.q_in[k])
     }
 
-    /// `(q, a)` of [`Metric::quad`] for `x` and its clamp into the box of step `k`.
+    /// `(q, a)` of [`Metric::quad`] for `x` and its clamp into the box of step `k` (one path,
+    /// or eight in lanes).
     #[inline(always)]
-    fn quad_to_box(&self, metric: &Metric, k: usize, x: &[f64]) -> (f64, f64) {
+    fn quad_to_box<T: Real>(&self, metric: &Metric, k: usize, x: &[T]) -> (T, T) {
         let (lo, hi, _) = self.diag_bounds(k);
-        metric.quad_by(|i| x[i] - clamp(x[i], lo[i], hi[i]))
+        metric.quad_by(|i| x[i] - x[i].clamp_with(|v| clamp(v, lo[i], hi[i])))
     }
 
-    /// Whether `x` is, by the "inside" shortcut alone, in the span of step `k` (then
-    /// [`inside`](Self::inside) is `true`; `false` says nothing). With a non-negative diagonal
-    /// metric, the same as `diag_quad_to_box(w, x, lo, hi) < q_in` with
-    /// [`diag_bounds`](Self::diag_bounds).
+    /// Whether `x` is, by the "inside" shortcut alone, in the span of step `k` (`false` says
+    /// nothing).
     #[inline(always)]
-    pub(crate) fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+    fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        self.in_box(k, x, |x| x) || {
+            let (q, a) = self.quad_to_box(metric, k, x);
+            self.close(metric, k, q, a)
+        }
+    }
+
+    /// [`inside_by_shortcut`](Self::inside_by_shortcut) of eight states in lanes (state `i` of
+    /// lane `l` in lane `l` of `x[i]`): bit `l` set when lane `l` is inside, the same answer
+    /// as for that state alone.
+    #[inline(always)]
+    fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
         let (q, a) = self.quad_to_box(metric, k, x);
+        // Loops rather than iterator adapters, which might not be inlined into the vector
+        // loop (and would then work on the lanes one by one).
+        let mut mask = 0;
+        for l in 0..8 {
+            let inside = self.in_box(k, x, |x| x.0[l]) || self.close(metric, k, q.0[l], a.0[l]);
+            mask |= u8::from(inside) << l;
+        }
+        mask
+    }
+
+    /// Whether the state `(at(x[i]))_i` is in the box of step `k` (which the span holds): most
+    /// states of an interval box's span, and the states at t = 0 of an interval analysis, whose
+    /// span there is the initial box with radius 0.
+    #[inline(always)]
+    fn in_box<T: Copy>(&self, k: usize, x: &[T], at: impl Fn(T) -> f64) -> bool {
+        let (lo, hi, _) = self.diag_bounds(k);
+        for i in 0..self.n {
+            if !(lo[i] <= at(x[i]) && at(x[i]) <= hi[i]) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Whether `(q, a)` of [`quad_to_box`](Self::quad_to_box) clearly puts the state in the
+    /// span of step `k`.
+    #[inline(always)]
+    fn close(&self, metric: &Metric, k: usize, q: f64, a: f64) -> bool {
         if self.nonneg {
             q < self.q_in[k]
         } else {
-            self.alone && q + (metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k]) < self.r2[k]
+            q + (metric.gamma * a + 8.0 * f64::EPSILON * self.r2[k]) < self.r2[k]
         }
     }
 
-    /// Whether `x` lies in the span of step `k`: the shortcuts, then [`Prs::span_contains`];
-    /// `true` only if certainly.
-    #[cfg(test)]
-    pub(crate) fn inside(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
-        self.inside_by_shortcut(metric, k, x) || self.inside_slow(metric, k, x)
-    }
-
-    /// [`inside`](Self::inside) for a state not inside by the shortcut (the same answer then).
-    #[cold]
-    #[inline(never)]
-    pub(crate) fn inside_slow(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
-        if !x.iter().all(|v| v.is_finite()) {
-            return false;
-        }
-        // In the box (which the span holds): the states at t = 0 of an interval analysis,
-        // whose span there is the initial box with radius 0.
-        let (lo, hi, _) = self.diag_bounds(k);
-        if self.alone && (0..self.n).all(|i| lo[i] <= x[i] && x[i] <= hi[i]) {
+    /// Whether the finite state `x` lies in the span of step `k` ([`Prs::own_span_contains`]'s
+    /// answer): the shortcuts, then that test.
+    fn decide(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
+        if self.inside_by_shortcut(metric, k, x) {
             return true;
         }
         let clearly_out = if self.nonneg {
@@ -636,7 +847,7 @@ impl<'a> Tube<'a> {
             let o2 = self.outer2[k];
             q - (metric.gamma * a + 8.0 * f64::EPSILON * o2) > o2
         };
-        !clearly_out && self.result.span_contains(k, x)
+        !clearly_out && self.result.own_span_contains(k, x)
     }
 }
 
@@ -713,7 +924,9 @@ mod tests {
         }
     }
 
-    fn result(method: Method, metric: Vec<f64>) -> Prs {
+    /// The result of `method` with `metric`; `members`: with the members of its intersection
+    /// (a contraction run's interval box, method.md 8.7), else its own set alone.
+    fn result(method: Method, metric: Vec<f64>, members: bool) -> Prs {
         let info = ModelInfo {
             name: "m".into(),
             states: vec!["x".into(), "y".into()],
@@ -743,16 +956,18 @@ mod tests {
             constants: Ok(Constants::given(&info, metric, -0.2, 0.5, 0.0)),
         };
         let mut r = engine::run(&Sys, &info, &analysis).unwrap();
-        // The set alone: a contraction run's interval box (method.md 8.7) turns the
-        // shortcuts off, and is tested with the other intersections.
-        r.also.clear();
+        if members {
+            assert!(!r.also.is_empty(), "{method:?}: an intersection");
+        } else {
+            r.also.clear();
+        }
         r
     }
 
     /// The interval method's box result turned into a parallelotope `{x : lo <= T x <= hi}`
     /// inside each box (the pendulum's `T`), so that the box's enclosing P-ball still holds it.
     fn parallelotope(metric: Vec<f64>) -> Prs {
-        let mut r = result(Method::Interval, metric);
+        let mut r = result(Method::Interval, metric, false);
         let t = [[1.0, 0.2], [1.0, 0.0]];
         r.transform = Some(TransformUsed {
             matrix: t.concat(),
@@ -836,8 +1051,8 @@ mod tests {
     #[test]
     fn the_tube_agrees_with_span_contains() {
         let mut rng = PathRng::new(7, 0);
-        for (method, metric) in methods_and_metrics() {
-            let r = result(method, metric);
+        for (method, metric, members) in methods_and_metrics() {
+            let r = result(method, metric, members);
             let m = Metric::new(&r.constants.metric, 2);
             let tube = Tube::new(&r, &m).unwrap();
             let (mut shortcut, mut inside, mut points) = (0, 0, 0);
@@ -893,13 +1108,17 @@ mod tests {
         }
     }
 
-    /// Both methods, each with the identity and a skewed metric.
-    fn methods_and_metrics() -> [(Method, Vec<f64>); 4] {
+    /// Both methods, each with the identity and a skewed metric; the contraction method's
+    /// set alone and as the intersection with its interval box (`true`).
+    fn methods_and_metrics() -> [(Method, Vec<f64>, bool); 6] {
+        let (identity, skewed) = (vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]);
         [
-            (Method::Contraction, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Contraction, vec![2.0, 0.7, 0.7, 1.0]),
-            (Method::Interval, vec![1.0, 0.0, 0.0, 1.0]),
-            (Method::Interval, vec![2.0, 0.7, 0.7, 1.0]),
+            (Method::Contraction, identity.clone(), false),
+            (Method::Contraction, skewed.clone(), false),
+            (Method::Contraction, identity.clone(), true),
+            (Method::Contraction, skewed.clone(), true),
+            (Method::Interval, identity, false),
+            (Method::Interval, skewed, false),
         ]
     }
 
@@ -908,8 +1127,8 @@ mod tests {
     #[test]
     fn shortcuts_agree_with_contains() {
         let mut rng = PathRng::new(5, 0);
-        for (method, metric) in methods_and_metrics() {
-            let r = result(method, metric);
+        for (method, metric, members) in methods_and_metrics() {
+            let r = result(method, metric, members);
             let m = Metric::new(&r.constants.metric, 2);
             let mem = Membership::new(&r, &m);
             for (k, st) in r.steps.iter().enumerate() {
