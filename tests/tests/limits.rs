@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use reachc_compiler::diagnostics::{render, Diagnostic};
 use reachc_compiler::driver::{check_source, load, LoadError};
 use reachc_compiler::limits::{
-    MAX_HEIGHT, MAX_REPORT_STEPS, MAX_STATES, MAX_TABLE_LEN, MAX_UNROLLED,
+    MAX_HEIGHT, MAX_REPORT_STEPS, MAX_STATES, MAX_TABLE_LEN, MAX_UNROLLED, MIN_REPORT_STEP,
 };
 
 /// A fresh directory for one test's files.
@@ -124,19 +124,29 @@ fn report_steps_are_bounded_in_check() {
     let spec = |fields: &str| {
         format!("model m\nstate x in [0, 1]\ndrift {{ x' = -x }}\nanalysis a {{ {fields} }}\n")
     };
-    for (fields, at, steps) in [
-        ("horizon = 1e6  step = 0.01", "0.01", "1.000e8"),
-        ("horizon = 1e9  step = 1e-3", "1e-3", "1.000e12"),
-        ("horizon = 1  step = 1e-300", "1e-300", "1.000e300"),
+    let too_many = |steps: &str| {
+        format!("{steps} report steps (horizon / step); at most {MAX_REPORT_STEPS:e}")
+    };
+    let too_short = |step: &str| format!("the report step is {step}; at least {MIN_REPORT_STEP:e}");
+    for (fields, at, message) in [
+        ("horizon = 1e6  step = 0.01", "0.01", too_many("1.000e8")),
+        ("horizon = 1e9  step = 1e-3", "1e-3", too_many("1.000e12")),
+        // Short steps: the integrators' subdivisions would be subnormal (a horizon of 1e-320
+        // with the default step hung `run`).
+        ("horizon = 1  step = 1e-300", "1e-300", too_short("1e-300")),
+        ("horizon = 1e-320", "1e-320", too_short("1e-322")),
+        (
+            "horizon = 1e-99  step = 1e-101",
+            "1e-101",
+            too_short("1e-101"),
+        ),
     ] {
         let (d, span) = one_error(&spec(fields));
-        assert_eq!(
-            d.message,
-            format!("{steps} report steps (horizon / step); at most {MAX_REPORT_STEPS:e}")
-        );
+        assert_eq!(d.message, message);
         assert_eq!(span, at);
     }
     assert!(errors(&spec("horizon = 1e5  step = 1")).is_empty());
+    assert!(errors(&spec("horizon = 1e-98  step = 1e-100")).is_empty());
 }
 
 #[test]
