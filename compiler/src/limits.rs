@@ -31,7 +31,6 @@ pub const MAX_NOISES: usize = 2_000;
 /// Most report steps (`horizon / step`) of one analysis.
 pub const MAX_REPORT_STEPS: f64 = 1e5;
 
-/// Shortest report step of one analysis: the engines subdivide a report step down to a
-/// millionth of it and halve from there, so far shorter steps would reach subnormal numbers,
-/// where `t + h == t` and no step makes progress.
-pub const MIN_REPORT_STEP: f64 = 1e-100;
+/// Shortest report step of one analysis (the engines' own limit: shorter steps would be
+/// subdivided into subnormal numbers, where no step makes progress).
+pub use reachc_core::engine::MIN_REPORT_STEP;

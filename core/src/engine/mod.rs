@@ -259,6 +259,11 @@ pub(crate) fn run_engine(run: &Run) -> Result<Prs, RunError> {
     }
 }
 
+/// Shortest report step an analysis may have: the integrators subdivide a report step down to
+/// a millionth of it and halve from there, so far shorter steps would reach subnormal
+/// numbers, where `t + h == t` and no step makes progress (the front end's limit too).
+pub const MIN_REPORT_STEP: f64 = 1e-100;
+
 /// Checks the analysis parameters and the model dimensions.
 pub(crate) fn validate(
     info: &ModelInfo,
@@ -270,11 +275,9 @@ pub(crate) fn validate(
     if !(a.delta > 0.0 && a.delta < 1.0) {
         return bad(format!("delta = {} must lie in (0, 1)", a.delta));
     }
-    // Shorter steps would subdivide into subnormal numbers, where `t + h == t` (the front
-    // end's limit, `reachc_compiler::limits::MIN_REPORT_STEP`).
-    if !(a.step >= 1e-100 && a.step.is_finite()) {
+    if !(a.step >= MIN_REPORT_STEP && a.step.is_finite()) {
         return bad(format!(
-            "step = {} must be finite and at least 1e-100",
+            "step = {} must be finite and at least {MIN_REPORT_STEP:e}",
             a.step
         ));
     }
