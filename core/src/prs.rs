@@ -363,6 +363,26 @@ impl Step {
     }
 }
 
+/// Whether `|x - c|_P <= r` certainly (interval arithmetic), `p` n x n row-major (both
+/// off-diagonal entries, so a slightly asymmetric `P` is used as given).
+pub(crate) fn within(p: &[f64], x: &[f64], c: &[f64], r: f64) -> bool {
+    let n = x.len();
+    let d: Vec<Interval> = x
+        .iter()
+        .zip(c)
+        .map(|(&a, &b)| Interval::point(a) - Interval::point(b))
+        .collect();
+    let mut q = Interval::ZERO;
+    for i in 0..n {
+        q += p[i * n + i] * d[i].sqr();
+        for j in i + 1..n {
+            q += Interval::point(p[i * n + j]) * d[i] * d[j]
+                + Interval::point(p[j * n + i]) * d[j] * d[i];
+        }
+    }
+    q.hi() <= Interval::point(r).sqr().lo()
+}
+
 impl DetSet {
     /// The centre of the set (of its hull for a parallelotope).
     pub fn center(&self) -> &[f64] {
@@ -633,33 +653,59 @@ impl Prs {
 
     /// [`Prs::contains_at`] for this result's own metric.
     pub(crate) fn own_contains_at(&self, k: usize, x: &[f64]) -> bool {
+        self.own_contains_at_with(k, x, None)
+    }
+
+    /// [`Prs::own_contains_at`], with the exact test of a parallelotope built once by the
+    /// caller (`test`, for this result's metric and transform): the same answers.
+    pub(crate) fn own_contains_at_with(
+        &self,
+        k: usize,
+        x: &[f64],
+        test: Option<&interval::ParallelotopeTest>,
+    ) -> bool {
         let st = &self.steps[k];
         let n = self.n();
         assert_eq!(x.len(), n, "contains: x has the wrong dimension");
         let p = &self.constants.metric;
         match &st.det {
-            DetSet::Ball { center, .. } => {
-                let d: Vec<Interval> = x
-                    .iter()
-                    .zip(center)
-                    .map(|(&a, &b)| Interval::point(a) - Interval::point(b))
-                    .collect();
-                let mut q = Interval::ZERO;
-                for i in 0..n {
-                    q += p[i * n + i] * d[i].sqr();
-                    for j in i + 1..n {
-                        // Both off-diagonal entries, so a slightly asymmetric P is used as given.
-                        q += Interval::point(p[i * n + j]) * d[i] * d[j]
-                            + Interval::point(p[j * n + i]) * d[j] * d[i];
-                    }
-                }
-                q.hi() <= Interval::point(st.prs_radius).sqr().lo()
+            DetSet::Ball { center, .. } => within(p, x, center, st.prs_radius),
+            // The set also holds B_P(c, r_t) when the deterministic set holds its centre c (a
+            // point certain where the search for the nearest point of the set may stop short;
+            // the Monte Carlo check decides most states by that ball alone).
+            DetSet::Box { lo, hi, center, .. } => {
+                interval::box_contains(p, n, x, lo, hi, st.r_t)
+                    || (self.holds_center(k) && within(p, x, center, st.r_t))
             }
-            DetSet::Box { lo, hi, .. } => interval::box_contains(p, n, x, lo, hi, st.r_t),
-            DetSet::Parallelotope { lo, hi, .. } => match &self.transform {
-                Some(tr) => interval::parallelotope_contains(p, tr, x, lo, hi, st.r_t),
+            DetSet::Parallelotope { lo, hi, center, .. } => match &self.transform {
+                Some(tr) => {
+                    let near = match test {
+                        Some(test) => test.contains(x, lo, hi, st.r_t),
+                        None => interval::parallelotope_contains(p, tr, x, lo, hi, st.r_t),
+                    };
+                    near || (self.holds_center(k) && within(p, x, center, st.r_t))
+                }
                 None => false,
             },
+        }
+    }
+
+    /// Whether the deterministic set of report step `k` certainly holds its centre
+    /// ([`DetSet::center`]).
+    pub(crate) fn holds_center(&self, k: usize) -> bool {
+        match &self.steps[k].det {
+            DetSet::Ball { .. } => true,
+            DetSet::Box { lo, hi, center, .. } => center
+                .iter()
+                .zip(lo.iter().zip(hi))
+                .all(|(c, (l, h))| l <= c && c <= h),
+            DetSet::Parallelotope { lo, hi, center, .. } => {
+                self.transform.as_ref().is_some_and(|tr| {
+                    let t: Vec<Vec<f64>> =
+                        tr.matrix.chunks(self.n()).map(<[f64]>::to_vec).collect();
+                    crate::engine::transform::inside(&t, center, lo, hi)
+                })
+            }
         }
     }
 

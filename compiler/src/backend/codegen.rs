@@ -987,9 +987,10 @@ fn method_fn(
         TokenStream::new()
     };
     // The simulator's vector loop calls `drift_x8` once per step of eight paths: inlined, its
-    // lanes stay in vector registers (a call passes them through memory).
+    // lanes stay in vector registers (a call passes them through memory) and it is compiled
+    // with the loop's processor extensions (fused multiply-adds in `X8::sin`).
     let inline = if kind == Kind::X8 {
-        quote!(#[inline])
+        quote!(#[inline(always)])
     } else {
         TokenStream::new()
     };

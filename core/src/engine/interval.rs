@@ -28,7 +28,7 @@
 
 use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
 use super::embedding::{BoxStep, Embedding};
-use super::transform::{self, Frame};
+use super::transform::{self, with_buffer, Frame};
 use super::{hints, local, nominal, r1, radius, validate, Run, RunError};
 use crate::decimal::time;
 use crate::interval::Interval;
@@ -370,7 +370,8 @@ pub fn interval_boxes(
 /// interval arithmetic to satisfy `|x - y|_P <= r`).
 pub(crate) fn box_contains(p: &[f64], n: usize, x: &[f64], lo: &[f64], hi: &[f64], r: f64) -> bool {
     let p = rows(p, n);
-    let y = nearest_in_box(&p, x, lo, hi);
+    let mut y = vec![0.0; n];
+    nearest_in_box(&p, x, lo, hi, &mut y);
     let d: Vec<Interval> = x
         .iter()
         .zip(&y)
@@ -390,26 +391,62 @@ pub(crate) fn parallelotope_contains(
     hi: &[f64],
     r: f64,
 ) -> bool {
-    let n = x.len();
-    let t = rows(&tr.matrix, n);
-    // Inside the parallelotope (the common case): distance 0, no inverse needed.
-    if transform::inside(&t, x, lo, hi) {
-        return true;
+    ParallelotopeTest::new(p, tr, x.len()).contains(x, lo, hi, r)
+}
+
+/// [`parallelotope_contains`] for one metric and transform, with everything that depends on
+/// them alone (the enclosure of `T^-1` and the metric in `y`) computed once: the same answers,
+/// for callers that test many states (the Monte Carlo check).
+#[derive(Clone, Debug)]
+pub(crate) struct ParallelotopeTest {
+    /// `T` by rows.
+    t: Vec<Vec<f64>>,
+    /// `P` by rows.
+    p: Vec<Vec<f64>>,
+    /// `T` with its inverse's enclosure and the metric `S' P S` of `y`; `None` when the
+    /// transform cannot be used (then only the parallelotope itself is certain).
+    frame: Option<(Frame, Vec<Vec<f64>>)>,
+}
+
+impl ParallelotopeTest {
+    /// For the metric `p` (`n x n` row-major) and the transform `tr`.
+    pub(crate) fn new(p: &[f64], tr: &TransformUsed, n: usize) -> Self {
+        let transform = crate::model::Transform {
+            matrix: tr.matrix.clone(),
+            inverse: tr.inverse.clone(),
+            frame: 0,
+            source: tr.source,
+        };
+        let p = rows(p, n);
+        let frame = Frame::new(&transform, n).ok().map(|f| {
+            let q = f.y_metric(&p);
+            (f, q)
+        });
+        ParallelotopeTest {
+            t: rows(&tr.matrix, n),
+            p,
+            frame,
+        }
     }
-    let transform = crate::model::Transform {
-        matrix: tr.matrix.clone(),
-        inverse: tr.inverse.clone(),
-        frame: 0,
-        source: tr.source,
-    };
-    let Ok(f) = Frame::new(&transform, n) else {
-        return false;
-    };
-    let p = rows(p, n);
-    // In y the distance is |y - T x|_Q with Q = T^-T P T^-1 (approximately).
-    let (tx, q) = f.y_problem(&p, x);
-    let y = nearest_in_box(&q, &tx, lo, hi);
-    f.certify(&p, x, &y, r)
+
+    /// Whether `x` lies in `T^-1 [lo, hi] (+) B_P(r)` (see [`parallelotope_contains`]).
+    pub(crate) fn contains(&self, x: &[f64], lo: &[f64], hi: &[f64], r: f64) -> bool {
+        // Inside the parallelotope (the common case): distance 0, no inverse needed.
+        if transform::inside(&self.t, x, lo, hi) {
+            return true;
+        }
+        let Some((f, q)) = &self.frame else {
+            return false;
+        };
+        // In y the distance is |y - T x|_Q with Q = T^-T P T^-1 (approximately).
+        let n = x.len();
+        with_buffer(2 * n, 0.0, |buf| {
+            let (tx, y) = buf.split_at_mut(n);
+            f.to_y_point(x, tx);
+            nearest_in_box(q, tx, lo, hi, y);
+            f.certify(&self.p, x, y, r)
+        })
+    }
 }
 
 /// A row-major `n x n` matrix by rows.
@@ -417,16 +454,18 @@ fn rows(m: &[f64], n: usize) -> Vec<Vec<f64>> {
     m.chunks(n).map(<[f64]>::to_vec).collect()
 }
 
-/// A point of the box `[lo, hi]` near the minimiser of `(y - x)' P (y - x)` (projected
+/// A point `y` of the box `[lo, hi]` near the minimiser of `(y - x)' P (y - x)` (projected
 /// coordinate descent; the problem is convex, and any point of the box is a valid candidate, so
 /// a few sweeps suffice).
 ///
 /// A sweep is a function of `y`'s bits alone: once one leaves them all unchanged, so would the
 /// rest of the 50, and the loop stops there with the same point (the Monte Carlo check calls
 /// this for every sample state near a set's boundary, most of which converge in a few sweeps).
-fn nearest_in_box(p: &[Vec<f64>], x: &[f64], lo: &[f64], hi: &[f64]) -> Vec<f64> {
+fn nearest_in_box(p: &[Vec<f64>], x: &[f64], lo: &[f64], hi: &[f64], y: &mut [f64]) {
     let n = x.len();
-    let mut y: Vec<f64> = (0..n).map(|i| x[i].clamp(lo[i], hi[i])).collect();
+    for i in 0..n {
+        y[i] = x[i].clamp(lo[i], hi[i]);
+    }
     for _ in 0..50 {
         let mut moved = false;
         for i in 0..n {
@@ -448,5 +487,4 @@ fn nearest_in_box(p: &[Vec<f64>], x: &[f64], lo: &[f64], hi: &[f64]) -> Vec<f64>
             break;
         }
     }
-    y
 }

@@ -12,6 +12,7 @@ use crate::model::{Transform, TransformSource};
 use crate::prs::TransformUsed;
 
 /// A transform ready for the engine: `T` and an enclosure of `T^-1`, both n x n row-major.
+#[derive(Clone, Debug)]
 pub(crate) struct Frame {
     n: usize,
     t: Vec<f64>,
@@ -146,25 +147,34 @@ impl Frame {
 
     /// Whether `|x - T^-1 y|_P^2 <= r^2` certainly (interval arithmetic), `p` by rows.
     pub(crate) fn certify(&self, p: &[Vec<f64>], x: &[f64], y: &[f64], r: f64) -> bool {
-        let yi: Vec<Interval> = y.iter().map(|&v| Interval::point(v)).collect();
-        let d: Vec<Interval> = self
-            .t_inv
-            .chunks(self.n)
-            .zip(x)
-            .map(|(row, &xi)| Interval::point(xi) - dot(row, &yi))
-            .collect();
-        quad_form_at_most(p, &d, r)
+        with_buffer(self.n, Interval::ZERO, |d| {
+            for ((di, row), &xi) in d.iter_mut().zip(self.t_inv.chunks(self.n)).zip(x) {
+                // `dot(row, y)` with `y` as point intervals.
+                let ty = row
+                    .iter()
+                    .zip(y)
+                    .fold(Interval::ZERO, |acc, (&a, &b)| acc + a * Interval::point(b));
+                *di = Interval::point(xi) - ty;
+            }
+            quad_form_at_most(p, d, r)
+        })
     }
 
-    /// `T x` and the metric `S' P S` of `y`, in floating point: where to look for the point of
-    /// the y-box nearest to `x` (any point found is then certified by [`Frame::certify`]).
-    pub(crate) fn y_problem(&self, p: &[Vec<f64>], x: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
+    /// `T x` in floating point, into `out`: where to look for the point of the y-box nearest to `x` (any
+    /// point found is then certified by [`Frame::certify`]).
+    pub(crate) fn to_y_point(&self, x: &[f64], out: &mut [f64]) {
         let n = self.n;
-        let tx = (0..n)
-            .map(|i| (0..n).map(|j| self.t[i * n + j] * x[j]).sum())
-            .collect();
+        for (i, o) in out.iter_mut().enumerate().take(n) {
+            *o = (0..n).map(|j| self.t[i * n + j] * x[j]).sum();
+        }
+    }
+
+    /// The metric `S' P S` of `y`, in floating point (with [`Frame::to_y_point`], the
+    /// problem of the nearest point of a y-box).
+    pub(crate) fn y_metric(&self, p: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let n = self.n;
         let s = |i: usize, j: usize| self.s[i * n + j];
-        let q = (0..n)
+        (0..n)
             .map(|a| {
                 (0..n)
                     .map(|b| {
@@ -175,8 +185,7 @@ impl Frame {
                     })
                     .collect()
             })
-            .collect();
-        (tx, q)
+            .collect()
     }
 
     /// The transform as used, for the result.
@@ -187,6 +196,17 @@ impl Frame {
             inverse_error: self.e,
             source: self.source,
         }
+    }
+}
+
+/// `f` of a buffer of `n` values `zero`: on the stack for small `n` (the Monte Carlo check
+/// calls the exact tests for many states; no allocation each time).
+pub(crate) fn with_buffer<T: Copy, R>(n: usize, zero: T, f: impl FnOnce(&mut [T]) -> R) -> R {
+    const SMALL: usize = 8;
+    if n <= SMALL {
+        f(&mut [zero; SMALL][..n])
+    } else {
+        f(&mut vec![zero; n])
     }
 }
 

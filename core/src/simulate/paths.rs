@@ -27,9 +27,10 @@ use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
 use super::noise::Noise;
 use super::normal::Ziggurat;
-use super::prs::{diag_quad, diag_quad_to_box, quad_small, Membership, Metric, Tube};
+use super::prs::{diag_quad, diag_quad_to_box, lanes, quad_small, Membership, Metric, Tube};
 use super::regions::Region;
 use super::rng::PathRng;
+use crate::lanes::X8;
 use crate::system::System;
 use std::ops::Range;
 
@@ -560,6 +561,27 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
     }
 
+    /// [`report`](Self::report)'s "quiet" answer for eight states in lanes (`(q, a)` their
+    /// distances): bit `l` set when lane `l` needs no record, the same answer as for that
+    /// state alone.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn quiet_x8(&self, rep: &Report<'_>, shortcuts: bool, x: &[X8], q: X8, a: X8) -> u8 {
+        match rep.quiet {
+            Some(b) => lanes(|l| q.0[l] < b),
+            None if shortcuts => {
+                let near = lanes(|l| q.0[l] < rep.thr);
+                if near == 0 {
+                    return 0;
+                }
+                near & self
+                    .membership
+                    .inside_by_shortcut_x8(&self.metric, rep.k, x, q, a)
+            }
+            None => 0,
+        }
+    }
+
     /// [`step_lanes`](Self::step_lanes) for additive diagonal noise, no inputs, no unsafe sets
     /// or domain, at most [`SMALL`] states, a non-negative diagonal metric and (at a report
     /// time) a bound from [`Lanes::quiet`]: the hot loop of most linear and many nonlinear
@@ -652,7 +674,6 @@ impl<S: System + ?Sized> Plan<'_, S> {
         thresholds: &[f64],
         st: &mut ChunkStats,
     ) {
-        use crate::lanes::X8;
         let n = dim.get();
         let (Some(g), Some(w)) = (self.noise.diagonal(), self.metric.nonneg_diagonal()) else {
             unreachable!("the caller checks additive diagonal noise and metric");
@@ -736,7 +757,6 @@ impl<S: System + ?Sized> Plan<'_, S> {
         thresholds: &[f64],
         st: &mut ChunkStats,
     ) {
-        use crate::lanes::X8;
         let (n, m) = (dim.get(), self.sys.m());
         let mut live = 0u8;
         for (a, path) in paths.iter().enumerate() {
@@ -768,19 +788,28 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     Some(tube) => tube.inside_by_shortcut_x8(&self.metric, k, &xs[..n]),
                     None => 0xff,
                 };
-                let (q, qa) = match &report {
-                    Some(rep) => quad_small(&upper, &xs[..n], rep.c),
-                    None if inside == 0xff => continue,
-                    None => (X8::splat(0.0), X8::splat(0.0)),
-                };
-                for (a, path) in paths.iter_mut().enumerate() {
-                    if !path.alive {
-                        if report.is_some() {
-                            st.ended(k);
-                        }
-                        continue;
+                // The lanes with something to do: at a report time, the ended paths and those
+                // not settled by the shortcuts of the tube and of `report`; between report
+                // times, the live paths the tube's shortcut did not settle.
+                let (q, qa, quiet) = match &report {
+                    Some(rep) => {
+                        let (q, qa) = quad_small(&upper, &xs[..n], rep.c);
+                        (q, qa, self.quiet_x8(rep, shortcuts, &xs[..n], q, qa))
                     }
-                    if report.is_none() && inside >> a & 1 == 1 {
+                    None => (X8::splat(0.0), X8::splat(0.0), 0xff),
+                };
+                let mut busy = if report.is_some() {
+                    !live | !(inside & quiet)
+                } else {
+                    live & !inside
+                };
+                // Lane by lane in order, as the scalar loops go path by path.
+                while busy != 0 {
+                    let a = busy.trailing_zeros() as usize;
+                    busy &= busy - 1;
+                    let path = &mut paths[a];
+                    if !path.alive {
+                        st.ended(k);
                         continue;
                     }
                     let xa: [f64; SMALL] = std::array::from_fn(|j| xs[j].0[a]);
@@ -788,8 +817,9 @@ impl<S: System + ?Sized> Plan<'_, S> {
                         self.tube_slow(k, &xa[..n], path, st);
                     }
                     if let Some(rep) = &report {
-                        let qa = (q.0[a], qa.0[a]);
-                        self.report(rep, qa, shortcuts, &xa[..n], path, st);
+                        if quiet >> a & 1 == 0 {
+                            self.record(k, &xa[..n], (q.0[a], qa.0[a]), rep.thr, st, path);
+                        }
                         if !path.alive {
                             live &= !(1 << a);
                         }

@@ -10,7 +10,12 @@
 //!   outside the PRS;
 //! * inside: for `"p_ball"`, `|x - x*_t|_P` clearly below the radius; for `"box"`, `x` in the
 //!   box (a subset of the PRS `box (+) B_P(r_t)`); for `"parallelotope"`, `T x` clearly in the
-//!   box `[lo, hi]` of `y = T x` (where `contains` also answers at once).
+//!   box `[lo, hi]` of `y = T x` (where `contains` also answers at once); for both, also
+//!   `|x - c|_P` clearly below `r_t` when the deterministic set certainly holds its centre `c`
+//!   (then `B_P(c, r_t)` lies in the PRS, and `contains` asks that ball too).
+//!
+//! The shortcuts are also computed for eight states at once in vector lanes
+//! ([`Membership::inside_by_shortcut_x8`]), with the same operations per lane.
 //!
 //! "Clearly" means by more than a bound on the rounding errors of both computations:
 //! `|q_computed - q| <= gamma * sum |w_ij d_i d_j|` with `gamma` a generous multiple of the unit
@@ -39,6 +44,7 @@
 //! inside the tube when it is not.
 
 use super::paths::SMALL;
+use crate::engine::interval::ParallelotopeTest;
 use crate::interval::Interval;
 use crate::lanes::{Real, X8};
 use crate::prs::{DetSet, Prs};
@@ -233,6 +239,8 @@ enum Shape {
         t: Vec<f64>,
         lo: Vec<f64>,
         hi: Vec<f64>,
+        /// The exact test (`Prs::contains_at`'s), built once.
+        exact: Box<ParallelotopeTest>,
     },
     /// Anything else: always ask `contains`.
     Other,
@@ -277,6 +285,7 @@ impl Shape {
                 t: tr.matrix.clone(),
                 lo,
                 hi,
+                exact: Box::new(ParallelotopeTest::new(&result.constants.metric, tr, n)),
             },
             _ => Shape::Other,
         }
@@ -344,6 +353,29 @@ impl<'a> Membership<'a> {
         true
     }
 
+    /// [`inside_by_shortcut`](Self::inside_by_shortcut) of eight states in lanes (state `i` of
+    /// path `l` in lane `l` of `x[i]`, `(q, a)` the lanes' `metric.quad`): bit `l` set when
+    /// lane `l` is inside by the shortcuts, the same answer as for that state alone.
+    #[inline(always)]
+    pub(crate) fn inside_by_shortcut_x8(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[X8],
+        q: X8,
+        a: X8,
+    ) -> u8 {
+        let mut mask = self.own.inside_by_shortcut_x8(metric, k, x, || (q, a));
+        for (m, s) in &self.also {
+            if mask == 0 {
+                break;
+            }
+            let c = s.centre(k);
+            mask &= s.inside_by_shortcut_x8(m, k, x, || m.quad_by(|i| x[i] - X8::from(c[i])));
+        }
+        mask
+    }
+
     /// Whether the finite state `x` is in the PRS of step `k`, given the centre `c = x*_k` and
     /// `(q, a) = metric.quad(x, c)`: in every member's set (`Prs::contains_at`'s answer, each
     /// set decided by its shortcuts where they hold).
@@ -404,6 +436,12 @@ struct OneSet<'a> {
     /// Per step, whether the set is the whole P-ball of the PRS radius (for [`Shape::PBall`]:
     /// else, the initial box at `t = 0`, only "clearly outside" is decided by the ball).
     ball: Vec<bool>,
+    /// Per step, whether a box or a parallelotope certainly holds its centre (then the PRS
+    /// holds the P-ball of radius `r_t` around it); the squared `r_t` and, with a non-negative
+    /// diagonal metric, the "clearly inside" bound of that ball.
+    holds: Vec<bool>,
+    rt2: Vec<f64>,
+    rt_in: Vec<f64>,
 }
 
 impl<'a> OneSet<'a> {
@@ -432,6 +470,17 @@ impl<'a> OneSet<'a> {
             .iter()
             .map(|s| matches!(s.det, DetSet::Ball { .. }))
             .collect();
+        let holds = (0..result.steps.len())
+            .map(|k| {
+                matches!(shape, Shape::Box { .. } | Shape::Parallelotope { .. })
+                    && result.holds_center(k)
+            })
+            .collect();
+        let rt2: Vec<f64> = result.steps.iter().map(|s| s.r_t * s.r_t).collect();
+        let rt_in = rt2
+            .iter()
+            .map(|r| r * (1.0 - eps16) / (1.0 + metric.gamma))
+            .collect();
         OneSet {
             result,
             shape,
@@ -441,6 +490,9 @@ impl<'a> OneSet<'a> {
             nonneg: metric.nonneg,
             n,
             ball,
+            holds,
+            rt2,
+            rt_in,
         }
     }
 
@@ -507,10 +559,109 @@ impl<'a> OneSet<'a> {
                 let (q, a) = quad();
                 self.clearly(metric, k, q, a).1
             }
-            Shape::Box { lo, hi } => self.in_box(lo, hi, k, x),
-            Shape::Parallelotope { t, lo, hi } => self.in_parallelotope(t, lo, hi, k, x),
+            Shape::Box { lo, hi } => {
+                self.in_box(lo, hi, k, x) || self.near_centre_by(metric, k, quad)
+            }
+            Shape::Parallelotope { t, lo, hi, .. } => {
+                self.in_parallelotope(t, lo, hi, k, x) || self.near_centre_by(metric, k, quad)
+            }
             Shape::Other => false,
         }
+    }
+
+    /// [`inside_by_shortcut_with`](Self::inside_by_shortcut_with) of eight states in lanes:
+    /// bit `l` set when lane `l` is inside by the shortcut, the same answer as for that state
+    /// alone (the same operations per lane).
+    #[inline(always)]
+    fn inside_by_shortcut_x8(
+        &self,
+        metric: &Metric,
+        k: usize,
+        x: &[X8],
+        quad: impl FnOnce() -> (X8, X8),
+    ) -> u8 {
+        match &self.shape {
+            Shape::PBall => {
+                let (q, a) = quad();
+                let mut mask = 0;
+                for l in 0..8 {
+                    mask |= u8::from(self.clearly(metric, k, q.0[l], a.0[l]).1) << l;
+                }
+                mask
+            }
+            Shape::Box { lo, hi } => {
+                let (lo, hi) = (&lo[k * self.n..][..self.n], &hi[k * self.n..][..self.n]);
+                let mut mask = 0xff;
+                for ((v, &l), &h) in x.iter().zip(lo).zip(hi) {
+                    mask &= lanes(|a| l <= v.0[a] && v.0[a] <= h);
+                }
+                mask | self.near_centre_x8(metric, k, mask, quad)
+            }
+            Shape::Parallelotope { t, lo, hi, .. } => {
+                let n = self.n;
+                let (lo, hi, x) = (&lo[k * n..][..n], &hi[k * n..][..n], &x[..n]);
+                let rel = 16.0 * (n as f64 + 2.0) * f64::EPSILON;
+                // `in_parallelotope`'s operations, lane by lane.
+                let mut mask = 0xff;
+                for ((row, &a), &b) in t.chunks_exact(n).zip(lo).zip(hi) {
+                    let (mut y, mut s) = (X8::splat(0.0), X8::splat(0.0));
+                    for (&tij, &xj) in row.iter().zip(x) {
+                        let p = tij * xj;
+                        y = y + p;
+                        s = s + p.abs();
+                    }
+                    let margin = rel * s + f64::MIN_POSITIVE;
+                    let (below, above) = (y - margin, y + margin);
+                    mask &= lanes(|l| a <= below.0[l] && above.0[l] <= b);
+                }
+                mask | self.near_centre_x8(metric, k, mask, quad)
+            }
+            Shape::Other => 0,
+        }
+    }
+
+    /// Whether `(q, a)` (from [`Metric::quad`] around the centre of step `k`) clearly puts
+    /// the state in `B_P(c, r_t)`, which a box's or a parallelotope's PRS holds when its
+    /// deterministic set holds its centre `c` (`Prs::contains_at` asks the same first).
+    #[inline(always)]
+    fn near_centre(&self, metric: &Metric, k: usize, q: f64, a: f64) -> bool {
+        self.holds[k]
+            && if self.nonneg {
+                q < self.rt_in[k]
+            } else {
+                q + (metric.gamma * a + 8.0 * f64::EPSILON * self.rt2[k]) < self.rt2[k]
+            }
+    }
+
+    /// [`near_centre`](Self::near_centre), with `(q, a)` computed only if the set holds its
+    /// centre.
+    #[inline(always)]
+    fn near_centre_by(&self, metric: &Metric, k: usize, quad: impl FnOnce() -> (f64, f64)) -> bool {
+        self.holds[k] && {
+            let (q, a) = quad();
+            self.near_centre(metric, k, q, a)
+        }
+    }
+
+    /// [`near_centre`](Self::near_centre) of eight states in lanes, for the lanes not already
+    /// in `mask` (`(q, a)` computed only if one is left).
+    #[inline(always)]
+    fn near_centre_x8(
+        &self,
+        metric: &Metric,
+        k: usize,
+        mask: u8,
+        quad: impl FnOnce() -> (X8, X8),
+    ) -> u8 {
+        if mask == 0xff || !self.holds[k] {
+            return 0;
+        }
+        let (q, a) = quad();
+        let mut near = 0;
+        for l in 0..8 {
+            near |= u8::from(self.near_centre(metric, k, q.0[l], a.0[l])) << l;
+        }
+        near
     }
 
     /// `T x` clearly in the box `[lo, hi]` of step `k`: then the outward-rounded `T x` that
@@ -572,22 +723,36 @@ impl<'a> OneSet<'a> {
                 if clearly_out {
                     return false;
                 }
-                if self.in_box(lo, hi, k, x) {
+                if self.in_box(lo, hi, k, x) || self.near_centre(metric, k, q, a) {
                     return true;
                 }
             }
-            Shape::Parallelotope { t, lo, hi } => {
+            Shape::Parallelotope { t, lo, hi, exact } => {
                 if clearly_out {
                     return false;
                 }
                 if self.in_parallelotope(t, lo, hi, k, x) {
                     return true;
                 }
+                if self.near_centre(metric, k, q, a) {
+                    return true;
+                }
+                return self.result.own_contains_at_with(k, x, Some(exact));
             }
             Shape::Other => {}
         }
         self.result.own_contains_at(k, x)
     }
+}
+
+/// The mask of the lanes `l` for which `f(l)` holds (bit `l`).
+#[inline(always)]
+pub(crate) fn lanes(f: impl Fn(usize) -> bool) -> u8 {
+    let mut mask = 0;
+    for l in 0..8 {
+        mask |= u8::from(f(l)) << l;
+    }
+    mask
 }
 
 /// Decides membership in the spans of a time-uniform result (see the module's notes): the
@@ -779,7 +944,18 @@ impl<'a> OneSpan<'a> {
     #[inline(always)]
     fn quad_to_box<T: Real>(&self, metric: &Metric, k: usize, x: &[T]) -> (T, T) {
         let (lo, hi, _) = self.diag_bounds(k);
-        metric.quad_by(|i| x[i] - x[i].clamp_with(|v| clamp(v, lo[i], hi[i])))
+        let d = |i: usize| x[i] - x[i].clamp_with(|v| clamp(v, lo[i], hi[i]));
+        if x.len() <= SMALL {
+            // Each difference once (the terms use each several times; the same bits).
+            // A loop rather than `array::from_fn`, whose closure is not inlined here.
+            let mut ds = [T::from(0.0); SMALL];
+            for (i, di) in ds.iter_mut().enumerate().take(x.len()) {
+                *di = d(i);
+            }
+            metric.quad_by(|i| ds[i])
+        } else {
+            metric.quad_by(d)
+        }
     }
 
     /// Whether `x` is, by the "inside" shortcut alone, in the span of step `k` (`false` says
@@ -798,8 +974,8 @@ impl<'a> OneSpan<'a> {
     #[inline(always)]
     fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
         let (q, a) = self.quad_to_box(metric, k, x);
-        // Loops rather than iterator adapters, which might not be inlined into the vector
-        // loop (and would then work on the lanes one by one).
+        // A loop rather than a closure or iterator adapters, which might not be inlined into
+        // the vector loop (and would then work on the lanes one by one).
         let mut mask = 0;
         for l in 0..8 {
             let inside = self.in_box(k, x, |x| x.0[l]) || self.close(metric, k, q.0[l], a.0[l]);
@@ -1003,6 +1179,70 @@ mod tests {
         r
     }
 
+    /// The lanes' shortcut (`inside_by_shortcut_x8`) against the scalar one, state by state:
+    /// eight states at a time from `xs`, distances around `c`.
+    fn lanes_agree(mem: &Membership<'_>, m: &Metric, k: usize, c: &[f64], xs: &[[f64; 2]]) {
+        for chunk in xs.chunks_exact(8) {
+            let x8: Vec<X8> = (0..2)
+                .map(|i| X8(std::array::from_fn(|l| chunk[l][i])))
+                .collect();
+            let (q, a) = quad_small(&m.upper(), &x8, c);
+            let mask = mem.inside_by_shortcut_x8(m, k, &x8, q, a);
+            for (l, x) in chunk.iter().enumerate() {
+                let (q, a) = m.quad(x, c);
+                let one = mem.inside_by_shortcut(m, k, x, q, a);
+                assert_eq!(mask >> l & 1 == 1, one, "k = {k}, lane {l}, x = {x:?}");
+            }
+        }
+    }
+
+    /// States in and around the P-ball of radius `1.5 r_t` about the centre of each step, for
+    /// boxes and parallelotopes: the ball of radius `r_t` decides many of those outside the
+    /// deterministic set (`near_centre`), and every shortcut, in lanes or alone, agrees with
+    /// `Prs::contains_at`.
+    #[test]
+    fn the_ball_around_the_centre_decides_states_outside_the_set() {
+        let mut rng = PathRng::new(8, 0);
+        let mut by_ball = 0;
+        for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
+            for r in [
+                parallelotope(metric.clone()),
+                result(Method::Interval, metric.clone(), false),
+            ] {
+                let m = Metric::new(&r.constants.metric, 2);
+                let mem = Membership::new(&r, &m);
+                for (k, st) in r.steps.iter().enumerate() {
+                    let c = st.nominal();
+                    let mut xs = Vec::new();
+                    for _ in 0..400 {
+                        let dir = [rng.uniform() - 0.5, rng.uniform() - 0.5];
+                        let (q1, _) = m.quad(&[c[0] + dir[0], c[1] + dir[1]], c);
+                        let scale = 1.5 * rng.uniform() * st.r_t / q1.sqrt();
+                        let x = [c[0] + scale * dir[0], c[1] + scale * dir[1]];
+                        let (q, a) = m.quad(&x, c);
+                        let exact = r.contains_at(k, &x);
+                        assert_eq!(mem.inside(&m, k, &x, c, q, a), exact, "k = {k}");
+                        if mem.inside_by_shortcut(&m, k, &x, q, a) {
+                            assert!(exact, "k = {k}: shortcut");
+                            let (lo, hi) = st.det.corners().expect("corners");
+                            let y = match &r.transform {
+                                Some(_) => [x[0] + 0.2 * x[1], x[0]],
+                                None => x,
+                            };
+                            if (0..2).any(|i| y[i] < lo[i] || y[i] > hi[i]) {
+                                by_ball += 1;
+                            }
+                        }
+                        xs.push(x);
+                    }
+                    lanes_agree(&mem, &m, k, c, &xs);
+                }
+            }
+        }
+        // Not vacuous.
+        assert!(by_ball > 1000, "{by_ball}");
+    }
+
     /// Points near the faces of the parallelotopes, just inside and just outside: the
     /// shortcut's "inside" always agrees with `Prs::contains_at`.
     #[test]
@@ -1018,6 +1258,7 @@ mod tests {
                 let DetSet::Parallelotope { lo, hi, .. } = &st.det else {
                     panic!("a parallelotope")
                 };
+                let mut xs = Vec::new();
                 for i in 0..400 {
                     // y uniform in the box, then one coordinate moved to a face, off by a few
                     // ulps to a relative 1e-6 either way.
@@ -1029,6 +1270,7 @@ mod tests {
                     let off = (rng.uniform() - 0.5) * [1e-15, 1e-12, 1e-6, 0.0][i / 2 % 4];
                     y[j] = face * (1.0 + off);
                     let x = [y[1], 5.0 * (y[0] - y[1])];
+                    xs.push(x);
                     let (q, a) = m.quad(&x, st.nominal());
                     let exact = r.contains_at(k, &x);
                     assert_eq!(mem.inside(&m, k, &x, st.nominal(), q, a), exact, "k = {k}");
@@ -1037,6 +1279,7 @@ mod tests {
                         shortcut += 1;
                     }
                 }
+                lanes_agree(&mem, &m, k, st.nominal(), &xs);
             }
         }
         // Not vacuous: points off the faces by 1e-6 are decided by the shortcut.
@@ -1133,6 +1376,7 @@ mod tests {
             let mem = Membership::new(&r, &m);
             for (k, st) in r.steps.iter().enumerate() {
                 let c = st.nominal();
+                let mut xs = Vec::new();
                 for i in 0..400 {
                     // A random direction, scaled to a P-distance s * prs_radius.
                     let dir = [rng.uniform() - 0.5, rng.uniform() - 0.5];
@@ -1145,6 +1389,7 @@ mod tests {
                     };
                     let scale = s * st.prs_radius / q1.sqrt();
                     let x = [c[0] + scale * dir[0], c[1] + scale * dir[1]];
+                    xs.push(x);
                     let (q, a) = m.quad(&x, c);
                     assert_eq!((q, a), quad_small(&m.upper(), &x, c));
                     let fast = mem.inside(&m, k, &x, c, q, a);
@@ -1156,6 +1401,7 @@ mod tests {
                         assert!(exact, "{method:?} k = {k} s = {s}: shortcut");
                     }
                 }
+                lanes_agree(&mem, &m, k, c, &xs);
             }
         }
     }
