@@ -160,8 +160,8 @@ impl Frame {
         })
     }
 
-    /// `T x` in floating point, into `out`: where to look for the point of the y-box nearest to `x` (any
-    /// point found is then certified by [`Frame::certify`]).
+    /// `T x` in floating point, into `out`: where to look for the point of the y-box nearest
+    /// to `x` (any point found is then certified by [`Frame::certify`]).
     pub(crate) fn to_y_point(&self, x: &[f64], out: &mut [f64]) {
         let n = self.n;
         for (i, o) in out.iter_mut().enumerate().take(n) {

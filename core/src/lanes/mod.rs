@@ -8,7 +8,6 @@
 
 mod sin;
 
-pub use sin::agrees as sin_agrees_with_libm;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// Eight `f64` lanes.

@@ -89,7 +89,7 @@ impl X8 {
 
 /// Whether the library's `sin` is the code [`small`] follows, on arguments spread over its
 /// range (checked once per process).
-pub fn agrees() -> bool {
+pub(crate) fn agrees() -> bool {
     static AGREES: OnceLock<bool> = OnceLock::new();
     *AGREES.get_or_init(|| agrees_with(f64::sin))
 }
