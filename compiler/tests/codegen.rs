@@ -66,8 +66,8 @@ fn every_shipped_spec_generates_parsable_deterministic_code() {
         ] {
             assert!(code.contains(&format!("fn {method}(")), "{name}: {method}");
         }
-        // The drift in lanes exactly for small models without inputs.
-        let lanes = model.inputs.is_empty() && model.states.len() <= LANES_MAX_STATES;
+        // The drift in lanes exactly for small models.
+        let lanes = model.states.len() <= LANES_MAX_STATES;
         assert_eq!(code.contains("fn drift_x8("), lanes, "{name}: drift_x8");
         assert!(code.contains("pub fn info() -> reachc_runtime::model::ModelInfo"));
         assert!(code.contains(&format!("pub const N: usize = {};", model.states.len())));
@@ -201,7 +201,7 @@ fn method_text<'a>(code: &'a str, name: &str) -> &'a str {
 }
 
 #[test]
-fn small_models_without_inputs_get_a_drift_in_lanes() {
+fn small_models_get_a_drift_in_lanes() {
     // tests/good/lanes.sde: no inputs, four states, every function of lanes and of `t` alone.
     let lanes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/good/lanes.sde");
     let (model, code, _) = generate_for(&lanes);
@@ -209,7 +209,8 @@ fn small_models_without_inputs_get_a_drift_in_lanes() {
     let x8 = method_text(&code, "drift_x8");
     assert!(
         x8.starts_with(
-            "fn drift_x8(\n        &self,\n        x: &[reachc_runtime::X8],\n        t: f64,\n        \
+            "fn drift_x8(\n        &self,\n        x: &[reachc_runtime::X8],\n        \
+             _u: &[reachc_runtime::X8],\n        t: f64,\n        \
              out: &mut [reachc_runtime::X8],\n    )"
         ),
         "{x8}"
@@ -256,11 +257,15 @@ fn small_models_without_inputs_get_a_drift_in_lanes() {
         assert!(x8.contains(snippet), "missing {snippet:?}:\n{x8}");
     }
 
-    // With an input (the Rust keywords' `where`), more states (linear_n: 10) or a drift split
-    // into helpers: no drift_x8 (the trait's default, per lane).
+    // With an input (the Rust keywords' `where`): the input in lanes, as the states.
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let (model, code, _) = generate_for(&root.join("tests/good/rust_keywords.sde"));
-    assert!(!model.inputs.is_empty() && !code.contains("X8"), "{code}");
+    assert_eq!(model.inputs.len(), 1);
+    let x8 = method_text(&code, "drift_x8");
+    assert!(x8.contains("u: &[reachc_runtime::X8],"), "{x8}");
+    assert!(x8.contains("u[0]") && !x8.contains("splat(u[0])"), "{x8}");
+    // With more states (linear_n: 10) or a drift split into helpers: no drift_x8 (the trait's
+    // default, per lane).
     let (model, code, _) = generate_for(&root.join("specs/linear_n.sde"));
     assert!(
         model.states.len() > LANES_MAX_STATES && !code.contains("X8"),

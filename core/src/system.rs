@@ -21,25 +21,29 @@ pub trait System {
     fn m(&self) -> usize;
     /// `out[i] = f_i(x, u, t)`; `out.len() == n`.
     fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]);
-    /// The drift of eight states at once, for models without inputs (`p == 0`): lane `l` of
-    /// `out[i]` is `f_i` at the state in lane `l` of `x`, bit for bit what
+    /// The drift of eight states and inputs at once: lane `l` of `out[i]` is `f_i` at the
+    /// state in lane `l` of `x` and the input in lane `l` of `u`, bit for bit what
     /// [`System::drift`] gives (the Monte Carlo simulator relies on it). The default calls
     /// `drift` once per lane; generated code evaluates the same expressions over [`X8`].
-    fn drift_x8(&self, x: &[X8], t: f64, out: &mut [X8]) {
-        let n = x.len();
-        let (mut small, mut heap) = ([0.0; 16], Vec::new());
-        let buf = if 2 * n <= small.len() {
-            &mut small[..2 * n]
+    fn drift_x8(&self, x: &[X8], u: &[X8], t: f64, out: &mut [X8]) {
+        let (n, p) = (x.len(), u.len());
+        let (mut small, mut heap) = ([0.0; 24], Vec::new());
+        let buf = if 2 * n + p <= small.len() {
+            &mut small[..2 * n + p]
         } else {
-            heap.resize(2 * n, 0.0);
+            heap.resize(2 * n + p, 0.0);
             &mut heap[..]
         };
-        let (xs, fs) = buf.split_at_mut(n);
+        let (xs, rest) = buf.split_at_mut(n);
+        let (us, fs) = rest.split_at_mut(p);
         for l in 0..8 {
             for (xi, x) in xs.iter_mut().zip(x) {
                 *xi = x.0[l];
             }
-            self.drift(xs, &[], t, fs);
+            for (uj, u) in us.iter_mut().zip(u) {
+                *uj = u.0[l];
+            }
+            self.drift(xs, us, t, fs);
             for (o, f) in out.iter_mut().zip(&*fs) {
                 o.0[l] = *f;
             }

@@ -43,7 +43,7 @@ impl System for Linear {
         out[1] = v8;
     }
     #[inline]
-    fn drift_x8(&self, x: &[X8], _t: f64, out: &mut [X8]) {
+    fn drift_x8(&self, x: &[X8], _u: &[X8], _t: f64, out: &mut [X8]) {
         let v6 = -(0.4 * x[0]);
         let v8 = -(0.4 * x[1]);
         out[0] = v6;

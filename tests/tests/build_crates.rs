@@ -473,12 +473,11 @@ fn small_crates_compile_clippy_clean_and_run() {
 }
 
 /// The program replacing a generated crate's `src/main.rs`: for each line of stdin (a point
-/// `x, u, t` then a box `(lo, hi)` per state, input and time, and for a model without inputs
-/// eight more states, the lanes, one after the other, as f64 bit patterns in hex), it prints,
-/// for the model and then each of its frames, drift, `D_x f`, `D_u f`, `G` at the point, then
-/// their interval versions and the sparse `D_x f` on the box (`lo hi` per entry), then (no
-/// inputs) `drift_x8` of the lanes at `t` (lane by lane for each entry), all as hex bit patterns
-/// on one line.
+/// `x, u, t` then a box `(lo, hi)` per state, input and time, then eight more states and inputs,
+/// the lanes, one after the other, as f64 bit patterns in hex), it prints, for the model and
+/// then each of its frames, drift, `D_x f`, `D_u f`, `G` at the point, then their interval
+/// versions and the sparse `D_x f` on the box (`lo hi` per entry), then `drift_x8` of the lanes
+/// at `t` (lane by lane for each entry), all as hex bit patterns on one line.
 fn probe_main(crate_ident: &str, type_name: &str) -> String {
     format!(
         r#"use std::io::{{BufRead, Write}};
@@ -493,7 +492,7 @@ fn dump(
     sys: &dyn System,
     (x, u, t): (&[f64], &[f64], f64),
     (xi, ui, ti): (&[Interval], &[Interval], Interval),
-    lanes: Option<&[X8]>,
+    (lx, lu): (&[X8], &[X8]),
     words: &mut Vec<String>,
 ) {{
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
@@ -522,13 +521,11 @@ fn dump(
         words.push(format!("{{:016x}}", v.lo().to_bits()));
         words.push(format!("{{:016x}}", v.hi().to_bits()));
     }}
-    if let Some(lanes) = lanes {{
-        // NaN where nothing is written: a missing store shows.
-        let mut f8 = vec![X8::splat(f64::NAN); n];
-        sys.drift_x8(lanes, t, &mut f8);
-        for v in f8.iter().flat_map(|v| v.0) {{
-            words.push(format!("{{:016x}}", v.to_bits()));
-        }}
+    // NaN where nothing is written: a missing store shows.
+    let mut f8 = vec![X8::splat(f64::NAN); n];
+    sys.drift_x8(lx, lu, t, &mut f8);
+    for v in f8.iter().flat_map(|v| v.0) {{
+        words.push(format!("{{:016x}}", v.to_bits()));
     }}
 }}
 
@@ -546,9 +543,9 @@ fn main() {{
         let ui: Vec<Interval> = (n..n + p).map(iv).collect();
         let ti = iv(n + p);
         let l = &b[2 * (n + p + 1)..];
-        let lanes: Option<Vec<X8>> = (p == 0)
-            .then(|| (0..n).map(|i| X8(std::array::from_fn(|k| l[k * n + i]))).collect());
-        let lanes = lanes.as_deref();
+        let lane = |i: usize| X8(std::array::from_fn(|k| l[k * (n + p) + i]));
+        let (lx, lu): (Vec<X8>, Vec<X8>) = ((0..n).map(lane).collect(), (n..n + p).map(lane).collect());
+        let lanes = (&lx[..], &lu[..]);
         let mut words: Vec<String> = Vec::new();
         dump(&sys, (x, u, t), (&xi, &ui, ti), lanes, &mut words);
         let mut k = 0;
@@ -612,8 +609,8 @@ fn evaluate(sys: &dyn System, s: &Sample) -> Values {
 }
 
 /// A point and a box around it: states near their initial set, inputs in their box, time in
-/// [0, 6] (past the end of the unicycle's table); for a model without inputs, the eight states
-/// of `drift_x8`'s lanes.
+/// [0, 6] (past the end of the unicycle's table); and the eight states and inputs of
+/// `drift_x8`'s lanes.
 struct Sample {
     x: Vec<f64>,
     u: Vec<f64>,
@@ -621,7 +618,7 @@ struct Sample {
     xi: Vec<Interval>,
     ui: Vec<Interval>,
     ti: Interval,
-    lanes: Vec<Vec<f64>>,
+    lanes: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 fn sample(model: &Model, rng: &mut Rng) -> Sample {
@@ -643,23 +640,26 @@ fn sample(model: &Model, rng: &mut Rng) -> Sample {
             .collect()
     };
     let x = state(rng);
-    let u: Vec<f64> = model
-        .input_box
-        .iter()
-        .map(|b| rng.uniform(b.lo, b.hi))
-        .collect();
+    let input = |rng: &mut Rng| -> Vec<f64> {
+        model
+            .input_box
+            .iter()
+            .map(|b| rng.uniform(b.lo, b.hi))
+            .collect()
+    };
+    let u = input(rng);
     let t = rng.uniform(0.0, 6.0);
     let n = model.states.len();
-    // The sample's own state, signed zeros, a wide one and states near the initial set, so
-    // the lanes differ from each other.
-    let lanes = if model.inputs.is_empty() {
-        let mut lanes = vec![x.clone(), vec![0.0; n], vec![-0.0; n]];
-        lanes.push((0..n).map(|_| rng.uniform(-1e3, 1e3)).collect());
-        lanes.extend((0..4).map(|_| state(rng)));
-        lanes
-    } else {
-        Vec::new()
-    };
+    // The sample's own state and input, signed zeros, a wide one and states near the initial
+    // set with inputs in the box, so the lanes differ from each other.
+    let p = model.inputs.len();
+    let mut lanes = vec![
+        (x.clone(), u.clone()),
+        (vec![0.0; n], vec![0.0; p]),
+        (vec![-0.0; n], vec![-0.0; p]),
+        ((0..n).map(|_| rng.uniform(-1e3, 1e3)).collect(), input(rng)),
+    ];
+    lanes.extend((0..4).map(|_| (state(rng), input(rng))));
     Sample {
         xi: x.iter().map(|&v| around(v, rng)).collect(),
         ui: u.iter().map(|&v| around(v, rng)).collect(),
@@ -705,11 +705,11 @@ fn generated_code_agrees_with_the_interpreter() {
     for path in shipped_specs() {
         let model = load(&path).unwrap().model;
         let stem = path.file_stem().unwrap().to_string_lossy();
-        let lanes = model.inputs.is_empty() && model.states.len() <= codegen::LANES_MAX_STATES;
+        let lanes = model.states.len() <= codegen::LANES_MAX_STATES;
         assert!(!lanes || shipped.contains(&&*stem), "{stem} is not probed");
     }
-    // Specs without inputs and with at most four states (generated with `drift_x8`) that the
-    // shipped ones do not cover: every function of values in lanes and of `t` alone, entries of
+    // Specs with at most four states (generated with `drift_x8`) that the shipped ones do not
+    // cover: every function of values in lanes and of `t` alone, entries of
     // `t` alone, constant, zero, and a state itself.
     let lanes_specs =
         ["lanes", "lanes_leaves"].map(|n| workspace().join(format!("tests/good/{n}.sde")));
@@ -743,9 +743,7 @@ fn generated_code_agrees_with_the_interpreter() {
         let written = write_with(&path, &dir, options);
         let mut model = load(&path).unwrap().model;
         // `drift_x8` is generated (else the trait's default, per lane, is what the probe sees).
-        let lanes = model.inputs.is_empty()
-            && model.states.len() <= codegen::LANES_MAX_STATES
-            && options == default;
+        let lanes = model.states.len() <= codegen::LANES_MAX_STATES && options == default;
         let lib = std::fs::read_to_string(dir.join("src/lib.rs")).unwrap();
         assert_eq!(lib.contains("fn drift_x8("), lanes, "{name}: drift_x8");
         let ident = written.crate_name.replace('-', "_");
@@ -770,7 +768,9 @@ fn generated_code_agrees_with_the_interpreter() {
                 words.push(hex(iv.lo()));
                 words.push(hex(iv.hi()));
             }
-            words.extend(s.lanes.iter().flatten().map(|&v| hex(v)));
+            for (x, u) in &s.lanes {
+                words.extend(x.iter().chain(u).map(|&v| hex(v)));
+            }
             input.push_str(&words.join(" "));
             input.push('\n');
         }
@@ -842,26 +842,24 @@ fn generated_code_agrees_with_the_interpreter() {
                         "{what}: {entry} = {g:?} misses {v:e}"
                     );
                 }
-                // `drift_x8`: lane `l` of entry `i` is the drift at the lane's state, bit for
-                // bit.
-                if !s.lanes.is_empty() {
-                    let n = sys.n();
-                    assert!(words.len() >= at + 8 * n, "{what}: too few lane values");
-                    let mut f = vec![0.0; n];
-                    for (l, state) in s.lanes.iter().enumerate() {
-                        sys.drift(state, &[], s.t, &mut f);
-                        for (i, &want) in f.iter().enumerate() {
-                            let got = words[at + 8 * i + l];
-                            assert!(
-                                same(got, want),
-                                "{what}: drift_x8[{i}] lane {l} at {state:?}, t = {}: \
-                                 generated {got:e}, interpreter {want:e}",
-                                s.t
-                            );
-                        }
+                // `drift_x8`: lane `l` of entry `i` is the drift at the lane's state and
+                // input, bit for bit.
+                let n = sys.n();
+                assert!(words.len() >= at + 8 * n, "{what}: too few lane values");
+                let mut f = vec![0.0; n];
+                for (l, (state, input)) in s.lanes.iter().enumerate() {
+                    sys.drift(state, input, s.t, &mut f);
+                    for (i, &want) in f.iter().enumerate() {
+                        let got = words[at + 8 * i + l];
+                        assert!(
+                            same(got, want),
+                            "{what}: drift_x8[{i}] lane {l} at {state:?}, u = {input:?}, t = {}: \
+                             generated {got:e}, interpreter {want:e}",
+                            s.t
+                        );
                     }
-                    at += 8 * n;
                 }
+                at += 8 * n;
             }
             assert_eq!(at, words.len(), "{name}: sample {k}: too many values");
         }

@@ -13,11 +13,11 @@
 //! enclosures. `sinc`, `sign`, `sinc'` and table interpolation call the same
 //! `reachc_runtime::{func, table}` functions the interpreter uses.
 //!
-//! A model without inputs and with at most [`LANES_MAX_STATES`] states also gets `drift_x8`,
-//! the drift of eight states at once over `reachc_runtime::X8` for the Monte Carlo simulator:
-//! the same expression text as `drift`, with values that depend on a state in lanes, and the
-//! constants, `t` and values of `t` alone as plain `f64` (widened where they meet lanes), so
-//! every lane is bit for bit what `drift` gives.
+//! A model with at most [`LANES_MAX_STATES`] states also gets `drift_x8`, the drift of eight
+//! states and inputs at once over `reachc_runtime::X8` for the Monte Carlo simulator: the same
+//! expression text as `drift`, with values that depend on a state or an input in lanes, and
+//! the constants, `t` and values of `t` alone as plain `f64` (widened where they meet lanes),
+//! so every lane is bit for bit what `drift` gives.
 //!
 //! A method larger than [`Options::split_above`] (a model with hundreds of states) is split into
 //! `#[inline(never)]` helper functions of bounded size in private modules, called in sequence,
@@ -59,8 +59,8 @@ use docs::{MethodDoc, SystemDocs};
 /// of one assignment per zero.
 const FILL_THRESHOLD: usize = 8;
 
-/// Models without inputs and with at most this many states get `drift_x8` (the simulator runs
-/// eight sample paths in lanes only for small models; larger ones keep the default, per lane).
+/// Models with at most this many states get `drift_x8` (the simulator runs eight sample paths
+/// in lanes only for small models; larger ones keep the default, per lane).
 pub const LANES_MAX_STATES: usize = 4;
 
 /// The default [`Options::split_above`]: every shipped spec but specs/chain1000.sde stays below
@@ -129,7 +129,7 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
     let p = int(model.inputs.len());
     let m = int(model.noises.len());
 
-    let lanes = model.inputs.is_empty() && model.states.len() <= LANES_MAX_STATES;
+    let lanes = model.states.len() <= LANES_MAX_STATES;
     let spec_names =
         |vars: &[Variable]| -> Vec<String> { vars.iter().map(|v| v.name.clone()).collect() };
     let (states, inputs, noises) = (
@@ -362,7 +362,7 @@ fn system_bodies(
             name: "drift",
             kind: Kind::X8,
             roots: drift,
-            with_u: false,
+            with_u: true,
             owner,
             doc: &docs.drift,
         };
@@ -428,7 +428,8 @@ fn format_file(tokens: TokenStream) -> String {
 enum Kind {
     F64,
     Interval,
-    /// `reachc_runtime::X8` for the values that depend on a state, `f64` for the others.
+    /// `reachc_runtime::X8` for the values that depend on a state or an input, `f64` for the
+    /// others.
     X8,
 }
 
@@ -536,7 +537,8 @@ struct Emitter<'a> {
     uses_t: bool,
     /// The path of the file's top level, where the tables are (`super::` in a helper module).
     top: TokenStream,
-    /// [`Kind::X8`]: the `let`s emitted so far whose value is in lanes (depends on a state).
+    /// [`Kind::X8`]: the `let`s emitted so far whose value is in lanes (depends on a state or
+    /// an input).
     lanes: BTreeSet<ExprId>,
 }
 
@@ -555,12 +557,12 @@ impl<'a> Emitter<'a> {
     }
 
     /// Whether the value of `id` is in lanes (`X8`): only in [`Kind::X8`], and there exactly
-    /// when it depends on a state; constants and values of `t` alone stay `f64`. A node is
-    /// asked for after its `let` (children come first).
+    /// when it depends on a state or an input; constants and values of `t` alone stay `f64`.
+    /// A node is asked for after its `let` (children come first).
     fn in_lanes(&self, id: ExprId) -> bool {
         self.kind == Kind::X8
             && match self.pool.node(id) {
-                Node::Var(v) => matches!(v, Var::State(_)),
+                Node::Var(v) => matches!(v, Var::State(_) | Var::Input(_)),
                 Node::Const(_) => false,
                 _ => self.lanes.contains(&id),
             }

@@ -444,7 +444,9 @@ impl ParallelotopeTest {
             let (tx, y) = buf.split_at_mut(n);
             f.to_y_point(x, tx);
             nearest_in_box(q, tx, lo, hi, y);
-            f.certify(&self.p, x, y, r)
+            // Floating point first: it says `true` only where `certify` would, and settles
+            // most of the states the Monte Carlo check asks about without interval arithmetic.
+            f.clearly_within(&self.p, x, y, r) || f.certify(&self.p, x, y, r)
         })
     }
 }

@@ -162,6 +162,15 @@ impl Group8 {
         self.rng.normal(zig, live)
     }
 
+    /// The next 64 random bits of every lane's stream ([`PathRng::next_u64`]; lane `l` in
+    /// entry `l`), for the draws of inputs.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    pub(crate) fn bits(&mut self) -> [u64; 8] {
+        // SAFETY: eight 64-bit lanes, any bit pattern a valid `u64`.
+        unsafe { std::mem::transmute::<__m512i, [u64; 8]>(self.rng.next()) }
+    }
+
     /// Path `l`'s state (by permutes: indexing into memory would keep the states out of
     /// registers in the whole loop).
     #[inline]

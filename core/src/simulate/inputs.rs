@@ -1,7 +1,8 @@
 //! Input signals of the sample paths: piecewise constant on intervals `[i h, (i + 1) h)` of the
 //! hold time `h`, drawn afresh per path and interval.
 
-use super::rng::PathRng;
+use super::rng::{uniform, PathRng};
+use crate::lanes::X8;
 use crate::model::Bounds;
 
 /// How the inputs of a sample path are chosen.
@@ -68,27 +69,67 @@ impl InputSchedule {
         rng: &mut PathRng,
         u: &mut [f64],
     ) {
+        if self.redraw(t, interval) {
+            for (j, uj) in u.iter_mut().enumerate() {
+                let bits = if self.draws() { rng.next_u64() } else { 0 };
+                *uj = self.draw(j, bits);
+            }
+        }
+    }
+
+    /// [`update`](Self::update) for eight paths in lanes (lane `l` of `u[j]`: input `j` of path
+    /// `l`), whose hold intervals are all `interval` (paths stepped in lockstep from the same
+    /// start are), `next` giving each lane's next 64 random bits: the same draws and values,
+    /// lane by lane.
+    #[inline]
+    pub(crate) fn update_x8(
+        &self,
+        t: f64,
+        interval: &mut Option<u64>,
+        mut next: impl FnMut() -> [u64; 8],
+        u: &mut [X8],
+    ) {
+        if self.redraw(t, interval) {
+            for (j, uj) in u.iter_mut().enumerate() {
+                let bits = if self.draws() { next() } else { [0; 8] };
+                *uj = X8(bits.map(|b| self.draw(j, b)));
+            }
+        }
+    }
+
+    /// Whether the input changes at the step starting at `t`, moving `interval` to that
+    /// step's hold interval.
+    #[inline(always)]
+    fn redraw(&self, t: f64, interval: &mut Option<u64>) -> bool {
         // The relative slack puts t = i h (up to rounding) into interval i, not i - 1.
         let i = match self.mode {
             InputMode::Centre => 0,
             _ => (t / self.hold * (1.0 + 1e-12)) as u64,
         };
-        if *interval == Some(i) {
-            return;
-        }
+        let changed = *interval != Some(i);
         *interval = Some(i);
-        for (j, uj) in u.iter_mut().enumerate() {
-            *uj = match self.mode {
-                InputMode::Random => self.lo[j] + self.width[j] * rng.uniform(),
-                InputMode::Corners => {
-                    if rng.next_u64() >> 63 == 1 {
-                        self.lo[j] + self.width[j]
-                    } else {
-                        self.lo[j]
-                    }
+        changed
+    }
+
+    /// Whether an input value takes random bits (one draw of 64 per input).
+    #[inline(always)]
+    fn draws(&self) -> bool {
+        self.mode != InputMode::Centre
+    }
+
+    /// Input `j`'s value from the random `bits` (ignored by [`InputMode::Centre`]).
+    #[inline(always)]
+    fn draw(&self, j: usize, bits: u64) -> f64 {
+        match self.mode {
+            InputMode::Random => self.lo[j] + self.width[j] * uniform(bits),
+            InputMode::Corners => {
+                if bits >> 63 == 1 {
+                    self.lo[j] + self.width[j]
+                } else {
+                    self.lo[j]
                 }
-                InputMode::Centre => self.lo[j] + 0.5 * self.width[j],
-            };
+            }
+            InputMode::Centre => self.lo[j] + 0.5 * self.width[j],
         }
     }
 }

@@ -10,8 +10,9 @@
 //! no inputs, no unsafe sets or domain, a small model with a non-negative diagonal metric),
 //! with every per-step constant in a register; `additive_x8`, the same eight paths at a time
 //! in AVX-512 lanes where the processor has them; `constant_x8`, eight paths in lanes for the
-//! other small models with constant noise and no inputs, unsafe sets or domain (the states in
-//! lanes, their checks and records in the scalar code); and `step_lanes` for everything else.
+//! other small models with constant noise and no inputs (the states, unsafe sets, domain and
+//! the PRS shortcuts in lanes, the rest of the checks and records in the scalar code); and
+//! `step_lanes` for everything else.
 //! All compute the same operations in the same order as [`sample_paths`](super::sample_paths),
 //! so the paths are the same whichever loop runs them.
 //!
@@ -241,6 +242,15 @@ struct Lanes {
     init: Vec<f64>,
 }
 
+/// Eight paths of a block, for the vector lanes: their states (`n` per path), flags and
+/// unsafe-set hits (as in [`Lanes`]).
+#[cfg(target_arch = "x86_64")]
+struct Group<'a> {
+    x: &'a mut [f64],
+    paths: &'a mut [Path],
+    hit: &'a mut [bool],
+}
+
 /// What a step ending at a report time records, besides the step itself.
 #[derive(Clone, Copy)]
 struct Report<'c> {
@@ -378,10 +388,12 @@ impl<S: System + ?Sized> Plan<'_, S> {
             start = lanes / 8 * 8;
             let groups =
                 l.x.chunks_exact_mut(8 * nn)
-                    .zip(l.paths.chunks_exact_mut(8));
-            for (x, paths) in groups.take(lanes / 8) {
+                    .zip(l.paths.chunks_exact_mut(8))
+                    .zip(l.hit.chunks_exact_mut(8 * sets));
+            for ((x, paths), hit) in groups.take(lanes / 8) {
+                let group = Group { x, paths, hit };
                 // SAFETY: `avx512` says the processor has the extensions.
-                unsafe { self.constant_x8(dim, x, paths, l.quiet.as_deref(), thresholds, st) };
+                unsafe { self.constant_x8(dim, group, l.quiet.as_deref(), thresholds, st) };
             }
         }
         // The paths the lanes did not take, if any.
@@ -444,14 +456,9 @@ impl<S: System + ?Sized> Plan<'_, S> {
     }
 
     /// Whether [`constant_x8`](Self::constant_x8) takes a model with `n` states: constant
-    /// noise, no inputs, unsafe sets or domain, at most [`SMALL`] states and channels.
+    /// noise, at most [`SMALL`] states, inputs and channels.
     fn lanes_take_constant(&self, n: usize) -> bool {
-        n <= SMALL
-            && self.sys.m() <= SMALL
-            && self.sys.p() == 0
-            && self.unsafe_sets.is_empty()
-            && self.domain.is_none()
-            && self.noise.is_constant()
+        n <= SMALL && self.sys.m() <= SMALL && self.sys.p() <= SMALL && self.noise.is_constant()
     }
 
     /// One Euler-Maruyama step of the block's paths, then (at a report time) their records. A
@@ -701,7 +708,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             };
             for step in 0..span.steps {
                 let t = span.t0 + f64::from(step) * h;
-                self.sys.drift_x8(&group.states()[..n], t, &mut f[..n]);
+                self.sys.drift_x8(&group.states()[..n], &[], t, &mut f[..n]);
                 group.step(n, &f, h, &ds, self.zig, live);
                 if pending != 0 {
                     let mut out = group.outside_box(n, w, lo, hi, q_in) & pending;
@@ -739,25 +746,27 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
     }
 
-    /// [`step_lanes`](Self::step_lanes) for eight paths (`paths`, states `x`) of a model with
-    /// constant noise (any structure), no inputs, no unsafe sets or domain and at most
-    /// [`SMALL`] states and channels, through every span: the normals, the drift (by
-    /// [`System::drift_x8`]) and the update in the lanes of AVX-512 registers, with the same
-    /// draws and IEEE operations per lane as `step_lanes`, so the same states; each state then
-    /// goes through the same scalar tube check and record as there. `quiet` is
-    /// [`Lanes::quiet`].
+    /// [`step_lanes`](Self::step_lanes) for eight paths (`group`) of a model with constant
+    /// noise (any structure) and at most [`SMALL`] states, inputs and channels, through every
+    /// span: the inputs, the normals, the drift (by [`System::drift_x8`]), the update and the
+    /// unsafe sets and domain in the lanes of AVX-512 registers, with the same draws and IEEE
+    /// operations per lane as `step_lanes`, so the same states and hits; each state then goes
+    /// through the same scalar tube check and record as there. `quiet` is [`Lanes::quiet`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
     fn constant_x8<D: Dim>(
         &self,
         dim: D,
-        x: &mut [f64],
-        paths: &mut [Path],
+        Group { x, paths, hit }: Group<'_>,
         quiet: Option<&[f64]>,
         thresholds: &[f64],
         st: &mut ChunkStats,
     ) {
-        let (n, m) = (dim.get(), self.sys.m());
+        let (n, m, p) = (dim.get(), self.sys.m(), self.sys.p());
+        let check_sets = !self.unsafe_sets.is_empty() || self.domain.is_some();
+        // The paths' inputs and their hold interval, the same for all eight (see
+        // `InputSchedule::update_x8`).
+        let (mut u, mut hold) = ([X8::splat(0.0); SMALL], None);
         let mut live = 0u8;
         for (a, path) in paths.iter().enumerate() {
             live |= u8::from(path.alive) << a;
@@ -768,15 +777,28 @@ impl<S: System + ?Sized> Plan<'_, S> {
         for (k, span) in (1..).zip(&self.spans) {
             for i in 0..span.steps {
                 let t = span.t0 + f64::from(i) * span.h;
-                // A path draws its m normals in channel order (the drift draws nothing).
+                // A path draws its inputs (when they change), then its m normals in channel
+                // order (the drift draws nothing).
+                if p > 0 {
+                    self.inputs
+                        .update_x8(t, &mut hold, || group.bits(), &mut u[..p]);
+                }
                 for zj in &mut z[..m] {
                     *zj = group.normal(self.zig, live);
                 }
                 let mut xs = group.states();
-                self.sys.drift_x8(&xs[..n], t, &mut f[..n]);
+                self.sys.drift_x8(&xs[..n], &u[..p], t, &mut f[..n]);
                 self.noise
                     .apply_x8(&mut xs[..n], &f[..n], span.h, span.sqrt_h, &mut z[..m]);
                 group.set_states(&xs);
+                if check_sets {
+                    let t_end = if i + 1 == span.steps {
+                        span.t1
+                    } else {
+                        t + span.h
+                    };
+                    self.check_sets_x8(t_end, &xs[..n], live, hit, paths, st);
+                }
                 let report = (i + 1 == span.steps).then(|| Report {
                     k,
                     c: &self.nominal[k * n..][..n],
@@ -825,6 +847,44 @@ impl<S: System + ?Sized> Plan<'_, S> {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// [`check_sets`](Self::check_sets) of the `live` lanes of eight states `x` (lane `l`:
+    /// path `paths[l]`, its hits `hit[l * sets..]` with `sets` at least 1), the regions decided
+    /// in lanes: the same hits and exits as lane by lane.
+    #[inline(always)]
+    fn check_sets_x8(
+        &self,
+        t: f64,
+        x: &[X8],
+        live: u8,
+        hit: &mut [bool],
+        paths: &mut [Path],
+        st: &mut ChunkStats,
+    ) {
+        let sets = self.unsafe_sets.len().max(1);
+        for (j, set) in self.unsafe_sets.iter().enumerate() {
+            let fresh = live & lanes(|l| !hit[l * sets + j]);
+            if fresh == 0 {
+                continue;
+            }
+            let mut new = fresh & set.contains_x8(x);
+            while new != 0 {
+                let l = new.trailing_zeros() as usize;
+                new &= new - 1;
+                hit[l * sets + j] = true;
+                st.unsafe_hits[j] += 1;
+                st.first_hit[j] = st.first_hit[j].min(t);
+            }
+        }
+        if let Some(d) = &self.domain {
+            let mut out = live & lanes(|l| !paths[l].left_domain) & !d.contains_x8(x);
+            while out != 0 {
+                let l = out.trailing_zeros() as usize;
+                out &= out - 1;
+                paths[l].left_domain = true;
             }
         }
     }
@@ -982,7 +1042,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{make_plan, Options};
+    use super::super::{make_plan, InputMode, Options};
     use super::*;
     use crate::engine;
     use crate::interval::Interval;
@@ -1085,8 +1145,9 @@ mod tests {
     /// against the scalar loops, path by path: a constant `G` that is not diagonal, a full
     /// metric, the contraction method's intersection with its interval box (time-uniform: the
     /// tube at every step; and pointwise) and the interval method's box, with and without
-    /// quantile candidates, and with sets narrowed so that paths leave them. The records,
-    /// counts and tube exits are the same.
+    /// quantile candidates, and with sets narrowed so that paths leave them (then also with
+    /// unsafe sets and a domain, checked after every step). The records, counts, tube exits,
+    /// unsafe-set hits with their first times, and domain exits are the same.
     #[test]
     fn lanes_with_constant_noise_do_not_change_the_paths() {
         if !super::super::avx512::available() {
@@ -1099,7 +1160,7 @@ mod tests {
                 .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
             s
         };
-        let mut outside = 0;
+        let (mut outside, mut hits, mut late) = (0, 0, 0.0_f64);
         for method in [Method::Contraction, Method::Interval] {
             for guarantee in [Guarantee::Uniform, Guarantee::Pointwise] {
                 let info = pendulum(method);
@@ -1116,23 +1177,129 @@ mod tests {
                             st.span.radius /= 3.0;
                         }
                     }
-                    let opts = Options::default();
-                    let mut plan = make_plan(&Pendulum, &info, &r, &opts).unwrap();
-                    assert!(plan.lanes_take_constant(2) && plan.noise.diagonal().is_none());
-                    for threshold in [f64::NEG_INFINITY, 0.5] {
+                    // With unsafe sets and a domain (checked after every step), and without;
+                    // the pendulum and, forced by an input, in each of the input modes.
+                    let regions = with_regions(&info, narrow);
+                    let forced = with_input(&regions);
+                    let modes = [InputMode::Random, InputMode::Corners, InputMode::Centre];
+                    let systems = [(&Pendulum as &dyn System, &regions, InputMode::Random)]
+                        .into_iter()
+                        .chain(modes.map(|mode| (&Forced as &dyn System, &forced, mode)));
+                    for ((sys, info, mode), threshold) in
+                        systems.flat_map(|s| [(s, f64::NEG_INFINITY), (s, 0.5)])
+                    {
+                        let opts = Options {
+                            inputs: mode,
+                            hold: Some(0.05),
+                            ..Options::default()
+                        };
+                        let mut plan = make_plan(sys, info, &r, &opts).unwrap();
+                        assert!(plan.lanes_take_constant(2) && plan.noise.diagonal().is_none());
                         let thresholds = vec![threshold; plan.times.len()];
                         plan.avx512 = true;
                         let lanes = sorted(plan.run_chunk(0..203, &thresholds));
                         plan.avx512 = false;
                         let scalar = sorted(plan.run_chunk(0..203, &thresholds));
-                        let case = format!("{method:?} {guarantee:?} narrow {narrow} {threshold}");
+                        let case = format!(
+                            "{method:?} {guarantee:?} narrow {narrow} {threshold} inputs {} \
+                             {mode:?}",
+                            sys.p()
+                        );
                         assert_eq!(lanes, scalar, "{case}");
                         outside += scalar.outside_any + scalar.outside_tube;
+                        hits += scalar.unsafe_hits.iter().sum::<u64>() + scalar.left_domain;
+                        if let Some(&t) = scalar.first_hit.get(1).filter(|t| t.is_finite()) {
+                            late = late.max(t);
+                        }
                     }
                 }
             }
         }
-        // Not vacuous: the narrowed sets are left.
+        // Not vacuous: the narrowed sets are left, the unsafe sets hit, the domain left.
         assert!(outside > 100, "{outside}");
+        assert!(hits > 100, "{hits}");
+        assert!(late > 0.0, "the ball is first entered after the start");
+    }
+
+    /// [`Pendulum`] forced by an input `u` on the second state: `omega' = ... + u`.
+    struct Forced;
+
+    impl System for Forced {
+        fn n(&self) -> usize {
+            2
+        }
+        fn p(&self) -> usize {
+            1
+        }
+        fn m(&self) -> usize {
+            1
+        }
+        fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
+            Pendulum.drift(x, u, t, out);
+            out[1] += u[0];
+        }
+        fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, o: &mut [Interval]) {
+            Pendulum.drift_interval(x, u, t, o);
+            o[1] += u[0];
+        }
+        fn jac_x(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
+            Pendulum.jac_x(x, u, t, out);
+        }
+        fn jac_x_interval(&self, x: &[Interval], u: &[Interval], t: Interval, o: &mut [Interval]) {
+            Pendulum.jac_x_interval(x, u, t, o);
+        }
+        fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
+            out.copy_from_slice(&[0.0, 1.0]);
+        }
+        fn jac_u_interval(&self, _: &[Interval], _: &[Interval], _: Interval, o: &mut [Interval]) {
+            o.copy_from_slice(&[Interval::ZERO, Interval::ONE]);
+        }
+        fn diffusion(&self, x: &[f64], t: f64, out: &mut [f64]) {
+            Pendulum.diffusion(x, t, out);
+        }
+        fn diffusion_interval(&self, x: &[Interval], t: Interval, o: &mut [Interval]) {
+            Pendulum.diffusion_interval(x, t, o);
+        }
+    }
+
+    /// `info` for [`Forced`]: its input in `[-0.5, 1]`.
+    fn with_input(info: &ModelInfo) -> ModelInfo {
+        let mut info = info.clone();
+        info.inputs = vec!["u".into()];
+        info.input_box = vec![Bounds::new(-0.5, 1.0)];
+        info
+    }
+
+    /// `info` with three unsafe sets (a box, a ball and a half-space, which pendulum paths
+    /// enter, the ball only after the start) and a domain that some leave, if `add`.
+    fn with_regions(info: &ModelInfo, add: bool) -> ModelInfo {
+        let mut info = info.clone();
+        if add {
+            let set = |name: &str, shape| UnsafeSet {
+                name: name.into(),
+                shape,
+            };
+            info.unsafe_sets = vec![
+                set("box", UnsafeShape::Box(vec![(1, Bounds::new(0.12, 1.0))])),
+                set(
+                    "ball",
+                    UnsafeShape::Ball {
+                        states: vec![0, 1],
+                        center: vec![0.15, -0.0765],
+                        radius: 0.01,
+                    },
+                ),
+                set(
+                    "half",
+                    UnsafeShape::HalfSpace {
+                        normal: vec![1.0, 0.5],
+                        offset: 0.3,
+                    },
+                ),
+            ];
+            info.domain = vec![Bounds::new(-0.315, 0.315), Bounds::ENTIRE];
+            info.has_domain = true;
+        }
+        info
     }
 }

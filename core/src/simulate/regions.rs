@@ -1,6 +1,8 @@
 //! Point membership in the spec's unsafe sets and domain, for counting the paths that enter an
 //! unsafe set or leave the domain. Sets are closed (a point on the boundary is in the set).
 
+use super::prs::lanes;
+use crate::lanes::X8;
 use crate::model::{Bounds, UnsafeShape};
 
 /// A region of the state space.
@@ -93,6 +95,37 @@ impl Region {
             }
         }
     }
+
+    /// [`contains`](Self::contains) of eight states in lanes (state `i` of lane `l` in
+    /// `x[i]`): bit `l` set when lane `l`'s state is in the region. The same operations per
+    /// lane, so the same answers (the sums here start from `+0` where `contains`'s may start
+    /// from `-0`: they can differ in the sign of a zero only, which no comparison sees).
+    #[inline(always)]
+    pub(crate) fn contains_x8(&self, x: &[X8]) -> u8 {
+        match self {
+            Region::Box(r) => {
+                let mut mask = 0xff;
+                for &(i, lo, hi) in r {
+                    mask &= lanes(|l| lo <= x[i].0[l] && x[i].0[l] <= hi);
+                }
+                mask
+            }
+            Region::Ball { states, center, r2 } => {
+                let mut d2 = X8::splat(0.0);
+                for (&i, &c) in states.iter().zip(center) {
+                    d2 = d2 + (x[i] - c) * (x[i] - c);
+                }
+                lanes(|l| d2.0[l] <= *r2)
+            }
+            Region::HalfSpace { normal, offset } => {
+                let mut s = X8::splat(0.0);
+                for &(i, a) in normal {
+                    s = s + X8::splat(a) * x[i];
+                }
+                lanes(|l| s.0[l] >= *offset)
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -131,5 +164,51 @@ mod tests {
         assert!(
             Region::unsafe_set(&UnsafeShape::Box(vec![(2, Bounds::new(0.0, 1.0))]), 2).is_err()
         );
+    }
+
+    #[test]
+    fn lanes_answer_as_one_state_does() {
+        let regions = [
+            Region::unsafe_set(&UnsafeShape::Box(vec![(1, Bounds::new(0.0, 1.0))]), 2).unwrap(),
+            Region::unsafe_set(
+                &UnsafeShape::Ball {
+                    states: vec![0, 1],
+                    center: vec![0.5, 0.25],
+                    radius: 0.5,
+                },
+                2,
+            )
+            .unwrap(),
+            Region::unsafe_set(
+                &UnsafeShape::HalfSpace {
+                    normal: vec![1.0, -0.5],
+                    offset: 0.125,
+                },
+                2,
+            )
+            .unwrap(),
+            Region::domain(&[Bounds::new(-1.0, 1.0), Bounds::new(f64::NEG_INFINITY, 0.75)]),
+        ];
+        // States on a grid that puts some on every boundary (the ball's and the half-space's
+        // included: 0.5 + 0.5 = 1, 0.5 * 0.25 + 0.125...), and non-finite ones.
+        let mut states: Vec<[f64; 2]> = (0..8 * 40)
+            .map(|k| [f64::from(k % 17) / 8.0 - 1.0, f64::from(k / 17) / 8.0 - 1.0])
+            .collect();
+        states[3] = [f64::NAN, 0.5];
+        states[12] = [0.5, f64::INFINITY];
+        let mut seen = [0u32; 4];
+        for chunk in states.chunks_exact(8) {
+            let x: Vec<X8> = (0..2)
+                .map(|i| X8(std::array::from_fn(|l| chunk[l][i])))
+                .collect();
+            for (r, region) in regions.iter().enumerate() {
+                let mask = region.contains_x8(&x);
+                for (l, s) in chunk.iter().enumerate() {
+                    assert_eq!(mask >> l & 1 == 1, region.contains(s), "{region:?} {s:?}");
+                    seen[r] += u32::from(region.contains(s));
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c > 10 && c < 300), "{seen:?}");
     }
 }

@@ -25,6 +25,13 @@ fn splitmix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Uniform on `[0, 1)` from the top 53 of 64 random `bits`.
+#[inline(always)]
+pub(crate) fn uniform(bits: u64) -> f64 {
+    // Through i64: 53 bits fit, and the signed conversion is one instruction.
+    ((bits >> 11) as i64) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
 /// The random stream of one path (wyrand).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PathRng {
@@ -61,8 +68,7 @@ impl PathRng {
     /// Uniform on `[0, 1)` with 53 random bits.
     #[inline(always)]
     pub(crate) fn uniform(&mut self) -> f64 {
-        // Through i64: 53 bits fit, and the signed conversion is one instruction.
-        ((self.next_u64() >> 11) as i64) as f64 * (1.0 / (1u64 << 53) as f64)
+        uniform(self.next_u64())
     }
 
     /// Uniform on `(0, 1]` (never 0: safe under `ln`).

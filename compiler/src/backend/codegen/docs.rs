@@ -37,7 +37,8 @@ impl MethodDoc {
                  (outward-rounded arithmetic).\n\n"
             }
             Kind::X8 => {
-                "Lanes form: eight states at once, each lane bit for bit what `drift` gives.\n\n"
+                "Lanes form: eight states and inputs at once, each lane bit for bit what `drift` \
+                 gives.\n\n"
             }
         };
         doc_attrs(&format!("{}.\n\n{form}{}", self.what, self.equations))
