@@ -69,6 +69,11 @@ fn every_shipped_spec_generates_parsable_deterministic_code() {
         // The drift in lanes exactly for small models.
         let lanes = model.states.len() <= LANES_MAX_STATES;
         assert_eq!(code.contains("fn drift_x8("), lanes, "{name}: drift_x8");
+        assert_eq!(
+            code.contains("fn diffusion_x8("),
+            lanes,
+            "{name}: diffusion_x8"
+        );
         assert!(code.contains("pub fn info() -> reachc_runtime::model::ModelInfo"));
         assert!(code.contains(&format!("pub const N: usize = {};", model.states.len())));
         if !model.tables.is_empty() {

@@ -7,6 +7,33 @@
 use crate::interval::Interval;
 use crate::lanes::X8;
 
+/// `f(x, u, out)` lane by lane, for lane `l` of every entry of `x`, `u` and `out` (the
+/// trait's default lanes forms).
+fn lane_by_lane(x: &[X8], u: &[X8], out: &mut [X8], mut f: impl FnMut(&[f64], &[f64], &mut [f64])) {
+    let (n, p, k) = (x.len(), u.len(), out.len());
+    let (mut small, mut heap) = ([0.0; 32], Vec::new());
+    let buf = if n + p + k <= small.len() {
+        &mut small[..n + p + k]
+    } else {
+        heap.resize(n + p + k, 0.0);
+        &mut heap[..]
+    };
+    let (xs, rest) = buf.split_at_mut(n);
+    let (us, os) = rest.split_at_mut(p);
+    for l in 0..8 {
+        for (a, v) in xs.iter_mut().zip(x) {
+            *a = v.0[l];
+        }
+        for (a, v) in us.iter_mut().zip(u) {
+            *a = v.0[l];
+        }
+        f(xs, us, os);
+        for (o, v) in out.iter_mut().zip(&*os) {
+            o.0[l] = *v;
+        }
+    }
+}
+
 /// A stochastic system `dX = f(X, u, t) dt + G(X, t) dW` with its derivatives.
 ///
 /// Implementations must be pure functions of their arguments. The interval versions must be
@@ -26,28 +53,7 @@ pub trait System {
     /// [`System::drift`] gives (the Monte Carlo simulator relies on it). The default calls
     /// `drift` once per lane; generated code evaluates the same expressions over [`X8`].
     fn drift_x8(&self, x: &[X8], u: &[X8], t: f64, out: &mut [X8]) {
-        let (n, p) = (x.len(), u.len());
-        let (mut small, mut heap) = ([0.0; 24], Vec::new());
-        let buf = if 2 * n + p <= small.len() {
-            &mut small[..2 * n + p]
-        } else {
-            heap.resize(2 * n + p, 0.0);
-            &mut heap[..]
-        };
-        let (xs, rest) = buf.split_at_mut(n);
-        let (us, fs) = rest.split_at_mut(p);
-        for l in 0..8 {
-            for (xi, x) in xs.iter_mut().zip(x) {
-                *xi = x.0[l];
-            }
-            for (uj, u) in us.iter_mut().zip(u) {
-                *uj = u.0[l];
-            }
-            self.drift(xs, us, t, fs);
-            for (o, f) in out.iter_mut().zip(&*fs) {
-                o.0[l] = *f;
-            }
-        }
+        lane_by_lane(x, u, out, |x, u, o| self.drift(x, u, t, o));
     }
     /// Natural inclusion function of the drift.
     fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]);
@@ -81,6 +87,13 @@ pub trait System {
     fn jac_u_interval(&self, x: &[Interval], u: &[Interval], t: Interval, out: &mut [Interval]);
     /// `G(x, t)`, n x m row-major.
     fn diffusion(&self, x: &[f64], t: f64, out: &mut [f64]);
+    /// The diffusion of eight states at once: lane `l` of `out[i * m + k]` is `G[i, k]` at the
+    /// state in lane `l` of `x`, bit for bit what [`System::diffusion`] gives (the Monte Carlo
+    /// simulator relies on it). The default calls `diffusion` once per lane; generated code
+    /// evaluates the same expressions over [`X8`].
+    fn diffusion_x8(&self, x: &[X8], t: f64, out: &mut [X8]) {
+        lane_by_lane(x, &[], out, |x, _, o| self.diffusion(x, t, o));
+    }
     /// Interval enclosure of `G`.
     fn diffusion_interval(&self, x: &[Interval], t: Interval, out: &mut [Interval]);
     /// The transformed system of frame `k` (see [`Transform::frame`](crate::model::Transform::frame)): the same interface in

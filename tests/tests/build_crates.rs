@@ -476,8 +476,9 @@ fn small_crates_compile_clippy_clean_and_run() {
 /// `x, u, t` then a box `(lo, hi)` per state, input and time, then eight more states and inputs,
 /// the lanes, one after the other, as f64 bit patterns in hex), it prints, for the model and
 /// then each of its frames, drift, `D_x f`, `D_u f`, `G` at the point, then their interval
-/// versions and the sparse `D_x f` on the box (`lo hi` per entry), then `drift_x8` of the lanes
-/// at `t` (lane by lane for each entry), all as hex bit patterns on one line.
+/// versions and the sparse `D_x f` on the box (`lo hi` per entry), then `drift_x8` and
+/// `diffusion_x8` of the lanes at `t` (lane by lane for each entry), all as hex bit patterns on
+/// one line.
 fn probe_main(crate_ident: &str, type_name: &str) -> String {
     format!(
         r#"use std::io::{{BufRead, Write}};
@@ -523,8 +524,10 @@ fn dump(
     }}
     // NaN where nothing is written: a missing store shows.
     let mut f8 = vec![X8::splat(f64::NAN); n];
+    let mut g8 = vec![X8::splat(f64::NAN); n * m];
     sys.drift_x8(lx, lu, t, &mut f8);
-    for v in f8.iter().flat_map(|v| v.0) {{
+    sys.diffusion_x8(lx, t, &mut g8);
+    for v in f8.iter().chain(&g8).flat_map(|v| v.0) {{
         words.push(format!("{{:016x}}", v.to_bits()));
     }}
 }}
@@ -842,24 +845,31 @@ fn generated_code_agrees_with_the_interpreter() {
                         "{what}: {entry} = {g:?} misses {v:e}"
                     );
                 }
-                // `drift_x8`: lane `l` of entry `i` is the drift at the lane's state and
-                // input, bit for bit.
-                let n = sys.n();
-                assert!(words.len() >= at + 8 * n, "{what}: too few lane values");
-                let mut f = vec![0.0; n];
+                // `drift_x8` and `diffusion_x8`: lane `l` of entry `i` is the drift (then
+                // `G`) at the lane's state and input, bit for bit.
+                let (n, m) = (sys.n(), sys.m());
+                assert!(
+                    words.len() >= at + 8 * n * (1 + m),
+                    "{what}: too few lane values"
+                );
+                let (mut f, mut g) = (vec![0.0; n], vec![0.0; n * m]);
                 for (l, (state, input)) in s.lanes.iter().enumerate() {
                     sys.drift(state, input, s.t, &mut f);
-                    for (i, &want) in f.iter().enumerate() {
+                    sys.diffusion(state, s.t, &mut g);
+                    let named =
+                        |name, v: &[f64]| v.iter().map(move |&v| (name, v)).collect::<Vec<_>>();
+                    let want = [named("drift_x8", &f), named("diffusion_x8", &g)].concat();
+                    for (i, &(method, want)) in want.iter().enumerate() {
                         let got = words[at + 8 * i + l];
                         assert!(
                             same(got, want),
-                            "{what}: drift_x8[{i}] lane {l} at {state:?}, u = {input:?}, t = {}: \
-                             generated {got:e}, interpreter {want:e}",
+                            "{what}: {method} entry {i} lane {l} at {state:?}, u = {input:?}, \
+                             t = {}: generated {got:e}, interpreter {want:e}",
                             s.t
                         );
                     }
                 }
-                at += 8 * n;
+                at += 8 * n * (1 + m);
             }
             assert_eq!(at, words.len(), "{name}: sample {k}: too many values");
         }

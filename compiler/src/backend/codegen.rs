@@ -13,11 +13,12 @@
 //! enclosures. `sinc`, `sign`, `sinc'` and table interpolation call the same
 //! `reachc_runtime::{func, table}` functions the interpreter uses.
 //!
-//! A model with at most [`LANES_MAX_STATES`] states also gets `drift_x8`, the drift of eight
-//! states and inputs at once over `reachc_runtime::X8` for the Monte Carlo simulator: the same
-//! expression text as `drift`, with values that depend on a state or an input in lanes, and
-//! the constants, `t` and values of `t` alone as plain `f64` (widened where they meet lanes),
-//! so every lane is bit for bit what `drift` gives.
+//! A model with at most [`LANES_MAX_STATES`] states also gets `drift_x8` and `diffusion_x8`,
+//! the drift and the diffusion of eight states and inputs at once over `reachc_runtime::X8` for
+//! the Monte Carlo simulator: the same expression text as `drift` and `diffusion`, with values
+//! that depend on a state or an input in lanes, and the constants, `t` and values of `t` alone
+//! as plain `f64` (widened where they meet lanes), so every lane is bit for bit what the `f64`
+//! method gives.
 //!
 //! A method larger than [`Options::split_above`] (a model with hundreds of states) is split into
 //! `#[inline(never)]` helper functions of bounded size in private modules, called in sequence,
@@ -59,8 +60,9 @@ use docs::{MethodDoc, SystemDocs};
 /// of one assignment per zero.
 const FILL_THRESHOLD: usize = 8;
 
-/// Models with at most this many states get `drift_x8` (the simulator runs eight sample paths
-/// in lanes only for small models; larger ones keep the default, per lane).
+/// Models with at most this many states get `drift_x8` and `diffusion_x8` (the simulator runs
+/// eight sample paths in lanes only for small models; larger ones keep the defaults, per
+/// lane).
 pub const LANES_MAX_STATES: usize = 4;
 
 /// The default [`Options::split_above`]: every shipped spec but specs/chain1000.sde stays below
@@ -276,7 +278,7 @@ pub fn generated_header(comment: &str) -> String {
 
 /// The `System` methods (f64 and interval) of a drift, diffusion and their Jacobians, and the
 /// modules of helper functions of those split into chunks (see [`chunked_method`]); with
-/// `lanes`, also `drift_x8` (unless the drift is chunked).
+/// `lanes`, also `drift_x8` and `diffusion_x8` (unless they would be chunked).
 fn system_bodies(
     pool: &Pool,
     tables: &mut Tables,
@@ -358,17 +360,23 @@ fn system_bodies(
         }
     }
     if lanes {
-        let def = MethodDef {
-            name: "drift",
-            kind: Kind::X8,
-            roots: drift,
-            with_u: true,
-            owner,
-            doc: &docs.drift,
-        };
-        // Never split: a drift that would be is left to the trait's default.
-        let (method, _) = method_fn(pool, tables, &def, options);
-        bodies.extend(method);
+        let x8 = [
+            ("drift", drift, true, &docs.drift),
+            ("diffusion", &diffusion[..], false, &docs.diffusion),
+        ];
+        for (name, roots, with_u, doc) in x8 {
+            let def = MethodDef {
+                name,
+                kind: Kind::X8,
+                roots,
+                with_u,
+                owner,
+                doc,
+            };
+            // Never split: a method that would be is left to the trait's default.
+            let (method, _) = method_fn(pool, tables, &def, options);
+            bodies.extend(method);
+        }
     }
     bodies.extend(sparse_fn);
     helpers.extend(sparse_helpers);
@@ -950,7 +958,7 @@ fn method_fn(
     let cost = lets.iter().map(|&id| node_cost(pool, id)).sum::<usize>() + writes;
     if cost > options.split_above {
         if kind == Kind::X8 {
-            // Only small models run in lanes; a drift that large keeps the trait's default.
+            // Only small models run in lanes; a method that large keeps the trait's default.
             return (TokenStream::new(), TokenStream::new());
         }
         return chunked_method(pool, tables, def, fill, options.chunk_size);

@@ -102,17 +102,21 @@ impl Noise {
         self.diagonal.as_deref()
     }
 
-    /// Whether `G` is constant (then [`apply_x8`](Self::apply_x8) applies).
-    pub(crate) fn is_constant(&self) -> bool {
-        self.constant
-    }
-
-    /// [`apply`](Self::apply) for a constant `G`, on eight paths in lanes (`x`, `f`: state
-    /// `i` of path `l` in lane `l` of entry `i`; `z`: the `m` channels' normals, likewise):
-    /// the same IEEE operations in the same order per lane, so the same states to the bit.
+    /// [`apply`](Self::apply) on eight paths in lanes (`x`, `f`: state `i` of path `l` in
+    /// lane `l` of entry `i`; `z`: the `m` channels' normals, likewise; `g`: scratch of `n * m`
+    /// when [`needs_matrix`](Self::needs_matrix), filled by [`System::diffusion_x8`]): the same
+    /// IEEE operations in the same order per lane, so the same states to the bit.
     #[inline(always)]
-    pub(crate) fn apply_x8(&self, x: &mut [X8], f: &[X8], h: f64, sqrt_h: f64, z: &mut [X8]) {
-        debug_assert!(self.constant, "apply_x8 needs a constant G");
+    #[allow(clippy::too_many_arguments)] // as `apply`
+    pub(crate) fn apply_x8<S: System + ?Sized>(
+        &self,
+        sys: &S,
+        x: &mut [X8],
+        f: &[X8],
+        (t, h, sqrt_h): (f64, f64, f64),
+        z: &mut [X8],
+        g: &mut [X8],
+    ) {
         if let Some(d) = &self.diagonal {
             for i in 0..x.len() {
                 x[i] = x[i] + (f[i] * h + d[i] * sqrt_h * z[i]);
@@ -122,10 +126,19 @@ impl Noise {
         for zj in z.iter_mut().take(self.m) {
             *zj = *zj * sqrt_h;
         }
+        if !self.constant {
+            sys.diffusion_x8(x, t, g);
+        }
         for i in 0..x.len() {
             let mut dx = f[i] * h;
             for k in self.row[i]..self.row[i + 1] {
-                dx = dx + self.vals[k] * z[self.cols[k]];
+                let j = self.cols[k];
+                let gij = if self.constant {
+                    X8::splat(self.vals[k])
+                } else {
+                    g[i * self.m + j]
+                };
+                dx = dx + gij * z[j];
             }
             x[i] = x[i] + dx;
         }

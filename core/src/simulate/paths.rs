@@ -9,10 +9,10 @@
 //! Four loops run the steps: `additive_lanes` for the common case (constant diagonal noise,
 //! no inputs, no unsafe sets or domain, a small model with a non-negative diagonal metric),
 //! with every per-step constant in a register; `additive_x8`, the same eight paths at a time
-//! in AVX-512 lanes where the processor has them; `constant_x8`, eight paths in lanes for the
-//! other small models with constant noise and no inputs (the states, unsafe sets, domain and
-//! the PRS shortcuts in lanes, the rest of the checks and records in the scalar code); and
-//! `step_lanes` for everything else.
+//! in AVX-512 lanes where the processor has them; `lanes_x8`, eight paths in lanes for the
+//! other models of at most 4 states, inputs and noise channels (the inputs, normals, drift,
+//! diffusion, update, unsafe sets, domain and the PRS shortcuts in lanes, the rest of the
+//! checks and records in the scalar code); and `step_lanes` for everything else.
 //! All compute the same operations in the same order as [`sample_paths`](super::sample_paths),
 //! so the paths are the same whichever loop runs them.
 //!
@@ -382,9 +382,9 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 unsafe { self.additive_x8(dim, x, paths, quiet, thresholds, st) };
             }
         }
-        // Other models with constant noise: eight paths at a time in `constant_x8`.
+        // Other small models: eight paths at a time in `lanes_x8`.
         #[cfg(target_arch = "x86_64")]
-        if start == 0 && self.avx512 && self.lanes_take_constant(n) {
+        if start == 0 && self.avx512 && self.lanes_take(n) {
             start = lanes / 8 * 8;
             let groups =
                 l.x.chunks_exact_mut(8 * nn)
@@ -393,7 +393,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             for ((x, paths), hit) in groups.take(lanes / 8) {
                 let group = Group { x, paths, hit };
                 // SAFETY: `avx512` says the processor has the extensions.
-                unsafe { self.constant_x8(dim, group, l.quiet.as_deref(), thresholds, st) };
+                unsafe { self.lanes_x8(dim, group, l.quiet.as_deref(), thresholds, st) };
             }
         }
         // The paths the lanes did not take, if any.
@@ -455,10 +455,10 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
     }
 
-    /// Whether [`constant_x8`](Self::constant_x8) takes a model with `n` states: constant
-    /// noise, at most [`SMALL`] states, inputs and channels.
-    fn lanes_take_constant(&self, n: usize) -> bool {
-        n <= SMALL && self.sys.m() <= SMALL && self.sys.p() <= SMALL && self.noise.is_constant()
+    /// Whether [`lanes_x8`](Self::lanes_x8) takes a model with `n` states: at most [`SMALL`]
+    /// states, inputs and channels.
+    fn lanes_take(&self, n: usize) -> bool {
+        n <= SMALL && self.sys.m() <= SMALL && self.sys.p() <= SMALL
     }
 
     /// One Euler-Maruyama step of the block's paths, then (at a report time) their records. A
@@ -746,15 +746,16 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
     }
 
-    /// [`step_lanes`](Self::step_lanes) for eight paths (`group`) of a model with constant
-    /// noise (any structure) and at most [`SMALL`] states, inputs and channels, through every
-    /// span: the inputs, the normals, the drift (by [`System::drift_x8`]), the update and the
-    /// unsafe sets and domain in the lanes of AVX-512 registers, with the same draws and IEEE
-    /// operations per lane as `step_lanes`, so the same states and hits; each state then goes
-    /// through the same scalar tube check and record as there. `quiet` is [`Lanes::quiet`].
+    /// [`step_lanes`](Self::step_lanes) for eight paths (`group`) of a model with at most
+    /// [`SMALL`] states, inputs and channels, through every span: the inputs, the normals, the
+    /// drift and a state-dependent diffusion (by [`System::drift_x8`] and
+    /// [`System::diffusion_x8`]), the update and the unsafe sets and domain in the lanes of
+    /// AVX-512 registers, with the same draws and IEEE operations per lane as `step_lanes`, so
+    /// the same states and hits; each state then goes through the same scalar tube check and
+    /// record as there. `quiet` is [`Lanes::quiet`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    fn constant_x8<D: Dim>(
+    fn lanes_x8<D: Dim>(
         &self,
         dim: D,
         Group { x, paths, hit }: Group<'_>,
@@ -774,6 +775,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         let (shortcuts, upper) = (self.membership.has_shortcuts(), self.metric.upper());
         let mut group = super::avx512::Group8::new(n, x, std::array::from_fn(|a| paths[a].rng));
         let (mut f, mut z) = ([X8::splat(0.0); SMALL], [X8::splat(0.0); SMALL]);
+        let mut g = [X8::splat(0.0); SMALL * SMALL];
         for (k, span) in (1..).zip(&self.spans) {
             for i in 0..span.steps {
                 let t = span.t0 + f64::from(i) * span.h;
@@ -788,8 +790,15 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 }
                 let mut xs = group.states();
                 self.sys.drift_x8(&xs[..n], &u[..p], t, &mut f[..n]);
-                self.noise
-                    .apply_x8(&mut xs[..n], &f[..n], span.h, span.sqrt_h, &mut z[..m]);
+                let steps = (t, span.h, span.sqrt_h);
+                self.noise.apply_x8(
+                    self.sys,
+                    &mut xs[..n],
+                    &f[..n],
+                    steps,
+                    &mut z[..m],
+                    &mut g[..n * m],
+                );
                 group.set_states(&xs);
                 if check_sets {
                     let t_end = if i + 1 == span.steps {
@@ -1141,15 +1150,16 @@ mod tests {
         info
     }
 
-    /// Eight paths in lanes (`constant_x8`; of 203 paths, the last three in the scalar loops)
+    /// Eight paths in lanes (`lanes_x8`; of 203 paths, the last three in the scalar loops)
     /// against the scalar loops, path by path: a constant `G` that is not diagonal, a full
     /// metric, the contraction method's intersection with its interval box (time-uniform: the
     /// tube at every step; and pointwise) and the interval method's box, with and without
     /// quantile candidates, and with sets narrowed so that paths leave them (then also with
-    /// unsafe sets and a domain, checked after every step). The records, counts, tube exits,
-    /// unsafe-set hits with their first times, and domain exits are the same.
+    /// unsafe sets and a domain, checked after every step); the pendulum, the pendulum with
+    /// state-dependent noise, and a forced pendulum in each input mode. The records, counts,
+    /// tube exits, unsafe-set hits with their first times, and domain exits are the same.
     #[test]
-    fn lanes_with_constant_noise_do_not_change_the_paths() {
+    fn lanes_do_not_change_the_paths() {
         if !super::super::avx512::available() {
             eprintln!("no AVX-512: nothing to compare");
             return;
@@ -1178,14 +1188,18 @@ mod tests {
                         }
                     }
                     // With unsafe sets and a domain (checked after every step), and without;
-                    // the pendulum and, forced by an input, in each of the input modes.
+                    // the pendulum, with state-dependent noise, and forced by an input in each
+                    // of the input modes.
                     let regions = with_regions(&info, narrow);
                     let forced = with_input(&regions);
                     let modes = [InputMode::Random, InputMode::Corners, InputMode::Centre];
-                    let systems = [(&Pendulum as &dyn System, &regions, InputMode::Random)]
-                        .into_iter()
-                        .chain(modes.map(|mode| (&Forced as &dyn System, &forced, mode)));
-                    for ((sys, info, mode), threshold) in
+                    let systems = [
+                        (&Pendulum as &dyn System, &regions, InputMode::Random, true),
+                        (&MULTIPLICATIVE, &regions, InputMode::Random, false),
+                    ]
+                    .into_iter()
+                    .chain(modes.map(|mode| (&FORCED as &dyn System, &forced, mode, true)));
+                    for ((sys, info, mode, constant), threshold) in
                         systems.flat_map(|s| [(s, f64::NEG_INFINITY), (s, 0.5)])
                     {
                         let opts = Options {
@@ -1194,7 +1208,8 @@ mod tests {
                             ..Options::default()
                         };
                         let mut plan = make_plan(sys, info, &r, &opts).unwrap();
-                        assert!(plan.lanes_take_constant(2) && plan.noise.diagonal().is_none());
+                        assert!(plan.lanes_take(2) && plan.noise.diagonal().is_none());
+                        assert_eq!(plan.noise.needs_matrix(), !constant);
                         let thresholds = vec![threshold; plan.times.len()];
                         plan.avx512 = true;
                         let lanes = sorted(plan.run_chunk(0..203, &thresholds));
@@ -1221,26 +1236,43 @@ mod tests {
         assert!(late > 0.0, "the ball is first entered after the start");
     }
 
-    /// [`Pendulum`] forced by an input `u` on the second state: `omega' = ... + u`.
-    struct Forced;
+    /// [`Pendulum`], `forced` by an input `u` on the second state (`omega' = ... + u`), or with
+    /// `multiplicative` noise (`G = [0, 0.1 + 0.05 sin theta]'`).
+    struct Variant {
+        forced: bool,
+        multiplicative: bool,
+    }
 
-    impl System for Forced {
+    const FORCED: Variant = Variant {
+        forced: true,
+        multiplicative: false,
+    };
+    const MULTIPLICATIVE: Variant = Variant {
+        forced: false,
+        multiplicative: true,
+    };
+
+    impl System for Variant {
         fn n(&self) -> usize {
             2
         }
         fn p(&self) -> usize {
-            1
+            usize::from(self.forced)
         }
         fn m(&self) -> usize {
             1
         }
         fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
             Pendulum.drift(x, u, t, out);
-            out[1] += u[0];
+            if self.forced {
+                out[1] += u[0];
+            }
         }
         fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, o: &mut [Interval]) {
             Pendulum.drift_interval(x, u, t, o);
-            o[1] += u[0];
+            if self.forced {
+                o[1] += u[0];
+            }
         }
         fn jac_x(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
             Pendulum.jac_x(x, u, t, out);
@@ -1249,20 +1281,33 @@ mod tests {
             Pendulum.jac_x_interval(x, u, t, o);
         }
         fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-            out.copy_from_slice(&[0.0, 1.0]);
+            if self.forced {
+                out.copy_from_slice(&[0.0, 1.0]);
+            }
         }
         fn jac_u_interval(&self, _: &[Interval], _: &[Interval], _: Interval, o: &mut [Interval]) {
-            o.copy_from_slice(&[Interval::ZERO, Interval::ONE]);
+            if self.forced {
+                o.copy_from_slice(&[Interval::ZERO, Interval::ONE]);
+            }
         }
         fn diffusion(&self, x: &[f64], t: f64, out: &mut [f64]) {
-            Pendulum.diffusion(x, t, out);
+            if self.multiplicative {
+                out.copy_from_slice(&[0.0, 0.1 + 0.05 * x[0].sin()]);
+            } else {
+                Pendulum.diffusion(x, t, out);
+            }
         }
         fn diffusion_interval(&self, x: &[Interval], t: Interval, o: &mut [Interval]) {
-            Pendulum.diffusion_interval(x, t, o);
+            if self.multiplicative {
+                let p = Interval::point;
+                o.copy_from_slice(&[Interval::ZERO, p(0.1) + p(0.05) * x[0].sin()]);
+            } else {
+                Pendulum.diffusion_interval(x, t, o);
+            }
         }
     }
 
-    /// `info` for [`Forced`]: its input in `[-0.5, 1]`.
+    /// `info` for [`FORCED`]: its input in `[-0.5, 1]`.
     fn with_input(info: &ModelInfo) -> ModelInfo {
         let mut info = info.clone();
         info.inputs = vec!["u".into()];

@@ -37,8 +37,8 @@ impl MethodDoc {
                  (outward-rounded arithmetic).\n\n"
             }
             Kind::X8 => {
-                "Lanes form: eight states and inputs at once, each lane bit for bit what `drift` \
-                 gives.\n\n"
+                "Lanes form: eight states and inputs at once, each lane bit for bit what the \
+                 `f64` form gives.\n\n"
             }
         };
         doc_attrs(&format!("{}.\n\n{form}{}", self.what, self.equations))
@@ -57,7 +57,7 @@ pub(super) struct SystemDocs {
     pub(super) jac_x_pattern: MethodDoc,
     /// `jac_u`, `jac_u_interval`.
     pub(super) jac_u: MethodDoc,
-    /// `diffusion`, `diffusion_interval`.
+    /// `diffusion`, `diffusion_interval`, `diffusion_x8`.
     pub(super) diffusion: MethodDoc,
 }
 
