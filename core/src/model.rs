@@ -8,7 +8,7 @@ use crate::interval::Interval;
 use std::fmt;
 
 /// A closed interval `[lo, hi]` of reals given by its ends (`-inf` and `inf` allowed), as plain
-/// data (no rounding: see [`Interval`](crate::Interval) for arithmetic).
+/// data (no rounding: see [`Interval`] for arithmetic).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
     /// Lower end.

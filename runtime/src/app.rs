@@ -2,7 +2,7 @@
 //! interpreter: run a model's analyses (summaries, JSON and CSV results) or check them against
 //! Monte Carlo sample paths (`simulate`).
 //!
-//! [`run`] and [`simulate`] take typed options ([`RunOptions`], [`SimulateOptions`]); a
+//! [`run`] and [`simulate()`] take typed options ([`RunOptions`], [`SimulateOptions`]); a
 //! generated binary's command line is their textual form, parsed by [`Command::parse`] and
 //! written by `to_args` (by hand, no clap, so the runtime stays light):
 //! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe]`, or `simulate --paths N [options]`
@@ -340,7 +340,7 @@ pub fn main_with<S: System + Sync>(sys: &S, info: &ModelInfo) -> ExitCode {
 }
 
 /// Runs the command line `args` (without the program name), writing to `out` / `err`: parses
-/// it ([`Command::parse`]) and calls [`run`] or [`simulate`]. A usage error exits with
+/// it ([`Command::parse`]) and calls [`run`] or [`simulate()`]. A usage error exits with
 /// [`EXIT_USAGE`] after the help text.
 pub fn run_cli<S: System + Sync>(
     sys: &S,

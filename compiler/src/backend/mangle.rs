@@ -162,7 +162,7 @@ pub fn type_name(model_name: &str) -> String {
 /// (`van_der_pol` -> `van-der-pol`, `VanDerPol` -> `van-der-pol`). A name that is empty,
 /// starts with a digit, or is a Rust keyword or a name Cargo reserves gets the prefix
 /// `model-` (`3d` -> `model-3d`, `fn` -> `model-fn`). A name longer than [`MAX_CRATE_NAME`]
-/// bytes is cut and ends with a hash of the model's name (see [`bounded`]).
+/// bytes is cut and ends with a hash of the model's name.
 pub fn crate_name(model_name: &str) -> String {
     bounded(model_name, unbounded_crate_name(model_name))
 }

@@ -75,7 +75,7 @@ pub struct SimStep {
     pub t: f64,
     /// The analysis' stochastic radius `r_t`.
     pub r_t: f64,
-    /// The analysis' PRS radius (see [`SimReport::compared`]).
+    /// The analysis' PRS radius (the coverage check compares the quantile with it).
     pub prs_radius: f64,
     /// Empirical `(1 - delta)` quantile of `|X_t - x*_t|_P`.
     pub quantile: f64,

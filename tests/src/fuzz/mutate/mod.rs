@@ -33,7 +33,7 @@ fn any_pick() -> impl Strategy<Value = Pick> {
 /// A change to the text of a spec.
 #[derive(Clone, Debug)]
 pub enum TextMutation {
-    /// A number literal replaced by one of [`EXTREMES`].
+    /// A number literal replaced by one of `EXTREMES`.
     Number(Pick, Pick),
     /// A token deleted.
     DeleteToken(Pick),
@@ -49,18 +49,18 @@ pub enum TextMutation {
     SwapLines(Pick, Pick),
     /// Up to four lines of another seed (`seed`, first line, count) inserted before a line.
     Splice(Pick, Pick, usize, Pick),
-    /// An identifier renamed (every occurrence, or the one chosen) to one of [`NAMES`], to
+    /// An identifier renamed (every occurrence, or the one chosen) to one of `NAMES`, to
     /// another identifier of the spec, or to a 300-character name.
     Rename(Pick, Pick, bool),
-    /// A number or identifier wrapped in [`DEPTHS`] parentheses.
+    /// A number or identifier wrapped in `DEPTHS` parentheses.
     Nest(Pick, Pick),
-    /// Every number of a matrix `[[..]]` multiplied by one of [`SCALES`].
+    /// Every number of a matrix `[[..]]` multiplied by one of `SCALES`.
     ScaleMatrix(Pick, Pick),
-    /// A `for` loop written twice, or wrapped in 1 to 3 loops over `1..`[`LOOP_ENDS`].
+    /// A `for` loop written twice, or wrapped in 1 to 3 loops over `1..LOOP_ENDS`.
     ForLoop(Pick, bool, usize, Pick),
-    /// An analysis key given one of its [`ANALYSIS`] values (replaced, or added).
+    /// An analysis key given one of its `ANALYSIS` values (replaced, or added).
     AnalysisKey(Pick, Pick, Pick),
-    /// One of [`LINES`] inserted before a line.
+    /// One of `LINES` inserted before a line.
     InsertLine(Pick, Pick),
 }
 
