@@ -17,28 +17,16 @@ Prints path-steps per second of the loop alone (numpy imports and result loading
 Needs numpy only (install it in a virtual environment outside the repository).
 """
 
-import argparse
-import json
 import time
 
 import numpy as np
 
+from em_common import report, setup
+
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("result")
-    ap.add_argument("--paths", type=int, default=1_000_000)
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    with open(args.result) as f:
-        res = json.load(f)
-    p = np.array(res["constants"]["metric"], dtype=float)
-    steps = res["steps"]
-    dt = res["step"]
+    n, _, p, steps, dt, rng = setup(__doc__, 1_000_000)
     a, s = -0.4, np.sqrt(2.0)
-
-    rng = np.random.default_rng(args.seed)
-    n = args.paths
     x1 = np.zeros(n)
     x2 = np.zeros(n)
     outside = np.zeros(n, dtype=bool)
@@ -55,10 +43,7 @@ def main():
         outside |= q > st["prs_radius"] ** 2
     secs = time.perf_counter() - started
     path_steps = n * (len(steps) - 1)
-    print(
-        f"numpy {np.__version__}: {path_steps:.3e} path-steps in {secs:.3f} s "
-        f"({path_steps / secs:.3e}/s); outside at some time {outside.sum()}"
-    )
+    report(path_steps, secs, [("outside at some time", outside.sum())])
 
 
 if __name__ == "__main__":

@@ -22,31 +22,20 @@ Prints path-steps per second of the loop alone (numpy imports and result loading
 Needs numpy only (install it in a virtual environment outside the repository).
 """
 
-import argparse
-import json
 import time
 
 import numpy as np
 
+from em_common import report, setup
+
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("result")
-    ap.add_argument("--paths", type=int, default=100_000)
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    with open(args.result) as f:
-        res = json.load(f)
-    p = np.array(res["constants"]["metric"], dtype=float)
-    steps = res["steps"]
-    dt = res["step"]
+    n, res, p, steps, dt, rng = setup(__doc__, 100_000)
     transform = res.get("transform")
     t_mat = np.array(transform["matrix"], dtype=float) if transform else None
     t_inv = np.array(transform["inverse"], dtype=float) if transform else None
     g, length, k1, k2, noise = 10.0, 1.0, -20.0, -20.0, 0.1
 
-    rng = np.random.default_rng(args.seed)
-    n = args.paths
     theta = rng.uniform(-np.pi / 10, np.pi / 10, n)
     omega = rng.uniform(-0.2, 0.2, n)
     outside = np.zeros(n, dtype=bool)
@@ -82,10 +71,10 @@ def main():
             outside |= quad(d0, d1) > st["r_t"] ** 2
     secs = time.perf_counter() - started
     path_steps = n * (len(steps) - 1)
-    print(
-        f"numpy {np.__version__}: {path_steps:.3e} path-steps in {secs:.3f} s "
-        f"({path_steps / secs:.3e}/s); outside at some time {outside.sum()}, "
-        f"left the tube {left_tube.sum()}"
+    report(
+        path_steps,
+        secs,
+        [("outside at some time", outside.sum()), ("left the tube", left_tube.sum())],
     )
 
 

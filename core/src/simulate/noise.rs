@@ -113,7 +113,9 @@ impl Noise {
         sys: &S,
         x: &mut [X8],
         f: &[X8],
-        (t, h, sqrt_h): (f64, f64, f64),
+        t: f64,
+        h: f64,
+        sqrt_h: f64,
         z: &mut [X8],
         g: &mut [X8],
     ) {

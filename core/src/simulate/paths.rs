@@ -58,6 +58,20 @@ impl Span {
             sqrt_h: h.sqrt(),
         }
     }
+
+    /// The start and end of Euler step `i` (the last one ends at `t1` exactly).
+    #[inline(always)]
+    pub(crate) fn step_times(&self, i: u32) -> (f64, f64) {
+        let t = self.t0 + f64::from(i) * self.h;
+        (
+            t,
+            if i + 1 == self.steps {
+                self.t1
+            } else {
+                t + self.h
+            },
+        )
+    }
 }
 
 /// Everything a chunk of paths needs, shared read-only by the workers.
@@ -405,18 +419,13 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 }
             }
             for i in 0..span.steps {
-                let t = span.t0 + f64::from(i) * span.h;
+                let (t, t_end) = span.step_times(i);
                 let report = (i + 1 == span.steps).then(|| Report {
                     k,
                     c: &self.nominal[k * n..][..n],
                     thr: thresholds[k],
                     quiet: l.quiet.as_ref().map(|q| q[k]),
                 });
-                let t_end = if report.is_some() {
-                    span.t1
-                } else {
-                    t + span.h
-                };
                 let step = Step {
                     t,
                     t_end,
@@ -778,7 +787,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         let mut g = [X8::splat(0.0); SMALL * SMALL];
         for (k, span) in (1..).zip(&self.spans) {
             for i in 0..span.steps {
-                let t = span.t0 + f64::from(i) * span.h;
+                let (t, t_end) = span.step_times(i);
                 // A path draws its inputs (when they change), then its m normals in channel
                 // order (the drift draws nothing).
                 if p > 0 {
@@ -790,22 +799,18 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 }
                 let mut xs = group.states();
                 self.sys.drift_x8(&xs[..n], &u[..p], t, &mut f[..n]);
-                let steps = (t, span.h, span.sqrt_h);
                 self.noise.apply_x8(
                     self.sys,
                     &mut xs[..n],
                     &f[..n],
-                    steps,
+                    t,
+                    span.h,
+                    span.sqrt_h,
                     &mut z[..m],
                     &mut g[..n * m],
                 );
                 group.set_states(&xs);
                 if check_sets {
-                    let t_end = if i + 1 == span.steps {
-                        span.t1
-                    } else {
-                        t + span.h
-                    };
                     self.check_sets_x8(t_end, &xs[..n], live, hit, paths, st);
                 }
                 let report = (i + 1 == span.steps).then(|| Report {
