@@ -71,8 +71,8 @@ pub(crate) fn log_inv_delta_upper(delta: f64) -> f64 {
 /// `eps1 = 2 ln(1 + 2/eps) / (1 - eps)^2` and `eps2 = 2 / (1 - eps)^2`, for `eps` in `(0, 1)`.
 ///
 /// The general formula is used for every `n`, including `n = 1` (where the paper allows the
-/// Hoeffding constants `eps1 = 2 ln 2`, `eps2 = 2`): the shared reference values
-/// (`kappa_paper_eps_1_16` in `shared/reference/kappa.jsonl`) use the general formula at `n = 1`,
+/// Hoeffding constants `eps1 = 2 ln 2`, `eps2 = 2`): the reference values
+/// (`kappa_paper_eps_1_16` in `core/tests/data/kappa.jsonl`) use the general formula at `n = 1`,
 /// and for `n = 1` the `amgf` rule is anyway never above the Hoeffding value
 /// `2 ln 2 + 2 ln(1/delta)` (since `cosh z >= e^z / 2`).
 ///

@@ -1,5 +1,5 @@
-//! `kappa(n, delta)` against the shared 30-digit reference values
-//! (`../shared/reference/kappa.jsonl`) and the structural properties of the rules.
+//! `kappa(n, delta)` against the 30-digit reference values (`core/tests/data/kappa.jsonl`,
+//! recomputed by `scripts/reference/kappa.py`) and the structural properties of the rules.
 
 use reachc_core::kappa::{kappa, kappa_amgf, kappa_paper, kappa_paper_optimal, log_phi_lower};
 use reachc_core::model::RadiusRule;
@@ -13,10 +13,7 @@ struct Row {
 }
 
 fn reference() -> Vec<Row> {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/reference/kappa.jsonl"
-    );
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/kappa.jsonl");
     let text = std::fs::read_to_string(path)
         .unwrap_or_else(|e| panic!("cannot read the kappa reference {path}: {e}"));
     let rows: Vec<Row> = text

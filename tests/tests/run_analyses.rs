@@ -19,9 +19,9 @@ fn run(spec: &str, name: &str) -> (Prs, Interpreter, ModelInfo) {
     (result, interp, prepared.info)
 }
 
-/// `kappa` for (n, delta) and a field of the shared 30-digit reference.
+/// `kappa` for (n, delta) and a field of the 30-digit reference (core/tests/data/README.md).
 fn reference_kappa(n: usize, delta: f64, field: &str) -> f64 {
-    let path = workspace().join("../shared/reference/kappa.jsonl");
+    let path = workspace().join("core/tests/data/kappa.jsonl");
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     text.lines()
         .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())

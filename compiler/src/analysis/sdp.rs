@@ -3,9 +3,10 @@
 //!
 //! `min c` subject to `A_i'P + PA_i <= 2cP` for every vertex `A_i` and `P >= I` is quasi-convex
 //! (convex feasibility for fixed `c`), so it is solved by bisection on `c` with one SDP
-//! feasibility problem per step (`min trace(P)` over the LMIs, with Clarabel), as in
-//! `reference/pendulum.json`. The returned `P` is a float proposal like any other metric: it must
-//! go through the certified [`super::constants`] before its rate is used.
+//! feasibility problem per step (`min trace(P)` over the LMIs, with Clarabel). The pendulum's
+//! optimum, computed independently, is in `core/tests/data/pendulum.json`. The returned `P` is a
+//! float proposal like any other metric: it must go through the certified
+//! [`super::constants`] before its rate is used.
 
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
@@ -232,7 +233,7 @@ mod tests {
 
     #[test]
     fn pendulum_reference() {
-        // reference/pendulum.json: sdp_optimum_c = -0.5132 for these vertices.
+        // core/tests/data/pendulum.json: sdp_optimum_c = -0.5132 for these vertices.
         let v = vec![vec![0.0, 1.0, -10.0, -20.0], vec![0.0, 1.0, -30.0, -20.0]];
         let (c, p) = optimal_metric(&v).unwrap();
         assert!((c + 0.5132).abs() < 1e-3, "c = {c}, P = {p:?}");
