@@ -520,7 +520,10 @@ pub enum Proved {
         /// Given the nominal (contraction) or the box (interval).
         given: Method,
     },
-    /// The initial box in `y = T x` and the map back to `x`.
+    /// The transformed system, the initial box in `y = T x` and the map back to `x`. The
+    /// transformed drift `T f(T^-1 y)` is built by the compiler with the exact `T^-1` and
+    /// coefficients folded without rounding (enclosures where a fold is inexact), so its
+    /// interval forms enclose it as the model's enclose `f`.
     TransformMaps {
         /// The bound of `T^-1`'s entries around the floating-point inverse.
         inverse_error: f64,
@@ -582,8 +585,6 @@ pub enum Unproved {
         /// Its step.
         step: f64,
     },
-    /// The transformed drift `T f(T^-1 y)` was formed with rounded coefficients.
-    TransformedDrift,
 }
 
 impl Prs {

@@ -571,7 +571,7 @@ impl<'a> Emitter<'a> {
         self.kind == Kind::X8
             && match self.pool.node(id) {
                 Node::Var(v) => matches!(v, Var::State(_) | Var::Input(_)),
-                Node::Const(_) => false,
+                Node::Const(_) | Node::Enclosure { .. } => false,
                 _ => self.lanes.contains(&id),
             }
     }
@@ -608,6 +608,14 @@ impl<'a> Emitter<'a> {
     fn operand(&mut self, id: ExprId) -> TokenStream {
         match self.pool.node(id) {
             Node::Const(c) => self.constant(c.get()),
+            &Node::Enclosure { approx, lo, hi } => match self.kind {
+                Kind::F64 | Kind::X8 => float(approx.get()),
+                Kind::Interval => {
+                    self.uses_interval = true;
+                    let (lo, hi) = (float(lo.get()), float(hi.get()));
+                    quote!(Interval::new(#lo, #hi))
+                }
+            },
             Node::Var(v) => match *v {
                 Var::State(i) => {
                     self.x_len = self.x_len.max(i as usize + 1);
@@ -637,7 +645,10 @@ impl<'a> Emitter<'a> {
     fn method(&mut self, recv: ExprId, method: &str, args: &[TokenStream]) -> TokenStream {
         let m = format_ident!("{}", method);
         let r = self.operand(recv);
-        if matches!(self.pool.node(recv), Node::Const(_)) {
+        if matches!(
+            self.pool.node(recv),
+            Node::Const(_) | Node::Enclosure { .. }
+        ) {
             let ty = match self.kind {
                 Kind::F64 | Kind::X8 => quote!(f64),
                 Kind::Interval => {
@@ -660,7 +671,7 @@ impl<'a> Emitter<'a> {
             self.lanes.insert(id);
         }
         match self.pool.node(id) {
-            Node::Const(_) | Node::Var(_) => self.operand(id),
+            Node::Const(_) | Node::Enclosure { .. } | Node::Var(_) => self.operand(id),
             Node::Sum { constant, terms } => {
                 let c = constant.get();
                 let mut acc = (c != 0.0).then(|| self.constant(c));
@@ -887,15 +898,19 @@ fn param_name(used: bool, name: &str) -> Ident {
     }
 }
 
-/// Whether `id` is a leaf (constant or variable), written inline rather than as a `let`.
+/// Whether `id` is a leaf (constant, enclosure or variable), written inline rather than as a
+/// `let`.
 fn is_leaf(pool: &Pool, id: ExprId) -> bool {
-    matches!(pool.node(id), Node::Const(_) | Node::Var(_))
+    matches!(
+        pool.node(id),
+        Node::Const(_) | Node::Enclosure { .. } | Node::Var(_)
+    )
 }
 
 /// The operands of a node, in the order [`Emitter::node_expr`] reads them.
 fn children(node: &Node) -> Vec<ExprId> {
     match node {
-        Node::Const(_) | Node::Var(_) => Vec::new(),
+        Node::Const(_) | Node::Enclosure { .. } | Node::Var(_) => Vec::new(),
         Node::Sum { terms, .. } => terms.iter().map(|&(t, _)| t).collect(),
         Node::Product { factors } => factors.iter().map(|&(b, _)| b).collect(),
         Node::Call1(_, a) | Node::Table { arg: a, .. } => vec![*a],

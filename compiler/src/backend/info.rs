@@ -58,7 +58,10 @@ pub fn prepare(model: &mut Model) -> Prepared {
         // One transformed system per distinct `T` (the checker numbered them).
         if let Some(t) = &a.spec.transform {
             if t.frame == frames.len() {
-                frames.push(Frame::of(model, t));
+                frames.push(
+                    Frame::of(model, t)
+                        .expect("the checker accepts only transforms with a finite inverse"),
+                );
             }
         }
         analyses.push(Analysis {

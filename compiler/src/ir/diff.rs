@@ -42,7 +42,7 @@ impl Pool {
         let zero = self.num(0.0);
         let node = self.node(id).clone();
         match node {
-            Node::Const(_) => zero,
+            Node::Const(_) | Node::Enclosure { .. } => zero,
             Node::Var(w) => {
                 if w == v {
                     self.num(1.0)

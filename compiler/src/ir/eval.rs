@@ -15,6 +15,9 @@ use super::table::Table;
 pub trait Arith: Copy {
     /// A constant (for intervals: the point interval, exact).
     fn constant(v: f64) -> Self;
+    /// A constant known to lie in `[lo, hi]` whose floating-point value is `approx`
+    /// ([`Node::Enclosure`]): `approx` for points, `[lo, hi]` for intervals.
+    fn enclosure(approx: f64, lo: f64, hi: f64) -> Self;
     /// `self + o`.
     fn add(self, o: Self) -> Self;
     /// `self - o`.
@@ -85,6 +88,9 @@ impl Pool {
         for &id in order {
             let v = match self.node(id) {
                 Node::Const(c) => T::constant(c.get()),
+                Node::Enclosure { approx, lo, hi } => {
+                    T::enclosure(approx.get(), lo.get(), hi.get())
+                }
                 Node::Var(v) => match *v {
                     Var::State(i) => vars.states[i as usize],
                     Var::Input(i) => vars.inputs[i as usize],
@@ -146,6 +152,9 @@ impl Arith for f64 {
     fn constant(v: f64) -> Self {
         v
     }
+    fn enclosure(approx: f64, _lo: f64, _hi: f64) -> Self {
+        approx
+    }
     fn add(self, o: Self) -> Self {
         self + o
     }
@@ -201,6 +210,9 @@ impl Arith for f64 {
 impl Arith for Interval {
     fn constant(v: f64) -> Self {
         Interval::point(v)
+    }
+    fn enclosure(_approx: f64, lo: f64, hi: f64) -> Self {
+        Interval::new(lo, hi)
     }
     fn add(self, o: Self) -> Self {
         self + o

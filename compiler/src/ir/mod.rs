@@ -10,6 +10,7 @@
 
 mod diff;
 mod eval;
+mod fold;
 mod node;
 mod pool;
 mod print;

@@ -99,11 +99,27 @@ pub enum Func2 {
 /// - `Product` factors are non-constant, non-`Product`, non-`Sum`-with-coefficient nodes sorted
 ///   by id, with non-zero integer exponents, no repeated base; a `Product` has at least two
 ///   factors or one factor with exponent != 1;
-/// - a constant sub-expression is always folded to `Const`.
+/// - a constant sub-expression is always folded, to `Const` when the folded value is exact and to
+///   `Enclosure` when it is not (the pool never rounds a constant silently); a coefficient that
+///   is not exact in floating point is an `Enclosure` factor of its term
+///   (`Product { [(enclosure, 1), (term, 1)] }` with coefficient 1 in the `Sum`).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Node {
-    /// A finite constant.
+    /// A finite constant, exactly this value.
     Const(F64),
+    /// A real constant known to lie in `[lo, hi]` (`lo < hi`): the exact value of a constant
+    /// expression whose floating-point value is not exact (`1/3`, `sin(1)`, `0.2 * 0.3`, the
+    /// entries of `T^-1`). Interval evaluation uses `[lo, hi]`, so the IR's enclosures hold the
+    /// real-number expression; point evaluation uses `approx`, the value the same operations
+    /// give in round-to-nearest floating point (inside `[lo, hi]`).
+    Enclosure {
+        /// The floating-point value (what point evaluation uses).
+        approx: F64,
+        /// A lower bound of the exact value.
+        lo: F64,
+        /// An upper bound of the exact value.
+        hi: F64,
+    },
     /// A model variable.
     Var(Var),
     /// `constant + sum(coef * term)`.

@@ -185,7 +185,6 @@ pub(super) fn deterministic(
         rigorous.push(Proved::TransformMaps {
             inverse_error: tr.inverse_error,
         });
-        not_validated.push(Unproved::TransformedDrift);
     }
     let det = Deterministic {
         start: det_set(start),

@@ -519,8 +519,9 @@ fn proved(p: &Proved) -> String {
             }
         ),
         Proved::TransformMaps { inverse_error } => format!(
-            "the initial box in y = T x (interval hull of T X0) and the map back to x (T^-1 \
-             enclosed entry-wise within {inverse_error:.1e} of the floating-point inverse)"
+            "the transformed drift T f(T^-1 y) (exact T^-1, coefficients folded without \
+             rounding), the initial box in y = T x (interval hull of T X0) and the map back to x \
+             (T^-1 enclosed entry-wise within {inverse_error:.1e} of the floating-point inverse)"
         ),
         Proved::ValidatedNominal { steps } => format!(
             "nominal trajectory on {steps} validated steps (a cubic through RK4 nodes, its \
@@ -578,12 +579,6 @@ fn unproved(u: &Unproved) -> String {
              up to the integration error",
             integrator.name()
         ),
-        Unproved::TransformedDrift => {
-            "the transformed drift T f(T^-1 y) is formed symbolically with T^-1 and the combined \
-             coefficients rounded to floating point (relative errors ~1e-16, not bounded; far \
-             below the integration error)"
-                .into()
-        }
     }
 }
 

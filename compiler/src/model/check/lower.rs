@@ -115,8 +115,9 @@ impl Checker<'_> {
     /// Lowers an expression that must be a constant and returns its value.
     pub(super) fn constant(&mut self, e: &Expr, env: &LoopEnv) -> Option<f64> {
         let id = self.lower(e, Allow::Constants, env)?;
-        // Every leaf is a number here and folding failures were reported, so this is a constant.
-        self.pool.as_const(id)
+        // Every leaf is a number here and folding failures were reported, so this is a constant
+        // (its floating-point value when the fold was not exact).
+        self.pool.as_value(id)
     }
 
     /// Lowers an expression that must be an integer constant (indices, loop bounds).
@@ -135,8 +136,8 @@ impl Checker<'_> {
     /// A node built from constant arguments that did not fold to a constant overflowed or left
     /// its domain (e.g. `1/0`, `log(-1)`): report it.
     fn check_folded(&mut self, id: ExprId, args: &[ExprId], span: Span) -> Option<ExprId> {
-        let all_const = args.iter().all(|a| self.pool.as_const(*a).is_some());
-        if all_const && self.pool.as_const(id).is_none() {
+        let all_const = args.iter().all(|a| self.pool.as_value(*a).is_some());
+        if all_const && self.pool.as_value(id).is_none() {
             return self.fail(
                 Diagnostic::error(
                     "this constant expression has no finite value",

@@ -364,14 +364,14 @@ impl Checker<'_> {
                 return not_linear(self);
             };
             let d = self.pool.diff(g, v);
-            let Some(a) = self.pool.as_const(d) else {
+            let Some(a) = self.pool.as_value(d) else {
                 return not_linear(self);
             };
             normal[i as usize] = a;
         }
         let zero = self.pool.num(0.0);
         let at_zero = self.pool.substitute(g, &mut |_| Some(zero));
-        let offset = -self.pool.as_const(at_zero)?;
+        let offset = -self.pool.as_value(at_zero)?;
         if normal.iter().all(|a| *a == 0.0) {
             return self.fail(Diagnostic::error(
                 "the half-space does not depend on any state",
