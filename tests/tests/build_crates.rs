@@ -828,7 +828,11 @@ fn generated_code_agrees_with_the_interpreter() {
                 for (&g, (entry, i)) in points.iter().zip(&want.points) {
                     assert!(
                         same(g, *i),
-                        "{what}: {entry}: generated {g:e}, interpreter {i:e}"
+                        "{what}: {entry}: generated {g:e}, interpreter {i:e} (x = {:?}, u = {:?}, \
+                         t = {:?})",
+                        s.x,
+                        s.u,
+                        s.t
                     );
                 }
                 for (g, (entry, i)) in boxes.iter().zip(&want.boxes) {

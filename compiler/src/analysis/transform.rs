@@ -126,9 +126,9 @@ fn exact_inverse(t: &[f64], n: usize) -> Option<Vec<BigRational>> {
         for r in 0..n {
             if r != col && !a[r][col].is_zero() {
                 let factor = a[r][col].clone();
-                for k in 0..2 * n {
-                    let d = &factor * &a[col][k];
-                    a[r][k] -= d;
+                let pivot_row = a[col].clone();
+                for (v, p) in a[r].iter_mut().zip(&pivot_row) {
+                    *v -= &factor * p;
                 }
             }
         }
@@ -235,9 +235,9 @@ mod tests {
                 assert!(holds(got[i], &fy), "y = {y:?}: {} misses {fy}", got[i]);
                 for j in 0..2 {
                     let mut d = BigRational::zero();
-                    for k in 0..2 {
-                        for l in 0..2 {
-                            d += q(t.matrix[2 * i + k]) * &jf[k][l] * &tinv[2 * l + j];
+                    for (k, row) in jf.iter().enumerate() {
+                        for (l, entry) in row.iter().enumerate() {
+                            d += q(t.matrix[2 * i + k]) * entry * &tinv[2 * l + j];
                         }
                     }
                     let g = got[2 + 2 * i + j];

@@ -154,7 +154,7 @@ pub(crate) fn inverse(m: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, MatrixError> {
     let inv: Vec<Vec<f64>> = a.into_iter().map(|row| row[n..].to_vec()).collect();
     // Far inside the floating-point range, so the exact inverse (which the pivot bound keeps
     // within a small relative distance of this one) is finite too (analysis/transform.rs).
-    if inv.iter().flatten().any(|v| !(v.abs() <= 1e300)) {
+    if inv.iter().flatten().any(|v| v.is_nan() || v.abs() > 1e300) {
         return Err(MatrixError::Singular);
     }
     Ok(inv)
