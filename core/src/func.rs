@@ -1,5 +1,5 @@
 //! Special functions shared by the compiler's IR interpreter and generated code, so both
-//! evaluate `sinc`, its derivative and `sign` with one implementation.
+//! evaluate `sinc`, its derivative, `sign` and `pow` with one implementation.
 //!
 //! The interval versions of `sinc` and `sign` are [`Interval::sinc`] and [`Interval::sign`];
 //! the derivative of `sinc` has no `Interval` method and is [`dsinc_interval`].
@@ -26,6 +26,15 @@ pub fn dsinc(x: f64) -> f64 {
     } else {
         (x * x.cos() - x.sin()) / (x * x)
     }
+}
+
+/// `x^y` by the C library's `pow`, out of line: where the caller's base or exponent is a
+/// literal, LLVM rewrites `f64::powf` (`pow(2, y)` as `exp2(y)`, which differs from `pow` in
+/// the last bit), and does so in some functions and not others. Generated code and the
+/// interpreter both call this function, so they agree bit for bit.
+#[inline(never)]
+pub fn pow(x: f64, y: f64) -> f64 {
+    x.powf(y)
 }
 
 /// -1, 0 or 1 (NaN stays NaN); unlike `f64::signum`, `sign(0) = 0`.

@@ -832,7 +832,11 @@ impl<'a> Emitter<'a> {
                 quote!(#x.#m(#y))
             }
             (Func2::Atan2, _) => self.method(a, "atan2", &[y]),
-            (Func2::Pow, Kind::F64 | Kind::X8) => self.method(a, "powf", &[y]),
+            (Func2::Pow, Kind::F64 | Kind::X8) if a_lanes => self.method(a, "powf", &[y]),
+            (Func2::Pow, Kind::F64 | Kind::X8) => {
+                let x = self.operand(a);
+                quote!(reachc_runtime::func::pow(#x, #y))
+            }
             (Func2::Pow, Kind::Interval) => self.method(a, "pow", &[y]),
         }
     }

@@ -174,7 +174,7 @@ impl Arith for f64 {
         f64::powi(self, n)
     }
     fn pow(self, o: Self) -> Self {
-        self.powf(o)
+        reachc_core::func::pow(self, o)
     }
     fn call1(self, f: Func1) -> Self {
         match f {
@@ -199,7 +199,7 @@ impl Arith for f64 {
             Func2::Atan2 => self.atan2(o),
             Func2::Min => f64::min(self, o),
             Func2::Max => f64::max(self, o),
-            Func2::Pow => self.powf(o),
+            Func2::Pow => reachc_core::func::pow(self, o),
         }
     }
     fn table(table: &Table, column: usize, at: Self) -> Self {

@@ -134,10 +134,10 @@ impl X8 {
         self.map(|a| a.powi(k))
     }
 
-    /// `f64::powf` of every lane.
+    /// [`crate::func::pow`] of every lane.
     #[inline(always)]
     pub fn powf(self, y: impl Into<X8>) -> X8 {
-        self.zip(y.into(), f64::powf)
+        self.zip(y.into(), crate::func::pow)
     }
 
     /// `f64::atan2` of every lane (`self` is `y`).
