@@ -2,6 +2,7 @@
 //! `reachc run` (and `simulate`) exits 1 with a diagnostic at the place its first line names
 //! (`// expect: LINE:COL CULPRIT`): the setting to change, the state, or the analysis.
 
+#[allow(dead_code)] // `spec` (the shipped specs) is not used here
 mod common;
 
 use std::path::{Path, PathBuf};
