@@ -105,3 +105,40 @@ impl Locator {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use reachc_compiler::driver::load;
+
+    fn locator() -> Locator {
+        let spec = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/run_errors/step_too_coarse.sde");
+        Locator::new(&load(&spec).unwrap(), false)
+    }
+
+    #[test]
+    fn a_binary_s_failure_line_is_rendered_at_its_setting() {
+        let l = locator();
+        let shown = l.line("reachc-failure blows_up setting:step could not run: it blew up");
+        assert!(
+            shown.starts_with("Error: analysis `blows_up` could not run: it blew up"),
+            "{shown}"
+        );
+        assert!(shown.contains("step_too_coarse.sde:18:5 ]"), "{shown}");
+        assert!(shown.contains("in analysis `blows_up`"), "{shown}");
+        // A state, by index: its declaration.
+        let shown = l.line("reachc-failure good state:0 could not run: left the domain");
+        assert!(shown.contains("step_too_coarse.sde:5:1 ]"), "{shown}");
+        assert!(shown.contains("state `x`"), "{shown}");
+        // Other lines pass through; an analysis the spec does not have is printed as prose.
+        assert_eq!(
+            l.line("skipped analysis `a`: why"),
+            "skipped analysis `a`: why\n"
+        );
+        assert_eq!(
+            l.line("reachc-failure other - could not run: x"),
+            "error: analysis `other` could not run: x\n"
+        );
+    }
+}
