@@ -171,7 +171,7 @@ fn an_unchanged_spec_runs_its_cached_binary_without_cargo() {
     assert_eq!(first.status.code(), Some(0), "{}", text(&first.stderr));
     assert_eq!(
         text(&first.stdout),
-        format!("fake binary -o {out}\n"),
+        format!("fake binary -o {out} --error-lines\n"),
         "the binary ran with the arguments"
     );
     let stderr = text(&first.stderr);
@@ -203,7 +203,10 @@ fn an_unchanged_spec_runs_its_cached_binary_without_cargo() {
     std::thread::sleep(std::time::Duration::from_millis(20));
     let second = world.reachc(&["run", &spec, "-o", &out], Some(Path::new("/bin/false")));
     assert_eq!(second.status.code(), Some(0), "{}", text(&second.stderr));
-    assert_eq!(text(&second.stdout), format!("fake binary -o {out}\n"));
+    assert_eq!(
+        text(&second.stdout),
+        format!("fake binary -o {out} --error-lines\n")
+    );
     assert_eq!(text(&second.stderr), "");
     assert_eq!(files(&cache), before);
     // simulate uses the same binary.

@@ -1,6 +1,7 @@
 //! Whole outputs and honest exit codes of `reachc run`, `simulate` and `plot` (interpreter
-//! backend): a failed command writes nothing, write errors are I/O errors (2), `--deny-unsafe`
-//! fails on "not shown safe" (3), a result that is not finite is an error (1).
+//! backend): a failed analysis keeps the others' files (each whole) and exits 1, write errors
+//! are I/O errors (2) that write nothing, `--deny-unsafe` fails on "not shown safe" (3), a
+//! result that is not finite is an error of its analysis (1).
 
 mod common;
 
@@ -62,37 +63,43 @@ fn run_interp(dir: &Path, extra: &[&str]) -> Output {
 }
 
 #[test]
-fn a_failed_run_writes_nothing() {
+fn a_failed_analysis_keeps_the_others() {
     let dir = scratch("failed", GROWING);
     let out = dir.join("out");
     let o = run_interp(&dir, &["-o", s(&out)]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    // `short` ran, `long` did not: neither is written, not even the folder.
-    assert!(!out.exists());
-    assert_eq!(names(&dir), ["spec.sde"]);
-    // Into an existing folder: its files are left as they were, no new one appears.
+    // `short` ran and is written, whole; `long` did not, and says so.
+    assert_eq!(names(&out), ["short.csv", "short.json"]);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("short.json")).unwrap()).unwrap();
+    assert_eq!(json["analysis"], "short");
+    assert!(text(&o).contains("error: 1 analysis of 2 failed (the others' files are written)"));
+    // Into an existing folder: the old file of `short` is replaced, no file of `long` appears.
+    std::fs::remove_dir_all(&out).unwrap();
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("short.json"), "old").unwrap();
     let o = run_interp(&dir, &["-o", s(&out)]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert_eq!(names(&out), ["short.json"]);
-    assert_eq!(
-        std::fs::read_to_string(out.join("short.json")).unwrap(),
-        "old"
-    );
-    // With --plot neither results nor pictures are written.
-    let plots = dir.join("plots");
-    let o = run_interp(&dir, &["-o", s(&out), "--plot", s(&plots)]);
-    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert!(!plots.exists());
-    assert_eq!(names(&out), ["short.json"]);
-    // The analysis that runs alone writes its files (over the old one).
-    let o = run_interp(&dir, &["-o", s(&out), "--analysis", "short"]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     assert_eq!(names(&out), ["short.csv", "short.json"]);
     assert!(std::fs::read_to_string(out.join("short.json"))
         .unwrap()
         .contains("\"analysis\": \"short\""));
+    // With --plot, results and pictures go together: `short` cannot be drawn (one state), so
+    // neither is written.
+    std::fs::remove_dir_all(&out).unwrap();
+    let plots = dir.join("plots");
+    let o = run_interp(&dir, &["-o", s(&out), "--plot", s(&plots)]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("a 2-D plot needs two states"),
+        "{}",
+        text(&o)
+    );
+    assert!(!plots.exists() && !out.exists());
+    // The analysis that runs alone: exit 0.
+    let o = run_interp(&dir, &["-o", s(&out), "--analysis", "short"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert_eq!(names(&out), ["short.csv", "short.json"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -103,13 +110,11 @@ fn a_result_that_is_not_finite_is_an_error_of_its_analysis() {
     let o = run_interp(&dir, &["-o", s(&out), "--analysis", "long"]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        stderr.contains(
-            "error: analysis `long`: the PRS is not finite from t = 1.8 on (r_t = inf: Psi_t \
-             overflowed (c = 400, sigma = 1"
-        ),
-        "{stderr}"
-    );
+    let message = "Error: analysis `long` has no finite result: the PRS is not finite from t = \
+                   1.8 on (r_t = inf: Psi_t overflowed (c = 400, sigma = 1";
+    assert!(stderr.contains(message), "{stderr}");
+    // Located at the horizon of `long` (line 20 of tests/good/radius_overflow.sde).
+    assert!(stderr.contains("spec.sde:20:5 ]"), "{stderr}");
     assert!(!out.exists());
     // simulate: the same error, nothing written.
     let o = simulate_interp(
@@ -117,8 +122,12 @@ fn a_result_that_is_not_finite_is_an_error_of_its_analysis() {
         &["--paths", "10", "--analysis", "long", "-o", s(&out)],
     );
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert!(text(&o).contains("error: analysis `long`: the PRS is not finite from t = 1.8"));
+    assert!(text(&o).contains(message), "{}", text(&o));
     assert!(!out.exists());
+    // simulate without --analysis: `short`'s report is written.
+    let o = simulate_interp(&dir, &["--paths", "10", "-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert_eq!(names(&out), ["short.sim.json"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

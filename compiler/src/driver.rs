@@ -82,16 +82,75 @@ pub fn check_source(source: &str, dir: &Path) -> (Option<Model>, Vec<Diagnostic>
     (model, all)
 }
 
-/// The bytes of the file at `path`, or `None` if it has more than `cap` bytes. Reads at most
-/// `cap + 1` bytes, so a special file (`/dev/zero`, a FIFO fed forever) cannot exhaust memory.
-pub(crate) fn read_capped(path: &Path, cap: usize) -> std::io::Result<Option<Vec<u8>>> {
+/// Why [`read_capped`] returned no bytes.
+#[derive(Debug)]
+pub(crate) enum ReadError {
+    /// The file could not be opened or read.
+    Io(std::io::Error),
+    /// The path names something other than a regular file (what it is, e.g. "a FIFO").
+    NotRegular(&'static str),
+    /// The file has more bytes than the cap.
+    TooLarge,
+}
+
+/// What a non-regular file is, for the message that refuses it.
+fn kind_of(t: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "an unknown kind of file"
+    }
+}
+
+/// Opens `path` for reading without waiting: on unix with `O_NONBLOCK`, so that opening a FIFO
+/// with no writer returns at once (the handle's type is checked before anything is read).
+fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    options.open(path)
+}
+
+/// The bytes of the regular file at `path`, at most `cap` of them. Anything but a regular file
+/// (a FIFO, a device, a directory) is refused before a byte is read: the file is opened without
+/// blocking and its handle's type checked (`fstat`, so the file checked is the file read). Reads
+/// at most `cap + 1` bytes.
+pub(crate) fn read_capped(path: &Path, cap: usize) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
+    let file = open_nonblocking(path).map_err(ReadError::Io)?;
+    let kind = file.metadata().map_err(ReadError::Io)?.file_type();
+    if !kind.is_file() {
+        return Err(ReadError::NotRegular(kind_of(kind)));
+    }
     let mut bytes = Vec::new();
     let limit = u64::try_from(cap).map_or(u64::MAX, |c| c.saturating_add(1));
-    std::fs::File::open(path)?
-        .take(limit)
-        .read_to_end(&mut bytes)?;
-    Ok((bytes.len() <= cap).then_some(bytes))
+    file.take(limit)
+        .read_to_end(&mut bytes)
+        .map_err(ReadError::Io)?;
+    if bytes.len() > cap {
+        return Err(ReadError::TooLarge);
+    }
+    Ok(bytes)
 }
 
 /// A spec error at the first invalid byte of `bytes` (rendered over the text with invalid bytes
@@ -114,14 +173,27 @@ fn not_utf8(path: &Path, bytes: &[u8], e: std::str::Utf8Error) -> LoadError {
 
 /// Reads, parses and checks the spec at `path`.
 pub fn load(path: &Path) -> Result<Loaded, LoadError> {
-    let bytes = read_capped(path, MAX_SOURCE_LEN)
-        .map_err(|e| LoadError::Io(format!("cannot read {}: {e}", path.display())))?;
-    let Some(bytes) = bytes else {
-        return Err(LoadError::Spec {
-            diagnostics: vec![crate::syntax::too_large()],
-            path: path.display().to_string(),
-            source: String::new(),
-        });
+    let bytes = match read_capped(path, MAX_SOURCE_LEN) {
+        Ok(bytes) => bytes,
+        Err(ReadError::Io(e)) => {
+            return Err(LoadError::Io(format!(
+                "cannot read {}: {e}",
+                path.display()
+            )))
+        }
+        Err(ReadError::NotRegular(kind)) => {
+            return Err(LoadError::Io(format!(
+                "cannot read {}: not a regular file ({kind}); give the path of a .sde file",
+                path.display()
+            )))
+        }
+        Err(ReadError::TooLarge) => {
+            return Err(LoadError::Spec {
+                diagnostics: vec![crate::syntax::too_large()],
+                path: path.display().to_string(),
+                source: String::new(),
+            })
+        }
     };
     let source =
         String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))?;

@@ -1,7 +1,7 @@
 //! [`Reach`]: one analysis of a model, checked once, run from any initial set inside what its
 //! constants were certified for.
 
-use crate::engine::{self, check_initial, Inputs, Needs, Run, RunError, Setup};
+use crate::engine::{self, check_initial, Detail, Inputs, Needs, Run, RunError, Setting, Setup};
 use crate::interval::Interval;
 use crate::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, Inclusion, InitialSet, Method, ModelInfo,
@@ -62,9 +62,12 @@ impl<'a> Reach<'a> {
         let needs = match (spec.method, spec.rate) {
             (_, Rate::Local) if spec.guarantee != Guarantee::Uniform => {
                 return Err(RunError::Unsupported(
-                    "local rates with a pointwise guarantee (the proof that the process never \
-                     leaves the regions needs the time-uniform tube): use `rate = global`"
-                        .into(),
+                    Detail::from(
+                        "local rates with a pointwise guarantee (the proof that the process \
+                         never leaves the regions needs the time-uniform tube): use \
+                         `rate = global`",
+                    )
+                    .at_setting(Setting::Rate),
                 ))
             }
             (_, Rate::Local) => Needs {
@@ -78,10 +81,13 @@ impl<'a> Reach<'a> {
                 rho: false,
             },
             (Method::Interval, rate) => {
-                return Err(RunError::Unsupported(format!(
-                    "a {} rate with the interval method (it uses a certified rate)",
-                    rate.name()
-                )))
+                return Err(RunError::Unsupported(
+                    Detail::from(format!(
+                        "a {} rate with the interval method (it uses a certified rate)",
+                        rate.name()
+                    ))
+                    .at_setting(Setting::Rate),
+                ))
             }
             (Method::Contraction, Rate::Global) => Needs {
                 c: true,
@@ -162,7 +168,10 @@ impl<'a> Reach<'a> {
         plan.check(&self.info.input_box)?;
         if let Rate::Empirical { .. } = self.spec.rate {
             return Err(RunError::Unsupported(
-                "an input plan with an empirical rate (its sample paths draw random inputs)".into(),
+                Detail::from(
+                    "an input plan with an empirical rate (its sample paths draw random inputs)",
+                )
+                .at_setting(Setting::Rate),
             ));
         }
         self.run_from(x0, Inputs::Plan(plan))
@@ -170,11 +179,14 @@ impl<'a> Reach<'a> {
 
     fn initial_box(&self, x0: &[Bounds]) -> Result<InitialSet, RunError> {
         if x0.len() != self.setup.n {
-            return Err(RunError::Invalid(format!(
-                "the initial box has {} ranges, the model {} states",
-                x0.len(),
-                self.setup.n
-            )));
+            return Err(RunError::Invalid(
+                format!(
+                    "the initial box has {} ranges, the model {} states",
+                    x0.len(),
+                    self.setup.n
+                )
+                .into(),
+            ));
         }
         Ok(InitialSet::from_box(x0))
     }
@@ -268,20 +280,26 @@ impl InputPlan {
     fn check(&self, input_box: &[Bounds]) -> Result<(), RunError> {
         for u in &self.values {
             if u.len() != input_box.len() {
-                return Err(RunError::Invalid(format!(
-                    "an input plan value has {} entries, the model {} inputs",
-                    u.len(),
-                    input_box.len()
-                )));
+                return Err(RunError::Invalid(
+                    format!(
+                        "an input plan value has {} entries, the model {} inputs",
+                        u.len(),
+                        input_box.len()
+                    )
+                    .into(),
+                ));
             }
             let inside = u
                 .iter()
                 .zip(input_box)
                 .all(|(&v, b)| Interval::try_new(b.lo, b.hi).is_some_and(|iv| iv.contains(v)));
             if !inside {
-                return Err(RunError::Invalid(format!(
-                    "the input plan value {u:?} leaves the input box, where the constants hold"
-                )));
+                return Err(RunError::Invalid(
+                    format!(
+                        "the input plan value {u:?} leaves the input box, where the constants hold"
+                    )
+                    .into(),
+                ));
             }
         }
         Ok(())

@@ -1,7 +1,7 @@
 //! The contraction-based delta-PRS engine on hand-written systems: closed forms, a Monte Carlo
 //! check of the probability level, safety margins, and the paper's pendulum.
 
-use reachc_core::engine::{self, RunError};
+use reachc_core::engine::{self, Culprit, RunError, Setting};
 use reachc_core::interval::Interval;
 use reachc_core::kappa::kappa;
 use reachc_core::model::{
@@ -725,7 +725,7 @@ fn errors() {
     an.spec.method = Method::Contraction;
     let constants = std::mem::replace(&mut an.constants, Err("d f[x1]/d x1 is unbounded".into()));
     match engine::run(&sys, &inf, &an) {
-        Err(RunError::NoConstants(m)) => assert!(m.contains("unbounded"), "{m}"),
+        Err(RunError::NoConstants(m)) => assert!(m.message.contains("unbounded"), "{m}"),
         other => panic!("expected NoConstants, got {other:?}"),
     }
     an.constants = constants;
@@ -740,7 +740,10 @@ fn errors() {
     let mut tiny = an.clone();
     (tiny.spec.horizon, tiny.spec.step) = (1e-320, 1e-322);
     match engine::run(&sys, &inf, &tiny) {
-        Err(RunError::Invalid(m)) => assert!(m.contains("at least 1e-100"), "{m}"),
+        Err(RunError::Invalid(m)) => {
+            assert!(m.message.contains("at least 1e-100"), "{m}");
+            assert_eq!(m.culprit, Some(Culprit::Setting(Setting::Step)));
+        }
         other => panic!("expected Invalid, got {other:?}"),
     }
     let mut bad = an.clone();
@@ -916,7 +919,7 @@ fn reach_refuses_what_the_constants_do_not_cover() {
     let mut wider = inf.clone();
     wider.input_box = vec![Bounds::new(-2.0, 2.0)];
     match Reach::new(&sys, &wider, "main").map(|_| ()) {
-        Err(RunError::Invalid(m)) => assert!(m.contains("input box"), "{m}"),
+        Err(RunError::Invalid(m)) => assert!(m.message.contains("input box"), "{m}"),
         other => panic!("expected Invalid, got {other:?}"),
     }
     let mut bounded = inf.clone();
@@ -924,7 +927,7 @@ fn reach_refuses_what_the_constants_do_not_cover() {
     bounded.has_domain = true;
     assert!(matches!(
         engine::run(&sys, &bounded, &bounded.analyses[0]),
-        Err(RunError::Invalid(m)) if m.contains("domain")
+        Err(RunError::Invalid(m)) if m.message.contains("domain")
     ));
     // With constants certified over that domain: initial sets inside it run, others do not.
     let constants = Constants::given(&bounded, vec![1.0], -1.0, 0.1, 1.0);
@@ -932,7 +935,10 @@ fn reach_refuses_what_the_constants_do_not_cover() {
     let reach = Reach::new(&sys, &bounded, "main").unwrap();
     assert!(reach.from_box(&[Bounds::new(4.0, 5.0)]).is_ok());
     match reach.from_box(&[Bounds::new(4.0, 5.5)]).map(|_| ()) {
-        Err(RunError::Invalid(m)) => assert!(m.contains("leaves the domain"), "{m}"),
+        Err(RunError::Invalid(m)) => {
+            assert!(m.message.contains("leaves the domain"), "{m}");
+            assert_eq!(m.culprit, Some(Culprit::State(0)));
+        }
         other => panic!("expected Invalid, got {other:?}"),
     }
     // A longer horizon than certified.
@@ -971,7 +977,7 @@ fn reach_under_an_input_plan() {
     let outside = InputPlan::constant(&[1.5]);
     assert!(matches!(
         reach.from_box_with(&x0, &outside),
-        Err(RunError::Invalid(m)) if m.contains("input box")
+        Err(RunError::Invalid(m)) if m.message.contains("input box")
     ));
     assert!(InputPlan::steps(vec![0.5], vec![vec![0.0]]).is_err());
     // A plan is not simulated with random inputs: the simulator refuses it.

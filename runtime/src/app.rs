@@ -5,15 +5,18 @@
 //! [`run`] and [`simulate()`] take typed options ([`RunOptions`], [`SimulateOptions`]); a
 //! generated binary's command line is their textual form, parsed by [`Command::parse`] and
 //! written by `to_args` (by hand, no clap, so the runtime stays light):
-//! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe]`, or `simulate --paths N [options]`
-//! (see [`SIMULATE_USAGE`]).
+//! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--error-lines]`, or
+//! `simulate --paths N [options]` (see [`SIMULATE_USAGE`]).
 //!
 //! Exit codes (the CLI's too): [`EXIT_OK`], [`EXIT_FAILED`] (an analysis could not run, its
 //! result is not finite, or a coverage check failed), [`EXIT_USAGE`] (a bad command line,
 //! including an analysis name the model does not have, or a file that cannot be written),
 //! [`EXIT_UNSAFE`] (`--deny-unsafe` and a verdict "not shown safe"). The files of one command
-//! are written whole or not at all ([`crate::output`]): nothing when an analysis fails.
+//! are written together, each whole ([`crate::output`]): when some analyses fail, the files of
+//! the others are written and each failure is reported ([`Failure`]; with `--error-lines` as
+//! the lines the CLI locates in the spec).
 
+use crate::failure::Failure;
 use crate::output::Files;
 use crate::report;
 use reachc_core::engine::RunError;
@@ -27,25 +30,28 @@ use std::process::ExitCode;
 /// Default output directory.
 pub const DEFAULT_OUT_DIR: &str = "reachc-out";
 
-const USAGE: &str = "usage: <model> [--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe]
+const USAGE: &str =
+    "usage: <model> [--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--error-lines]
        <model> simulate --paths N [options]   (Monte Carlo check; simulate --help)
   --analysis NAME  run only this analysis (default: all)
   -o, --out DIR    output directory for <analysis>.json and <analysis>.csv (default: reachc-out)
   -q, --quiet      do not print the summaries
   --deny-unsafe    exit with status 3 when a verdict is \"not shown safe\"
+  --error-lines    report failed analyses as `reachc-failure` lines (for reachc)
   -h, --help       print this help
-  Exit status: 0 ok, 1 an analysis could not run (nothing is written), 2 usage or I/O
-  error, 3 not shown safe with --deny-unsafe (the results are written).";
+  Exit status: 0 ok, 1 an analysis could not run (the others' results are written), 2 usage
+  or I/O error, 3 not shown safe with --deny-unsafe (the results are written).";
 
 /// Help of the `simulate` mode.
 pub const SIMULATE_USAGE: &str =
     "usage: <model> simulate --paths N [--analysis NAME] [--seed S] [--dt H]
          [--delta D] [--inputs random|corners|centre] [--hold T] [--confidence C]
          [--threads T] [--shard I/K [--spec-hash H]] [-o DIR] [--quiet] [--progress]
+         [--error-lines]
   Euler-Maruyama sample paths checked against each analysis' delta-PRS; writes
   DIR/<analysis>.sim.json. Exit status 0 when every coverage check passes, 1 when one fails
-  (the reports are written) or an analysis cannot be simulated (nothing is written), 2 on
-  usage or I/O errors. With --shard, only shard I of K of the paths, and instead of the
+  or an analysis cannot be simulated (the other reports are written), 2 on usage or I/O
+  errors. With --shard, only shard I of K of the paths, and instead of the
   reports the exact statistics DIR/<analysis>.shard-I-of-K.part (exit status 0 when written),
   for `reachc simulate merge`.
   --paths N          number of sample paths (required)
@@ -62,12 +68,13 @@ pub const SIMULATE_USAGE: &str =
   --spec-hash H      the spec's identity recorded in the parts (reachc passes its SHA-256)
   -o, --out DIR      output directory (default: reachc-out)
   -q, --quiet        do not print the summaries
-  --progress         write `reachc-progress <analysis> <done> <total>` lines to stderr";
+  --progress         write `reachc-progress <analysis> <done> <total>` lines to stderr
+  --error-lines      report failed analyses as `reachc-failure` lines (for reachc)";
 
 /// Exit status of a successful run.
 pub const EXIT_OK: u8 = 0;
-/// Exit status when an analysis could not run or its result is not finite (nothing is written),
-/// or, for `simulate`, a coverage check failed.
+/// Exit status when an analysis could not run or its result is not finite (the other analyses'
+/// files are written), or, for `simulate`, a coverage check failed.
 pub const EXIT_FAILED: u8 = 1;
 /// Exit status of a usage error (an unknown analysis name too) or an I/O error (a file that
 /// cannot be written: nothing is).
@@ -90,6 +97,8 @@ pub struct RunOptions {
     /// `out_dir` is a staging directory that the caller moves into place (`reachc run --plot`):
     /// do not print where the files were written.
     pub stage: bool,
+    /// Report failed analyses as [`Failure::to_line`] lines (the CLI locates them in the spec).
+    pub error_lines: bool,
 }
 
 impl Default for RunOptions {
@@ -100,6 +109,7 @@ impl Default for RunOptions {
             quiet: false,
             deny_unsafe: false,
             stage: false,
+            error_lines: false,
         }
     }
 }
@@ -124,6 +134,8 @@ pub struct SimulateOptions {
     /// The spec's identity written into parts (`reachc` passes the SHA-256 of the spec's
     /// source); parts merge only with parts of the same.
     pub spec_hash: Option<String>,
+    /// Report failed analyses as [`Failure::to_line`] lines (the CLI locates them in the spec).
+    pub error_lines: bool,
     /// The simulation itself.
     pub sim: simulate::Options,
 }
@@ -138,6 +150,7 @@ impl Default for SimulateOptions {
             delta: None,
             shard: None,
             spec_hash: None,
+            error_lines: false,
             sim: simulate::Options::default(),
         }
     }
@@ -212,6 +225,7 @@ fn parse_run(args: &[String]) -> Result<Command, String> {
             "-q" | "--quiet" => opts.quiet = true,
             "--deny-unsafe" => opts.deny_unsafe = true,
             "--stage" => opts.stage = true,
+            "--error-lines" => opts.error_lines = true,
             "-h" | "--help" => return Ok(Command::Help(USAGE)),
             other => return Err(format!("unexpected argument `{other}`")),
         }
@@ -230,6 +244,7 @@ fn parse_simulate(args: &[String]) -> Result<Command, String> {
             "-o" | "--out" => a.out_dir = PathBuf::from(value()?),
             "-q" | "--quiet" => a.quiet = true,
             "--progress" => a.progress = true,
+            "--error-lines" => a.error_lines = true,
             "--paths" => paths = Some(number::<u64>(flag, value()?)?),
             "--seed" => a.sim.seed = number(flag, value()?)?,
             "--dt" => a.sim.dt = Some(number(flag, value()?)?),
@@ -282,6 +297,7 @@ impl RunOptions {
             (self.quiet, "--quiet"),
             (self.deny_unsafe, "--deny-unsafe"),
             (self.stage, "--stage"),
+            (self.error_lines, "--error-lines"),
         ] {
             if on {
                 args.push(flag.into());
@@ -320,6 +336,9 @@ impl SimulateOptions {
         }
         if self.progress {
             args.push("--progress".into());
+        }
+        if self.error_lines {
+            args.push("--error-lines".into());
         }
         args
     }
@@ -363,12 +382,53 @@ pub fn run_cli<S: System + Sync>(
     }
 }
 
+/// Where failed analyses are reported: to a caller's list, or to `err` (in prose, or as
+/// [`Failure::to_line`] lines with `lines`).
+struct Failures<'a> {
+    collect: Option<&'a mut Vec<Failure>>,
+    lines: bool,
+    count: usize,
+}
+
+impl<'a> Failures<'a> {
+    fn new(collect: Option<&'a mut Vec<Failure>>, lines: bool) -> Self {
+        Failures {
+            collect,
+            lines,
+            count: 0,
+        }
+    }
+
+    fn report(&mut self, failure: Failure, err: &mut dyn Write) {
+        self.count += 1;
+        match &mut self.collect {
+            Some(list) => list.push(failure),
+            None if self.lines => {
+                let _ = writeln!(err, "{}", failure.to_line());
+            }
+            None => {
+                let _ = writeln!(err, "{failure}");
+            }
+        }
+    }
+
+    /// After the other analyses' files are written: whether any failed, printing how many
+    /// (unless collected: the caller prints them, then [`Failure::summary`]).
+    fn any(&self, of: usize, err: &mut dyn Write) -> bool {
+        if self.count > 0 && self.collect.is_none() {
+            let _ = writeln!(err, "{}", Failure::summary(self.count, of));
+        }
+        self.count > 0
+    }
+}
+
 /// Runs the selected analyses, prints their summaries and writes `DIR/<analysis>.json` and
-/// `.csv`, all at the end and only when every analysis ran. Returns [`EXIT_OK`],
-/// [`EXIT_FAILED`] if some analysis could not run or its result is not finite (nothing is
-/// written then), [`EXIT_USAGE`] for an unknown analysis name or files that cannot be written,
-/// [`EXIT_UNSAFE`] with `deny_unsafe` when a verdict is "not shown safe". Analyses with an
-/// unsupported method are reported as skipped, not as failures.
+/// `.csv` for each that ran, all at the end (each file whole). Returns [`EXIT_OK`],
+/// [`EXIT_FAILED`] if some analysis could not run or its result is not finite (reported on
+/// `err`; the files of the others are written), [`EXIT_USAGE`] for an unknown analysis name or
+/// files that cannot be written, [`EXIT_UNSAFE`] with `deny_unsafe` when a verdict is "not
+/// shown safe" (and nothing failed). Analyses with an unsupported method are reported as
+/// skipped, not as failures.
 pub fn run<S: System + Sync>(
     sys: &S,
     info: &ModelInfo,
@@ -376,11 +436,36 @@ pub fn run<S: System + Sync>(
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> u8 {
+    run_analyses(sys, info, opts, out, err, None)
+}
+
+/// [`run`], with the failed analyses added to `failures` instead of printed (the CLI's
+/// interpreter backend locates them in the spec), [`Failure::summary`] included.
+pub fn run_collecting<S: System + Sync>(
+    sys: &S,
+    info: &ModelInfo,
+    opts: &RunOptions,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+    failures: &mut Vec<Failure>,
+) -> u8 {
+    run_analyses(sys, info, opts, out, err, Some(failures))
+}
+
+fn run_analyses<S: System + Sync>(
+    sys: &S,
+    info: &ModelInfo,
+    opts: &RunOptions,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+    collect: Option<&mut Vec<Failure>>,
+) -> u8 {
     let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
-    let (mut files, mut failed, mut not_safe) = (Files::new(), false, false);
-    for name in selected {
+    let mut failures = Failures::new(collect, opts.error_lines);
+    let (mut files, mut not_safe) = (Files::new(), false);
+    for &name in &selected {
         let res = match Reach::new(sys, info, name).and_then(|r| r.run()) {
             Ok(res) => res,
             Err(RunError::Unsupported(why)) => {
@@ -388,14 +473,12 @@ pub fn run<S: System + Sync>(
                 continue;
             }
             Err(e) => {
-                let _ = writeln!(err, "error: analysis `{name}` could not run: {e}");
-                failed = true;
+                failures.report(Failure::run(name, &e), err);
                 continue;
             }
         };
         if let Some(why) = report::not_finite(&res) {
-            let _ = writeln!(err, "error: analysis `{name}`: {why}");
-            failed = true;
+            failures.report(Failure::not_finite(name, &why), err);
             continue;
         }
         if !opts.quiet {
@@ -412,12 +495,11 @@ pub fn run<S: System + Sync>(
         );
         files.add(dir.join(format!("{name}.csv")), csv);
     }
-    if failed {
-        let _ = writeln!(err, "nothing written: an analysis failed");
-        return EXIT_FAILED;
-    }
     if let Err(code) = commit(files, !opts.quiet && !opts.stage, out, err) {
         return code;
+    }
+    if failures.any(selected.len(), err) {
+        return EXIT_FAILED;
     }
     if opts.deny_unsafe && not_safe {
         let _ = writeln!(err, "error: not shown safe (--deny-unsafe)");
@@ -507,9 +589,10 @@ pub fn part_file_name(analysis: &str, shard: Shard) -> String {
 pub type Progress<'a> = dyn FnMut(&str, u64, u64) + 'a;
 
 /// For each selected analysis: compute its PRS (at `opts.delta` if given), simulate the paths,
-/// print the summary; at the end, write every `DIR/<analysis>.sim.json` (whole or not at all).
+/// print the summary; at the end, write every `DIR/<analysis>.sim.json` (each whole).
 /// Returns [`EXIT_OK`] when every coverage check passes, [`EXIT_FAILED`] when one fails (the
-/// reports are written) or an analysis cannot run or be simulated (nothing is written),
+/// reports are written) or an analysis cannot run or be simulated (reported on `err`; the
+/// other analyses' reports are written),
 /// [`EXIT_USAGE`] for a usage error or files that cannot be written. Analyses without a PRS (no constants, unsupported
 /// transform) are skipped with a message. `progress(analysis, done, total)` is called after each
 /// batch of paths; without it, `opts.progress` writes `reachc-progress` lines to `err` instead.
@@ -522,13 +605,38 @@ pub fn simulate<S: System + Sync>(
     opts: &SimulateOptions,
     out: &mut dyn Write,
     err: &mut dyn Write,
+    progress: Option<&mut Progress<'_>>,
+) -> u8 {
+    simulate_analyses(sys, info, opts, (out, err), progress, None)
+}
+
+/// [`simulate()`], with the failed analyses added to `failures` instead of printed (the CLI's
+/// interpreter backend locates them in the spec), [`Failure::summary`] included.
+pub fn simulate_collecting<S: System + Sync>(
+    sys: &S,
+    info: &ModelInfo,
+    opts: &SimulateOptions,
+    (out, err): (&mut dyn Write, &mut dyn Write),
+    progress: Option<&mut Progress<'_>>,
+    failures: &mut Vec<Failure>,
+) -> u8 {
+    simulate_analyses(sys, info, opts, (out, err), progress, Some(failures))
+}
+
+fn simulate_analyses<S: System + Sync>(
+    sys: &S,
+    info: &ModelInfo,
+    opts: &SimulateOptions,
+    (out, err): (&mut dyn Write, &mut dyn Write),
     mut progress: Option<&mut Progress<'_>>,
+    collect: Option<&mut Vec<Failure>>,
 ) -> u8 {
     let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
-    let (mut files, mut failed, mut coverage_failed) = (Files::new(), false, false);
-    for name in selected {
+    let mut failures = Failures::new(collect, opts.error_lines);
+    let (mut files, mut coverage_failed) = (Files::new(), false);
+    for &name in &selected {
         let reach = Reach::new(sys, info, name).and_then(|r| match opts.delta {
             Some(d) => r.with_delta(d),
             None => Ok(r),
@@ -540,14 +648,12 @@ pub fn simulate<S: System + Sync>(
                 continue;
             }
             Err(e) => {
-                let _ = writeln!(err, "error: analysis `{name}` could not run: {e}");
-                failed = true;
+                failures.report(Failure::run(name, &e), err);
                 continue;
             }
         };
         if let Some(why) = report::not_finite(&result) {
-            let _ = writeln!(err, "error: analysis `{name}`: {why}");
-            failed = true;
+            failures.report(Failure::not_finite(name, &why), err);
             continue;
         }
         let started = std::time::Instant::now();
@@ -575,8 +681,7 @@ pub fn simulate<S: System + Sync>(
                 return EXIT_USAGE;
             }
             Err(SimError::Invalid(m)) => {
-                let _ = writeln!(err, "error: analysis `{name}` cannot be simulated: {m}");
-                failed = true;
+                failures.report(Failure::simulation(name, &m), err);
                 continue;
             }
         };
@@ -616,14 +721,10 @@ pub fn simulate<S: System + Sync>(
             }
         }
     }
-    if failed {
-        let _ = writeln!(err, "nothing written: an analysis failed");
-        return EXIT_FAILED;
-    }
     if let Err(code) = commit(files, !opts.quiet, out, err) {
         return code;
     }
-    if coverage_failed {
+    if failures.any(selected.len(), err) || coverage_failed {
         EXIT_FAILED
     } else {
         EXIT_OK
@@ -646,6 +747,7 @@ mod tests {
             quiet: true,
             deny_unsafe: true,
             stage: true,
+            error_lines: true,
         };
         assert_eq!(Command::parse(&run.to_args()), Ok(Command::Run(run)));
         let sim = SimulateOptions {
@@ -656,6 +758,7 @@ mod tests {
             delta: Some(0.1 + 0.2),
             shard: Some(Shard { index: 3, count: 8 }),
             spec_hash: Some("0a1b".into()),
+            error_lines: true,
             sim: simulate::Options {
                 paths: 12345,
                 seed: u64::MAX,

@@ -73,6 +73,8 @@ pub use reachc_core::{Bounds, InputPlan, Interval, ModelInfo, Prs, Reach, System
 
 #[cfg(feature = "app")]
 pub mod app;
+#[cfg(feature = "app")]
+pub mod failure;
 mod include;
 #[cfg(feature = "app")]
 pub mod merge;

@@ -64,14 +64,29 @@ fn generated_binaries_follow_the_exit_code_policy() {
     // An unknown analysis: a usage error.
     let (code, err) = binary(THROUGH, &["--analysis", "nope", "-o", o]);
     assert_eq!(code, EXIT_USAGE, "{err}");
-    // A result that is not finite: the analysis failed, nothing written.
+    // A result that is not finite: that analysis failed, the other one is written.
     let fresh = dir.join("fresh");
     let (code, err) = binary(GROWING, &["-q", "-o", fresh.to_str().unwrap()]);
     assert_eq!(code, EXIT_FAILED, "{err}");
     assert!(
-        err.contains("the PRS is not finite from t = 1.8 on"),
+        err.contains(
+            "error: analysis `long` has no finite result: the PRS is not finite from t = 1.8 on"
+        ),
         "{err}"
     );
-    assert!(!fresh.exists());
+    assert!(fresh.join("short.json").is_file() && !fresh.join("long.json").exists());
+    // With --error-lines, the failure is the line reachc locates: at the horizon.
+    let (code, err) = binary(
+        GROWING,
+        &["-q", "--error-lines", "-o", fresh.to_str().unwrap()],
+    );
+    assert_eq!(code, EXIT_FAILED, "{err}");
+    assert!(
+        err.starts_with(
+            "reachc-failure long setting:horizon has no finite result: the PRS is not finite \
+             from t = 1.8 on"
+        ),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

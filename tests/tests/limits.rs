@@ -228,16 +228,17 @@ fn tables_are_capped() {
 
 #[cfg(unix)]
 #[test]
-fn a_special_file_stops_at_the_cap() {
+fn a_special_file_is_refused() {
     let src = format!(
         "model m\nstate x in [0, 1]\ntable r = csv(\"/dev/zero\")\ndrift {{ x' = r.y - x }}\n{TAIL}"
     );
     let diags = errors(&src);
     assert_eq!(diags.len(), 1, "{diags:#?}");
-    assert!(
-        diags[0].labels[0].message.contains("larger than the limit"),
-        "{diags:#?}"
+    assert_eq!(
+        diags[0].labels[0].message,
+        "/dev/zero: not a regular file (a character device); a table is read from a CSV file"
     );
+    assert_eq!(&src[diags[0].span()], "\"/dev/zero\"");
 }
 
 #[test]

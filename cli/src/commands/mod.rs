@@ -3,6 +3,7 @@
 //! `run --deny-unsafe` ([`reachc_runtime::app`]).
 
 mod build;
+mod failures;
 pub mod inspect;
 mod plot;
 mod progress;

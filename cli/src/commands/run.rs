@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use clap::ValueEnum;
 
+use super::failures::Locator;
 use super::plot::{self, RunPlotArgs};
 use super::progress::CompileDisplay;
 use super::{load_reporting, EXIT_USAGE};
@@ -27,9 +28,10 @@ pub enum Backend {
 }
 
 /// Runs `reachc run` (and, with `--plot`, plots the results). Exit codes as the runtime's
-/// [`reachc_runtime::app::run`]: 0 ok, 1 spec errors or an analysis that cannot run (nothing
-/// written), 2 usage, I/O or cargo failures (nothing written), 3 "not shown safe" with
-/// `--deny-unsafe` (everything written).
+/// [`reachc_runtime::app::run`]: 0 ok, 1 spec errors or an analysis that cannot run (each
+/// failure located in the spec; the other analyses' results are written), 2 usage, I/O or
+/// cargo failures (nothing written), 3 "not shown safe" with `--deny-unsafe` (everything
+/// written).
 pub fn run_spec(
     spec: &Path,
     analysis: Option<String>,
@@ -41,6 +43,7 @@ pub fn run_spec(
     let color = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
     plot::check_states(plot, &loaded)?;
+    let locator = Locator::new(&loaded, color);
     let out_dir = out.unwrap_or_else(|| PathBuf::from(DEFAULT_OUT_DIR));
     // With --plot, the results are staged and written together with the pictures.
     let staging = plot.plot.as_ref().map(|_| plot::staging_dir());
@@ -50,28 +53,39 @@ pub fn run_spec(
         quiet: false,
         deny_unsafe,
         stage: staging.is_some(),
+        error_lines: backend == Backend::Compiled,
     };
     let (code, model) = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
-            let code = reachc_runtime::app::run(
+            let mut failures = Vec::new();
+            let code = reachc_runtime::app::run_collecting(
                 &interp,
                 &info,
                 &opts,
                 &mut std::io::stdout().lock(),
                 &mut std::io::stderr().lock(),
+                &mut failures,
             );
+            locator.print_collected(&failures, analysis.as_deref());
             (code, (interp, info))
         }
         Backend::Compiled => {
             let binary = compiled_binary(&mut loaded, color, quiet)?;
-            let status = std::process::Command::new(&binary)
+            let cannot_run = |e: std::io::Error| {
+                eprintln!("error: cannot run {}: {e}", binary.display());
+                EXIT_USAGE
+            };
+            // Its failures come as `reachc-failure` lines on stderr, located here.
+            let mut child = std::process::Command::new(&binary)
                 .args(opts.to_args())
-                .status()
-                .map_err(|e| {
-                    eprintln!("error: cannot run {}: {e}", binary.display());
-                    EXIT_USAGE
-                })?;
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .map_err(cannot_run)?;
+            if let Some(stderr) = child.stderr.take() {
+                locator.forward(stderr);
+            }
+            let status = child.wait().map_err(cannot_run)?;
             // The plots simulate paths in-process: the interpreter computes the same numbers.
             (exit_code(status), plot::interpreter_quiet(loaded))
         }

@@ -10,6 +10,7 @@ use std::fmt::Write as FmtWrite;
 
 use indicatif::{MultiProgress, ProgressBar, ProgressState, ProgressStyle};
 
+use super::failures::Locator;
 use super::run::{compiled_binary, exit_code, interpreter, Backend};
 use super::{load_reporting, EXIT_SPEC, EXIT_USAGE};
 use reachc_runtime::app::{SimulateOptions, DEFAULT_OUT_DIR};
@@ -124,6 +125,8 @@ impl SimulateArgs {
             delta: self.delta,
             shard: self.shard,
             spec_hash: self.shard.map(|_| spec_hash),
+            // Set for the compiled backend (the interpreter's failures are typed).
+            error_lines: false,
             sim: simulate::Options {
                 // Required by clap unless merging.
                 paths: self.paths.unwrap_or_default(),
@@ -233,8 +236,8 @@ fn spec_exit(code: u8) -> Result<(), u8> {
 }
 
 /// Runs `reachc simulate`. Exit codes: 0 every coverage check passed (or, with a shard, its
-/// part was written), 1 one failed (or spec errors, or an analysis that could not run), 2
-/// usage, I/O or cargo failures.
+/// part was written), 1 one failed (or spec errors, or an analysis that could not run: each
+/// located in the spec, the others' reports written), 2 usage, I/O or cargo failures.
 pub fn run_simulate(
     spec: &Path,
     sim: &SimulateArgs,
@@ -244,38 +247,45 @@ pub fn run_simulate(
     let color = std::io::stderr().is_terminal();
     let show_bar = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
+    let locator = Locator::new(&loaded, color);
     let mut opts = sim.options(out, loaded.source_hash());
     let code = match backend {
         Backend::Interp => {
             let (interp, info) = interpreter(loaded, color);
             let mut bars = Bars::new(opts.shard);
             let mut progress = |a: &str, done: u64, total: u64| bars.update(a, done, total);
-            reachc_runtime::app::simulate(
+            let mut failures = Vec::new();
+            let code = reachc_runtime::app::simulate_collecting(
                 &interp,
                 &info,
                 &opts,
-                &mut std::io::stdout().lock(),
-                &mut std::io::stderr().lock(),
+                (&mut std::io::stdout().lock(), &mut std::io::stderr().lock()),
                 show_bar.then_some(&mut progress as &mut dyn FnMut(&str, u64, u64)),
-            )
+                &mut failures,
+            );
+            locator.print_collected(&failures, opts.analysis.as_deref());
+            code
         }
         Backend::Compiled => {
             let binary = compiled_binary(&mut loaded, color, sim.quiet)?;
-            // With a bar, the binary's `reachc-progress` lines drive it.
+            // With a bar, the binary's `reachc-progress` lines drive it; its failures come as
+            // `reachc-failure` lines, located here.
             opts.progress = show_bar;
-            run_binary(&binary, &opts.to_args(), show_bar, opts.shard)?
+            opts.error_lines = true;
+            run_binary(&binary, &opts.to_args(), (show_bar, opts.shard), &locator)?
         }
     };
     spec_exit(code)
 }
 
-/// Runs the generated binary's `simulate` mode (of `shard`, if any); with a bar, its
-/// `reachc-progress` lines drive the bar and its other output is printed around it.
+/// Runs the generated binary's `simulate` mode (of `shard`, if any); its failure lines are
+/// located by `locator`; with a bar, its `reachc-progress` lines drive the bar and its other
+/// output is printed around it.
 fn run_binary(
     binary: &Path,
     args: &[String],
-    show_bar: bool,
-    shard: Option<Shard>,
+    (show_bar, shard): (bool, Option<Shard>),
+    locator: &Locator,
 ) -> Result<u8, u8> {
     let cannot_run = |e: std::io::Error| {
         eprintln!("error: cannot run {}: {e}", binary.display());
@@ -284,7 +294,11 @@ fn run_binary(
     let mut cmd = Command::new(binary);
     cmd.args(args);
     if !show_bar {
-        let status = cmd.status().map_err(cannot_run)?;
+        let mut child = cmd.stderr(Stdio::piped()).spawn().map_err(cannot_run)?;
+        if let Some(stderr) = child.stderr.take() {
+            locator.forward(stderr);
+        }
+        let status = child.wait().map_err(cannot_run)?;
         return Ok(exit_code(status));
     }
     let mut child = cmd
@@ -310,7 +324,7 @@ fn run_binary(
             let Ok(line) = line else { break };
             match parse_progress(&line) {
                 Some((analysis, done, total)) => bars.update(analysis, done, total),
-                None => bars.multi.suspend(|| eprintln!("{line}")),
+                None => bars.multi.suspend(|| eprint!("{}", locator.line(&line))),
             }
         }
     });

@@ -7,6 +7,7 @@ pub use check::check;
 
 use crate::diagnostics::Span;
 use crate::ir::{ExprId, Pool, Table};
+use reachc_core::engine::Setting;
 
 // The sets and analyses are the core's data model: the checker lowers straight into it and the
 // backends hand it on unchanged.
@@ -68,4 +69,9 @@ pub struct Analysis {
     pub spec: AnalysisSpec,
     /// The block.
     pub span: Span,
+    /// The name after `analysis`.
+    pub name_span: Span,
+    /// The settings written in the block, each with its `key = value` field (the places a
+    /// run-time failure's [`Setting`] points at; a default points at the block).
+    pub settings: Vec<(Setting, Span)>,
 }

@@ -9,7 +9,7 @@ use super::assemble::{
 use super::defect::{Nominal, NominalStep};
 use super::intersect::intersect;
 use super::radius::expm1_over;
-use super::{interval, local, nominal, r1, radius, rates, Run, RunError};
+use super::{interval, local, nominal, r1, radius, rates, Detail, Run, RunError, Setting};
 use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
@@ -25,8 +25,8 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     let metric = &consts.metric;
 
     // Initial set and inputs.
-    let (x0, half) =
-        radius::initial_center_and_halfwidths(run.initial, n).map_err(RunError::Invalid)?;
+    let (x0, half) = radius::initial_center_and_halfwidths(run.initial, n)
+        .map_err(|m| RunError::Invalid(m.into()))?;
     let (r1, r1_bound) = r1::bound(metric, run.initial, &half);
     let grid = nominal::time_grid(spec.horizon, spec.step);
     let (inputs, r2) = run.nominal_inputs(&grid);
@@ -249,13 +249,16 @@ fn nominal_steps(
         return Nominal::new(run.sys, &consts.metric, tolerance, domain).steps(x0, grid, inputs);
     }
     let traj = nominal::integrate(run.sys, x0, inputs, grid, spec.integrator).map_err(|k| {
-        RunError::NonFinite(format!(
-            "the nominal trajectory is not finite at t = {} ({} integration, step {}; the \
-             default validated integrator reports where and why a step fails)",
-            time(grid[k]),
-            spec.integrator.name(),
-            spec.step
-        ))
+        RunError::NonFinite(
+            Detail::from(format!(
+                "the nominal trajectory is not finite at t = {} ({} integration, step {}; the \
+                 default validated integrator reports where and why a step fails)",
+                time(grid[k]),
+                spec.integrator.name(),
+                spec.step
+            ))
+            .at_setting(Setting::Integrator),
+        )
     })?;
     Ok(traj
         .windows(2)

@@ -13,7 +13,7 @@
 
 use super::hermite::Cubic;
 use super::radius::BoxRadius;
-use super::RunError;
+use super::{Culprit, Detail, RunError, Setting};
 use crate::decimal::time;
 use crate::interval::Interval;
 use crate::system::System;
@@ -54,20 +54,26 @@ impl StepBudget {
     pub(crate) fn take(&mut self, t: f64, window: &[f64]) -> Result<(), RunError> {
         let (what, hint) = (self.what, self.hint);
         if self.total >= MAX_STEPS {
-            return Err(RunError::NonFinite(format!(
-                "{what} needs more than {MAX_STEPS} validated steps before t = {} ({hint})",
-                time(t)
-            )));
+            return Err(RunError::NonFinite(
+                Detail::from(format!(
+                    "{what} needs more than {MAX_STEPS} validated steps before t = {} ({hint})",
+                    time(t)
+                ))
+                .at_setting(Setting::Horizon),
+            ));
         }
         if self.in_interval >= MAX_STEPS_PER_REPORT {
-            return Err(RunError::NonFinite(format!(
-                "{what} needs more than {MAX_STEPS_PER_REPORT} validated steps in the report \
-                 interval [{}, {}] (at t = {}): it grows without bound there, or is too stiff \
-                 for this report step ({hint})",
-                time(window[0]),
-                time(window[1]),
-                time(t)
-            )));
+            return Err(RunError::NonFinite(
+                Detail::from(format!(
+                    "{what} needs more than {MAX_STEPS_PER_REPORT} validated steps in the \
+                     report interval [{}, {}] (at t = {}): it grows without bound there, or is \
+                     too stiff for this report step ({hint})",
+                    time(window[0]),
+                    time(window[1]),
+                    time(t)
+                ))
+                .at_setting(Setting::Step),
+            ));
         }
         self.total += 1;
         self.in_interval += 1;
@@ -184,12 +190,16 @@ impl<'a> Nominal<'a> {
             }
             h = 0.5 * h_used;
             if h < min_h {
-                return Err(RunError::NonFinite(format!(
-                    "the nominal trajectory cannot be validated at t = {}: the step shrank \
-                     below {min_h:e} without bounding the defect (the drift is too large or \
-                     not smooth here: a shorter horizon or a smaller report step may help)",
-                    time(t)
-                )));
+                return Err(RunError::NonFinite(
+                    Detail::from(format!(
+                        "the nominal trajectory cannot be validated at t = {}: the step shrank \
+                         below {min_h:e} without bounding the defect (the drift is too large \
+                         or not smooth here: a shorter horizon or a smaller report step may \
+                         help)",
+                        time(t)
+                    ))
+                    .at_setting(Setting::Horizon),
+                ));
             }
         }
     }
@@ -243,11 +253,14 @@ impl<'a> Nominal<'a> {
         }
         if let Some(domain) = self.domain {
             if let Some(i) = (0..n).find(|&i| lo[i] < domain[i].lo || hi[i] > domain[i].hi) {
-                return Err(RunError::Invalid(format!(
-                    "the nominal trajectory leaves the domain in state {i} near t = {}: the \
-                     constants hold only in the domain (enlarge it, or shorten the horizon)",
-                    time(t)
-                )));
+                return Err(RunError::Invalid(
+                    Detail::from(format!(
+                        "the nominal trajectory leaves the domain in state {i} near t = {}: the \
+                         constants hold only in the domain (enlarge it, or shorten the horizon)",
+                        time(t)
+                    ))
+                    .at(Culprit::State(i)),
+                ));
             }
         }
         Ok(Some(NominalStep {

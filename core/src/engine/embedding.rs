@@ -13,7 +13,7 @@
 use super::defect::{StepBudget, MIN_STEP};
 use super::hermite::Cubic;
 use super::nominal::rk4_step;
-use super::RunError;
+use super::{Detail, RunError, Setting};
 use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{Inclusion, Integrator};
@@ -287,14 +287,17 @@ impl<'a> Embedding<'a> {
             }
             h = shrink * used;
             if h < min_h {
-                return Err(RunError::NonFinite(format!(
-                    "the embedding system cannot be validated at t = {}: the step would have \
+                return Err(RunError::NonFinite(
+                    Detail::from(format!(
+                        "the embedding system cannot be validated at t = {}: the step would have \
                      to be shorter than {min_h:e} (a millionth of the report step), with the \
                      box {wmax:e} wide and growing without bound there (try the other \
                      inclusion, a coordinate transform, the contraction method or a shorter \
                      horizon)",
-                    time(t)
-                )));
+                        time(t)
+                    ))
+                    .at_setting(Setting::Inclusion),
+                ));
             }
         }
     }

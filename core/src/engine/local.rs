@@ -19,7 +19,7 @@
 
 use super::linalg::{self, lambda_max, product, symmetric_part};
 use super::uniform::{Scale, Tube};
-use super::{Run, RunError};
+use super::{Detail, Run, RunError, Setting};
 use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::Bounds;
@@ -99,15 +99,21 @@ impl<'a> Certifier<'a> {
     /// The certifier of a run: its metric, input box and the compiler's constants.
     pub(super) fn new(run: &Run<'a>) -> Result<Certifier<'a>, RunError> {
         let (sys, n, consts) = (run.sys, run.setup.n, run.setup.consts);
-        let chol = linalg::cholesky(&linalg::to_intervals(&consts.metric), n)
-            .ok_or_else(|| RunError::Invalid("the metric is not positive definite".into()))?;
+        let chol = linalg::cholesky(&linalg::to_intervals(&consts.metric), n).ok_or_else(|| {
+            RunError::Invalid(
+                Detail::from("the metric is not positive definite").at_setting(Setting::Metric),
+            )
+        })?;
         let diagonal = (0..n).all(|i| (0..n).all(|j| i == j || consts.metric[i * n + j] == 0.0));
         let dense = n <= DENSE_MAX;
         if !dense && !diagonal {
-            return Err(RunError::Unsupported(format!(
-                "local rates for more than {DENSE_MAX} states need a diagonal metric (give \
-                 `metric = identity` or `rate = global`)"
-            )));
+            return Err(RunError::Unsupported(
+                Detail::from(format!(
+                    "local rates for more than {DENSE_MAX} states need a diagonal metric (give \
+                     `metric = identity` or `rate = global`)"
+                ))
+                .at_setting(Setting::Rate),
+            ));
         }
         let (r, r_inv) = if dense {
             let mut r = vec![Interval::ZERO; n * n];
@@ -401,13 +407,16 @@ impl<'a> Certifier<'a> {
                 )
             })
             .unwrap_or_default();
-        RunError::NonFinite(format!(
-            "the local rates cannot be certified at t = {}: no region around the tube holds \
-             the tube its own rates give (last region tried: {}){entry}. A shorter horizon, a \
-             smaller initial set or less noise may help",
-            time(t0),
-            region.join(", ")
-        ))
+        RunError::NonFinite(
+            Detail::from(format!(
+                "the local rates cannot be certified at t = {}: no region around the tube holds \
+                 the tube its own rates give (last region tried: {}){entry}. A shorter horizon, \
+                 a smaller initial set or less noise may help",
+                time(t0),
+                region.join(", ")
+            ))
+            .at_setting(Setting::Horizon),
+        )
     }
 }
 

@@ -19,6 +19,7 @@
 
 mod assemble;
 mod contraction;
+mod culprit;
 mod defect;
 mod embedding;
 mod gaussian;
@@ -37,6 +38,7 @@ pub(crate) mod transform;
 mod uniform;
 
 pub use contraction::MAX_BOX_STATES;
+pub use culprit::{Culprit, Detail, Setting};
 pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
 pub use r1::MAX_BALL_STATES;
@@ -63,14 +65,28 @@ pub enum RunError {
     },
     /// The analysis asks for something this engine does not do (yet), e.g. a coordinate
     /// transform for a system without the transformed frame.
-    Unsupported(String),
+    Unsupported(Detail),
     /// The compiler could not bound the constants of Assumption 1.
-    NoConstants(String),
+    NoConstants(Detail),
     /// The analysis or model data is inconsistent (bad delta, step, dimensions, metric...), or
     /// not covered by the certified constants.
-    Invalid(String),
-    /// The nominal trajectory left the finite numbers.
-    NonFinite(String),
+    Invalid(Detail),
+    /// The nominal trajectory or the embedding system left the finite numbers, or could not
+    /// be validated.
+    NonFinite(Detail),
+}
+
+impl RunError {
+    /// What the failure points at in the spec, if the engine knows.
+    pub fn culprit(&self) -> Option<Culprit> {
+        match self {
+            RunError::UnknownAnalysis { .. } => None,
+            RunError::Unsupported(d)
+            | RunError::NoConstants(d)
+            | RunError::Invalid(d)
+            | RunError::NonFinite(d) => d.culprit,
+        }
+    }
 }
 
 impl fmt::Display for RunError {
@@ -128,11 +144,14 @@ impl<'a> Setup<'a> {
                 .filter(|(_, used)| *used)
                 .map(|(name, _)| *name)
                 .collect();
-            RunError::NoConstants(format!(
-                "analysis `{}` has no constants ({}): {why}",
-                spec.name,
-                used.join(", ")
-            ))
+            RunError::NoConstants(
+                format!(
+                    "analysis `{}` has no constants ({}): {why}",
+                    spec.name,
+                    used.join(", ")
+                )
+                .into(),
+            )
         })?;
         Setup::with(sys, info, spec, consts, needs)
     }
@@ -150,10 +169,13 @@ impl<'a> Setup<'a> {
         covered(info, spec, consts)?;
         let metric = &consts.metric;
         if metric.len() != n * n {
-            return Err(RunError::Invalid(format!(
-                "the metric has {} entries, expected {n} x {n}",
-                metric.len()
-            )));
+            return Err(RunError::Invalid(
+                Detail::from(format!(
+                    "the metric has {} entries, expected {n} x {n}",
+                    metric.len()
+                ))
+                .at_setting(Setting::Metric),
+            ));
         }
         for (what, v, used) in [
             ("c", consts.c, needs.c),
@@ -161,18 +183,21 @@ impl<'a> Setup<'a> {
             ("rho", consts.rho, needs.rho),
         ] {
             if used && !v.is_finite() {
-                return Err(RunError::NoConstants(format!("{what} = {v} is not finite")));
+                return Err(RunError::NoConstants(
+                    format!("{what} = {v} is not finite").into(),
+                ));
             }
         }
         // Rigorous factorisation of P, used by every P^-1 quantity.
         let chol = linalg::cholesky(&linalg::to_intervals(metric), n).ok_or_else(|| {
             RunError::Invalid(
-                "the metric P is not (certifiably) symmetric positive definite".into(),
+                Detail::from("the metric P is not (certifiably) symmetric positive definite")
+                    .at_setting(Setting::Metric),
             )
         })?;
         let p_inv_diag = linalg::inverse_diagonal(&chol, n);
         let checks = safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv_diag)
-            .map_err(RunError::Invalid)?;
+            .map_err(|m| RunError::Invalid(m.into()))?;
         Ok(Setup {
             consts,
             n,
@@ -271,31 +296,44 @@ pub(crate) fn validate(
     n: usize,
     p: usize,
 ) -> Result<(), RunError> {
-    let bad = |m: String| Err(RunError::Invalid(m));
+    let bad = |m: String| Err(RunError::Invalid(m.into()));
+    let bad_setting = |s: Setting, m: String| Err(RunError::Invalid(Detail::from(m).at_setting(s)));
     if !(a.delta > 0.0 && a.delta < 1.0) {
-        return bad(format!("delta = {} must lie in (0, 1)", a.delta));
+        return bad_setting(
+            Setting::Delta,
+            format!("delta = {} must lie in (0, 1)", a.delta),
+        );
     }
     if !(a.step >= MIN_REPORT_STEP && a.step.is_finite()) {
-        return bad(format!(
-            "step = {} must be finite and at least {MIN_REPORT_STEP:e}",
-            a.step
-        ));
+        return bad_setting(
+            Setting::Step,
+            format!(
+                "step = {} must be finite and at least {MIN_REPORT_STEP:e}",
+                a.step
+            ),
+        );
     }
     if !(a.horizon >= 0.0 && a.horizon.is_finite()) {
-        return bad(format!(
-            "horizon = {} must be non-negative and finite",
-            a.horizon
-        ));
+        return bad_setting(
+            Setting::Horizon,
+            format!("horizon = {} must be non-negative and finite", a.horizon),
+        );
     }
     if a.horizon / a.step > 1e8 {
-        return bad(format!(
-            "horizon / step = {} report steps is too many",
-            a.horizon / a.step
-        ));
+        return bad_setting(
+            Setting::Step,
+            format!(
+                "horizon / step = {} report steps is too many",
+                a.horizon / a.step
+            ),
+        );
     }
     if let RadiusRule::Paper(eps) = a.radius {
         if !(eps > 0.0 && eps < 1.0) {
-            return bad(format!("the paper rule's eps = {eps} must lie in (0, 1)"));
+            return bad_setting(
+                Setting::Radius,
+                format!("the paper rule's eps = {eps} must lie in (0, 1)"),
+            );
         }
     }
     if n == 0 {
@@ -322,7 +360,10 @@ pub(crate) fn validate(
         }
     }
     if let Some(&i) = a.outputs.iter().find(|&&i| i >= n) {
-        return bad(format!("output state index {i} is out of range (n = {n})"));
+        return bad_setting(
+            Setting::Outputs,
+            format!("output state index {i} is out of range (n = {n})"),
+        );
     }
     Ok(())
 }
@@ -341,11 +382,14 @@ fn covered(info: &ModelInfo, spec: &AnalysisSpec, consts: &Constants) -> Result<
     } else {
         return Ok(());
     };
-    Err(RunError::Invalid(format!(
-        "the constants of analysis `{}` were certified for another {what} than the model's: \
-         change the spec and compile it again",
-        spec.name
-    )))
+    Err(RunError::Invalid(
+        format!(
+            "the constants of analysis `{}` were certified for another {what} than the model's: \
+             change the spec and compile it again",
+            spec.name
+        )
+        .into(),
+    ))
 }
 
 /// Checks an initial set against the model: one entry per state, and inside the domain when the
@@ -356,8 +400,8 @@ pub(crate) fn check_initial(
     in_domain: bool,
 ) -> Result<(), RunError> {
     let n = info.states.len();
-    let (center, half) =
-        radius::initial_center_and_halfwidths(initial, n).map_err(RunError::Invalid)?;
+    let (center, half) = radius::initial_center_and_halfwidths(initial, n)
+        .map_err(|m| RunError::Invalid(m.into()))?;
     if info.has_domain && in_domain {
         for i in 0..n {
             // Boxes as given; ball coordinates by their bounding boxes (rounded outward).
@@ -367,11 +411,14 @@ pub(crate) fn check_initial(
             });
             let domain = info.domain[i];
             if lo < domain.lo || hi > domain.hi {
-                return Err(RunError::Invalid(format!(
-                    "the initial set leaves the domain in state `{}` ([{lo}, {hi}] is not in \
-                     [{}, {}]): the constants hold only in the domain",
-                    info.states[i], domain.lo, domain.hi
-                )));
+                return Err(RunError::Invalid(
+                    Detail::from(format!(
+                        "the initial set leaves the domain in state `{}` ([{lo}, {hi}] is not \
+                         in [{}, {}]): the constants hold only in the domain",
+                        info.states[i], domain.lo, domain.hi
+                    ))
+                    .at(Culprit::State(i)),
+                ));
             }
         }
     }

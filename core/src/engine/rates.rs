@@ -3,7 +3,7 @@
 //! follow their per-step recursions with it (Proposition 2 and eq. Psi with piecewise-constant
 //! rates).
 
-use super::{Run, RunError};
+use super::{Detail, Run, RunError, Setting};
 use crate::decimal::time;
 use crate::model::ModelInfo;
 use crate::simulate::{self, InputMode};
@@ -39,8 +39,12 @@ pub(crate) fn empirical(
         initial: run.initial.clone(),
         ..run.info.clone()
     };
-    let sampled = simulate::sample_paths(sys, &info, grid, Some(&traj[0]), &opts)
-        .map_err(|e| RunError::Invalid(format!("sampling paths for the empirical rate: {e}")))?;
+    let sampled = simulate::sample_paths(sys, &info, grid, Some(&traj[0]), &opts).map_err(|e| {
+        RunError::Invalid(
+            Detail::from(format!("sampling paths for the empirical rate: {e}"))
+                .at_setting(Setting::Rate),
+        )
+    })?;
     // Per report time, the pooled quotient over the paths.
     let mut at = vec![f64::NEG_INFINITY; grid.len()];
     let (mut fx, mut fn_) = (vec![0.0; n], vec![0.0; n]);
@@ -51,10 +55,13 @@ pub(crate) fn empirical(
         for path in &sampled {
             let x = &path[k * n..(k + 1) * n];
             if x.iter().any(|v| !v.is_finite()) {
-                return Err(RunError::NonFinite(format!(
-                    "a sample path of the empirical rate estimate is not finite at t = {}",
-                    time(t)
-                )));
+                return Err(RunError::NonFinite(
+                    Detail::from(format!(
+                        "a sample path of the empirical rate estimate is not finite at t = {}",
+                        time(t)
+                    ))
+                    .at_setting(Setting::Rate),
+                ));
             }
             sys.drift(x, u_center, t, &mut fx);
             for i in 0..n {
@@ -83,11 +90,14 @@ pub(crate) fn empirical(
         rates[0] = rates[1];
     }
     if let Some(k) = rates.iter().position(|c| !c.is_finite()) {
-        return Err(RunError::NonFinite(format!(
-            "no finite empirical rate at t = {} (every sample equals the nominal, or a drift is \
-             not finite)",
-            time(grid[k])
-        )));
+        return Err(RunError::NonFinite(
+            Detail::from(format!(
+                "no finite empirical rate at t = {} (every sample equals the nominal, or a drift \
+                 is not finite)",
+                time(grid[k])
+            ))
+            .at_setting(Setting::Rate),
+        ));
     }
     Ok(rates)
 }

@@ -80,7 +80,7 @@ fn what_the_constants_do_not_cover_is_refused() {
     // outgrows its regions and the run says when (the global rate refuses the box outright).
     assert!(matches!(
         reach.from_box(&start(1.95)),
-        Err(RunError::NonFinite(m)) if m.contains("local rates cannot be certified at t = 4.5")
+        Err(RunError::NonFinite(m)) if m.message.contains("local rates cannot be certified at t = 4.5")
     ));
     let mut global = info.clone();
     for a in &mut global.analyses {
@@ -89,7 +89,7 @@ fn what_the_constants_do_not_cover_is_refused() {
     let reach_global = Reach::new(&sys, &global, "contraction").unwrap();
     assert!(matches!(
         reach_global.from_box(&start(1.95)),
-        Err(RunError::Invalid(m)) if m.contains("leaves the domain")
+        Err(RunError::Invalid(m)) if m.message.contains("leaves the domain")
     ));
     // The input box is [-0.05, 0.05].
     let strong = InputPlan::constant(&[0.1]);
@@ -99,6 +99,6 @@ fn what_the_constants_do_not_cover_is_refused() {
     edited.domain[0] = Bounds::new(-3.0, 3.0);
     assert!(matches!(
         Reach::new(&sys, &edited, "contraction").map(|_| ()),
-        Err(RunError::Invalid(m)) if m.contains("domain")
+        Err(RunError::Invalid(m)) if m.message.contains("domain")
     ));
 }

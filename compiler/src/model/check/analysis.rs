@@ -13,6 +13,7 @@ use crate::model::{
     MetricChoice as Metric, RadiusRule, Rate, Transform,
 };
 use crate::syntax::ast::{Arg, Block, Expr, ExprKind, Ident};
+use reachc_core::engine::Setting;
 use reachc_core::model::{AutoFit, InitialSet, TransformSource};
 use reachc_core::Interval;
 
@@ -283,6 +284,11 @@ impl Checker<'_> {
                 outputs,
             },
             span,
+            name_span: name.span.clone(),
+            settings: Setting::ALL
+                .into_iter()
+                .filter_map(|s| f.get(s.key()).map(|(_, span)| (s, span.clone())))
+                .collect(),
         });
     }
 

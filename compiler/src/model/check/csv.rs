@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::driver::read_capped;
+use crate::driver::{read_capped, ReadError};
 use crate::ir::Table;
 use crate::limits::MAX_TABLE_LEN;
 
@@ -12,11 +12,15 @@ use crate::limits::MAX_TABLE_LEN;
 /// [`MAX_TABLE_LEN`] bytes are read. Errors are `"SHOWN:LINE: what"` strings, where `shown` is
 /// the path as the spec wrote it.
 pub(super) fn load(name: &str, path: &Path, shown: &str) -> Result<Table, String> {
-    let bytes = read_capped(path, MAX_TABLE_LEN)
-        .map_err(|e| format!("{shown}: cannot read: {e}"))?
-        .ok_or_else(|| {
+    let bytes = read_capped(path, MAX_TABLE_LEN).map_err(|e| match e {
+        ReadError::Io(e) => format!("{shown}: cannot read: {e}"),
+        ReadError::NotRegular(kind) => {
+            format!("{shown}: not a regular file ({kind}); a table is read from a CSV file")
+        }
+        ReadError::TooLarge => {
             format!("{shown}: the file is larger than the limit of {MAX_TABLE_LEN} bytes (8 MiB)")
-        })?;
+        }
+    })?;
     let text = String::from_utf8(bytes).map_err(|e| {
         format!(
             "{shown}: not UTF-8 text (invalid byte at offset {})",
