@@ -327,3 +327,78 @@ fn merge_refuses_parts_that_do_not_belong_together() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 26: a stiff system (`x' = -20 x + y`, report step 0.1) whose PRS is correct. With the
+/// default steps (`h L <= 0.05`: `L = min(||J||_inf, ||J||_1) = 20`, so `h = 0.0025`, 40 steps
+/// per report step) no path leaves the tube; `--dt 0.1`, the old default, is honoured with a
+/// warning (`h L = 2`), and its Euler-Maruyama error shows as paths outside.
+#[test]
+fn simulate_chooses_dt_from_the_dynamics_on_a_stiff_system() {
+    let dir = std::env::temp_dir().join(format!("reachc-cli-sim-stiff-{}", std::process::id()));
+    let d = dir.to_str().unwrap();
+    let stiff = spec("../tests/good/stiff.sde");
+    let sim = |extra: &[&str]| {
+        let mut args = vec![
+            "simulate",
+            &stiff,
+            "--backend",
+            "interp",
+            "--paths",
+            "4000",
+            "-o",
+            d,
+        ];
+        args.extend_from_slice(extra);
+        let o = reachc(&args);
+        let json: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join("contraction.sim.json")).unwrap(),
+        )
+        .unwrap();
+        (o, json)
+    };
+    let (o, json) = sim(&[]);
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert_eq!(o.status.code(), Some(0), "{out}\n{err}");
+    assert!(
+        out.contains(
+            "Euler-Maruyama with dt = 0.0025 (800 steps per path; chosen by the rule h L <= 0.05)"
+        ),
+        "{out}"
+    );
+    assert!(!err.contains("warning"), "{err}");
+    assert_eq!(json["verdict"]["status"], "pass");
+    assert_eq!(json["outside_tube"]["count"], 0);
+    assert_eq!(json["steps_per_path"], 800);
+    let rule = &json["dt_rule"];
+    assert_eq!(rule["source"], "rule");
+    assert_eq!(rule["status"], "met");
+    assert_eq!(rule["coarse_intervals"], 0);
+    assert_eq!(rule["rule_min"], 0.0025);
+    let hl = rule["hl_max"].as_f64().unwrap();
+    assert!((hl - 0.05).abs() < 1e-12, "{hl}");
+    let dt = json["dt"].as_f64().unwrap();
+    assert!((dt - 0.0025).abs() < 1e-15, "{dt}");
+
+    let (o, json) = sim(&["--dt", "0.1"]);
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert_eq!(o.status.code(), Some(1), "{out}\n{err}");
+    assert!(
+        err.contains(
+            "warning: analysis `contraction`: --dt 0.1 is coarser than the rule h L <= 0.05 asks \
+             on 20 report intervals (h L up to 2.000; the rule's step: 0.0025)"
+        ),
+        "{err}"
+    );
+    assert!(out.contains("  warning: --dt 0.1 is coarser"), "{out}");
+    assert_eq!(json["dt_rule"]["status"], "coarser");
+    assert_eq!(json["dt_rule"]["coarse_intervals"], 20);
+    assert_eq!(json["steps_per_path"], 20);
+    assert_eq!(json["verdict"]["status"], "fail");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -110,8 +110,8 @@ fn a_result_that_is_not_finite_is_an_error_of_its_analysis() {
     let o = run_interp(&dir, &["-o", s(&out), "--analysis", "long"]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     let stderr = String::from_utf8_lossy(&o.stderr);
-    let message = "Error: analysis `long` has no finite result: the PRS is not finite from t = \
-                   1.8 on (r_t = inf: Psi_t overflowed (c = 400, sigma = 1";
+    let message = "the PRS is not finite from t = 1.8 on: the stochastic radius r_t = inf: \
+                   Psi_t overflowed (c = 400, sigma = 1";
     assert!(stderr.contains(message), "{stderr}");
     // Located at the horizon of `long` (line 20 of tests/good/radius_overflow.sde).
     assert!(stderr.contains("spec.sde:20:5 ]"), "{stderr}");
@@ -207,7 +207,10 @@ fn messages_count_in_the_singular_and_plural() {
     );
     let t = text(&o);
     assert!(
-        t.contains("  1 path (seed 0), Euler-Maruyama with dt = 0.1 (10 steps per path)"),
+        t.contains(
+            "  1 path (seed 0), Euler-Maruyama with dt = 0.0166666666667 (60 steps per path; \
+             chosen by the rule h L <= 0.05)"
+        ),
         "{t}"
     );
     assert!(t.contains(" path-steps/s, 1 thread)\n"), "{t}");

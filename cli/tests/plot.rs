@@ -204,6 +204,65 @@ fn plot_reads_a_result_with_or_without_the_spec() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A result cut by a first-order zonotope (a member written by hand into the JSON of
+/// `reachc run`: zonotopes around the nominal) is drawn, with the zonotope named in the
+/// legend; a malformed zonotope is refused with the member named.
+#[test]
+fn plot_draws_a_zonotope_member() {
+    let dir = temp_dir("zonotope");
+    let d = dir.to_str().unwrap();
+    let run = reachc(&[
+        "run",
+        &spec("linear.sde"),
+        "--backend",
+        "interp",
+        "--analysis",
+        "amgf_rule",
+        "-o",
+        d,
+    ]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run));
+    let result = dir.join("amgf_rule.json");
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&result).unwrap()).unwrap();
+    let original = json.clone();
+    let zonotope = |generators: serde_json::Value| {
+        let mut member = original.clone();
+        for step in member["steps"].as_array_mut().unwrap() {
+            step["det_set"] = serde_json::json!({
+                "shape": "zonotope",
+                "center": step["nominal"].clone(),
+                "radius": 1.0,
+                "generators": generators.clone(),
+                "remainder": 0.02,
+                "hull_lo": [-1.0, -1.0],
+                "hull_hi": [1.0, 1.0],
+            });
+        }
+        member["role"] = serde_json::json!("first_order");
+        member
+    };
+    let good = zonotope(serde_json::json!([[0.2, 0.05], [-0.05, 0.1]]));
+    json["also"] = serde_json::json!([good]);
+    let cut = dir.join("cut.json");
+    std::fs::write(&cut, json.to_string()).unwrap();
+    let o = reachc(&["plot", cut.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let sets = svg(&dir.join("amgf_rule_sets.svg"));
+    assert!(sets.contains("first-order zonotope"), "{sets}");
+
+    json["also"] = serde_json::json!([zonotope(serde_json::json!([[0.2, 0.05, 0.0]]))]);
+    std::fs::write(&cut, json.to_string()).unwrap();
+    let o = reachc(&["plot", cut.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).contains("member 1 of the intersection: step 0: malformed Zonotope set"),
+        "{}",
+        text(&o)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn plot_errors_are_usage_errors_and_write_nothing() {
     let dir = temp_dir("errors");
@@ -343,7 +402,7 @@ fn an_analysis_without_a_prs_gets_paths_and_unsafe_sets() {
 
 #[test]
 fn sample_paths_are_the_monte_carlo_paths() {
-    // Path p of sample_paths is path p of simulate: the largest distance from the nominal at
+    // Path p of result_paths is path p of simulate: the largest distance from the nominal at
     // each report time is the report's `max`.
     let mut loaded = reachc_compiler::driver::load(Path::new(&spec("pendulum.sde"))).unwrap();
     let prepared = prepare(&mut loaded.model);
@@ -357,9 +416,7 @@ fn sample_paths_are_the_monte_carlo_paths() {
         ..Options::default()
     };
     let report = simulate::simulate(&interp, &info, &result, &opts, &mut |_, _| {}).unwrap();
-    let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
-    let paths = simulate::sample_paths(&interp, &info, &times, Some(&result.initial_center), &opts)
-        .unwrap();
+    let paths = simulate::result_paths(&interp, &info, &result, &opts).unwrap();
     assert_eq!(paths.len(), 64);
     let p = &result.constants.metric;
     for (k, step) in result.steps.iter().enumerate() {

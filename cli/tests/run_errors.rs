@@ -70,8 +70,7 @@ fn every_run_time_failure_is_located_in_the_spec() {
 #[test]
 fn a_failure_names_the_setting_to_change_and_the_analysis() {
     let dir = scratch("setting");
-    let spec =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/run_errors/step_too_coarse.sde");
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/run_errors/box_blows_up.sde");
     let path = spec.to_str().unwrap();
     let out = dir.join("out");
     let o = reachc(&[
@@ -87,14 +86,14 @@ fn a_failure_names_the_setting_to_change_and_the_analysis() {
     assert!(
         stderr.contains(
             "Error: analysis `blows_up` could not run: numerical failure: the embedding system \
-             needs more than 10000 validated steps in the report interval [1.6, 1.7]"
+             cannot be validated at t = 1.66579467492"
         ),
         "{stderr}"
     );
     for label in [
         "the setting to change",
         "in analysis `blows_up`",
-        "step = 0.1",
+        "inclusion = jacobian",
     ] {
         assert!(stderr.contains(label), "{label}: {stderr}");
     }
@@ -107,7 +106,7 @@ fn a_failure_names_the_setting_to_change_and_the_analysis() {
     // The analysis that ran is written.
     assert!(out.join("good.json").is_file() && !out.join("blows_up.json").exists());
     // A default setting: the analysis' name, and the key to set.
-    let spec = spec.with_file_name("step_default.sde");
+    let spec = spec.with_file_name("inclusion_default.sde");
     let o = reachc(&[
         "run",
         "--backend",
@@ -118,9 +117,12 @@ fn a_failure_names_the_setting_to_change_and_the_analysis() {
     ]);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
-        stderr.contains("this analysis, with the default `step`"),
+        stderr.contains("this analysis, with the default `inclusion`"),
         "{stderr}"
     );
-    assert!(stderr.contains("set `step = ...` in the block"), "{stderr}");
+    assert!(
+        stderr.contains("set `inclusion = ...` in the block"),
+        "{stderr}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -198,6 +198,20 @@ pub fn load(path: &Path) -> Result<Loaded, LoadError> {
     let source =
         String::from_utf8(bytes).map_err(|e| not_utf8(path, e.as_bytes(), e.utf8_error()))?;
     let dir = path.parent().unwrap_or(Path::new("."));
+    load_source(path, source, dir)
+}
+
+/// Parses and checks spec text that the caller already has (a string from Python, an editor
+/// buffer): `path` names it in the diagnostics and in [`Loaded::path`], CSV paths are resolved
+/// against `dir`. Text longer than the limit of [`load`] is the same spec error.
+pub fn load_source(path: &Path, source: String, dir: &Path) -> Result<Loaded, LoadError> {
+    if source.len() > MAX_SOURCE_LEN {
+        return Err(LoadError::Spec {
+            diagnostics: vec![crate::syntax::too_large()],
+            path: path.display().to_string(),
+            source: String::new(),
+        });
+    }
     let (model, diagnostics) = check_source(&source, dir);
     match model {
         Some(model) => Ok(Loaded {

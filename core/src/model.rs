@@ -386,13 +386,17 @@ pub struct AnalysisSpec {
     pub transform: Option<Transform>,
     /// States to report (indices; all when empty).
     pub outputs: Vec<usize>,
+    /// Whether validated runs add the first-order sets (method.md 8.8) to their PRS: the
+    /// linearised flow's zonotope plus a certified remainder, intersected with the method's
+    /// own set (up to [`crate::engine::MAX_FIRST_ORDER_STATES`] states).
+    pub first_order: bool,
 }
 
 impl Default for AnalysisSpec {
     /// The language's defaults (docs/language.md) with a horizon of 1: contraction method,
     /// `delta = 1e-3`, `step = horizon / 100`, identity metric, amgf rule, certified rate,
     /// Jacobian inclusion, validated integration, a uniform guarantee, no transform, every
-    /// state reported.
+    /// state reported, first-order sets on.
     fn default() -> Self {
         AnalysisSpec {
             name: String::new(),
@@ -408,6 +412,7 @@ impl Default for AnalysisSpec {
             guarantee: Guarantee::Uniform,
             transform: None,
             outputs: Vec::new(),
+            first_order: true,
         }
     }
 }

@@ -5,6 +5,7 @@
 //! plus the stochastic ball of radius `r_t` in the metric `P` of the analysis' constants.
 
 use crate::engine::interval;
+use crate::engine::zonotope;
 use crate::interval::Interval;
 use crate::model::{
     Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricRegion, Provenance,
@@ -89,8 +90,36 @@ pub struct Prs {
     /// 8.7: same stochastic event, so at that metric's `delta`); each member's `delta` says
     /// which.
     pub also: Vec<Prs>,
+    /// What this result is within an intersection: [`Role::Own`] for the analysis' result,
+    /// the member's kind for those in [`Prs::also`] (set by the engine that made it).
+    pub role: Role,
     /// Advice on the result (interval method: a wrapping box, a box leaving the domain).
     pub hints: Vec<Hint>,
+}
+
+/// What a result is within an intersection ([`Prs::also`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// The analysis' own result (its first metric's, with several).
+    Own,
+    /// A further metric's result, of the same method, at `delta / K` (method.md 8.6).
+    Metric,
+    /// The interval method's box of a contraction run, at the same delta (method.md 8.7).
+    Box,
+    /// The first-order sets of the same run, at the same delta (method.md 8.8).
+    FirstOrder,
+}
+
+impl Role {
+    /// The role's name in outputs: `own`, `metric`, `box`, `first_order`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Role::Own => "own",
+            Role::Metric => "metric",
+            Role::Box => "box",
+            Role::FirstOrder => "first_order",
+        }
+    }
 }
 
 /// Where the contraction rate `c_t` came from.
@@ -353,6 +382,25 @@ pub enum DetSet {
         /// Upper bound of the hull's P-radius around `center`.
         radius: f64,
     },
+    /// `{center + sum_j xi_j g_j : |xi_j| <= 1} (+) B_P(remainder)` (first-order sets,
+    /// method.md 8.8): the image of the initial box under the flow's linearisation along the
+    /// nominal (a zonotope with the generators `g_j`), plus a P-ball bounding the error of the
+    /// linearisation; with the zonotope's interval hull `[hull_lo, hull_hi]` (without the
+    /// ball), all inside the P-ball `(center, radius)`.
+    Zonotope {
+        /// The centre (the nominal state).
+        center: Vec<f64>,
+        /// The generators, generator-major: `g_j` is `generators[j n..(j + 1) n]`.
+        generators: Vec<f64>,
+        /// The P-radius of the ball added to the zonotope (upper bound).
+        remainder: f64,
+        /// Lower corner of the zonotope's interval hull.
+        hull_lo: Vec<f64>,
+        /// Upper corner of the zonotope's interval hull.
+        hull_hi: Vec<f64>,
+        /// Upper bound of the whole set's P-radius around `center`.
+        radius: f64,
+    },
 }
 
 impl Step {
@@ -361,6 +409,16 @@ impl Step {
     pub fn nominal(&self) -> &[f64] {
         self.det.center()
     }
+}
+
+/// A membership test of [`Prs::own_contains_at`] built once for many states (the Monte Carlo
+/// check).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Prepared<'a> {
+    /// The test of a result's parallelotopes (its metric and transform).
+    Parallelotope(&'a interval::ParallelotopeTest),
+    /// The test of one step's zonotope (with the result's metric).
+    Zonotope(&'a zonotope::ZonotopeTest),
 }
 
 /// Whether `|x - c|_P <= r` certainly (interval arithmetic), `p` n x n row-major (both
@@ -384,12 +442,24 @@ pub(crate) fn within(p: &[f64], x: &[f64], c: &[f64], r: f64) -> bool {
 }
 
 impl DetSet {
+    /// The name of the set's shape in result files: `"p_ball"`, `"box"`, `"parallelotope"` or
+    /// `"zonotope"`.
+    pub fn shape(&self) -> &'static str {
+        match self {
+            DetSet::Ball { .. } => "p_ball",
+            DetSet::Box { .. } => "box",
+            DetSet::Parallelotope { .. } => "parallelotope",
+            DetSet::Zonotope { .. } => "zonotope",
+        }
+    }
+
     /// The centre of the set (of its hull for a parallelotope).
     pub fn center(&self) -> &[f64] {
         match self {
             DetSet::Ball { center, .. }
             | DetSet::Box { center, .. }
-            | DetSet::Parallelotope { center, .. } => center,
+            | DetSet::Parallelotope { center, .. }
+            | DetSet::Zonotope { center, .. } => center,
         }
     }
 
@@ -398,28 +468,51 @@ impl DetSet {
         match self {
             DetSet::Ball { radius, .. }
             | DetSet::Box { radius, .. }
-            | DetSet::Parallelotope { radius, .. } => *radius,
+            | DetSet::Parallelotope { radius, .. }
+            | DetSet::Zonotope { radius, .. } => *radius,
         }
     }
 
     /// The box of an interval method's set, `(lo, hi)`: in `x` for [`DetSet::Box`], in
-    /// `y = T x` for [`DetSet::Parallelotope`]; `None` for a ball.
+    /// `y = T x` for [`DetSet::Parallelotope`]; `None` for a ball or a zonotope.
     pub fn corners(&self) -> Option<(&[f64], &[f64])> {
         match self {
-            DetSet::Ball { .. } => None,
+            DetSet::Ball { .. } | DetSet::Zonotope { .. } => None,
             DetSet::Box { lo, hi, .. } | DetSet::Parallelotope { lo, hi, .. } => Some((lo, hi)),
         }
     }
 
-    /// An interval hull of the set in `x`: `None` for a ball (its hull needs `P^-1`, see
-    /// [`Prs::hull`]).
+    /// An interval hull in `x` of the set without its [`DetSet::ball_added`]: `None` for a
+    /// ball (its hull needs `P^-1`, see [`Prs::hull`]).
     pub fn box_hull(&self) -> Option<(&[f64], &[f64])> {
         match self {
             DetSet::Ball { .. } => None,
             DetSet::Box { lo, hi, .. } => Some((lo, hi)),
             DetSet::Parallelotope {
                 hull_lo, hull_hi, ..
+            }
+            | DetSet::Zonotope {
+                hull_lo, hull_hi, ..
             } => Some((hull_lo, hull_hi)),
+        }
+    }
+
+    /// The P-radius of the ball added to the set's [`DetSet::box_hull`] part: a zonotope's
+    /// remainder, 0 for boxes and parallelotopes (and for a ball, which has no such part).
+    pub fn ball_added(&self) -> f64 {
+        match self {
+            DetSet::Zonotope { remainder, .. } => *remainder,
+            _ => 0.0,
+        }
+    }
+
+    /// The generators of a zonotope, `g_j` one per item; empty for the other shapes.
+    pub fn generators(&self) -> Vec<&[f64]> {
+        match self {
+            DetSet::Zonotope {
+                center, generators, ..
+            } if !center.is_empty() => generators.chunks(center.len()).collect(),
+            _ => Vec::new(),
         }
     }
 }
@@ -588,6 +681,12 @@ pub enum Unproved {
 }
 
 impl Prs {
+    /// This result as a member of an intersection, of kind `role`.
+    pub(crate) fn with_role(mut self, role: Role) -> Prs {
+        self.role = role;
+        self
+    }
+
     /// The dimension `n`.
     pub fn n(&self) -> usize {
         self.states.len()
@@ -657,56 +756,84 @@ impl Prs {
         self.own_contains_at_with(k, x, None)
     }
 
-    /// [`Prs::own_contains_at`], with the exact test of a parallelotope built once by the
-    /// caller (`test`, for this result's metric and transform): the same answers.
+    /// [`Prs::own_contains_at`], with the exact test of step `k`'s set built once by the
+    /// caller (`test`: of this result's parallelotopes, for its metric and transform, or of
+    /// step `k`'s zonotope, for its metric): the same answers.
     pub(crate) fn own_contains_at_with(
         &self,
         k: usize,
         x: &[f64],
-        test: Option<&interval::ParallelotopeTest>,
+        test: Option<Prepared<'_>>,
     ) -> bool {
         let st = &self.steps[k];
         let n = self.n();
         assert_eq!(x.len(), n, "contains: x has the wrong dimension");
         let p = &self.constants.metric;
+        // The set also holds B_P(c, r) when the deterministic set holds its centre c (a point
+        // certain where the search for the nearest point of the set may stop short; the Monte
+        // Carlo check decides most states by that ball alone).
+        let near_centre = || {
+            self.centre_radius(k)
+                .is_some_and(|r| within(p, x, st.det.center(), r))
+        };
         match &st.det {
             DetSet::Ball { center, .. } => within(p, x, center, st.prs_radius),
-            // The set also holds B_P(c, r_t) when the deterministic set holds its centre c (a
-            // point certain where the search for the nearest point of the set may stop short;
-            // the Monte Carlo check decides most states by that ball alone).
-            DetSet::Box { lo, hi, center, .. } => {
-                interval::box_contains(p, n, x, lo, hi, st.r_t)
-                    || (self.holds_center(k) && within(p, x, center, st.r_t))
+            DetSet::Box { lo, hi, .. } => {
+                interval::box_contains(p, n, x, lo, hi, st.r_t) || near_centre()
             }
-            DetSet::Parallelotope { lo, hi, center, .. } => match &self.transform {
+            DetSet::Parallelotope { lo, hi, .. } => match &self.transform {
                 Some(tr) => {
                     let near = match test {
-                        Some(test) => test.contains(x, lo, hi, st.r_t),
-                        None => interval::parallelotope_contains(p, tr, x, lo, hi, st.r_t),
+                        Some(Prepared::Parallelotope(test)) => test.contains(x, lo, hi, st.r_t),
+                        _ => interval::parallelotope_contains(p, tr, x, lo, hi, st.r_t),
                     };
-                    near || (self.holds_center(k) && within(p, x, center, st.r_t))
+                    near || near_centre()
                 }
                 None => false,
             },
+            DetSet::Zonotope {
+                center, generators, ..
+            } => {
+                let r = self.zonotope_radius(k);
+                let near = match test {
+                    Some(Prepared::Zonotope(test)) => test.contains(x, r),
+                    _ => zonotope::contains(p, x, center, generators, r),
+                };
+                near || near_centre()
+            }
         }
     }
 
-    /// Whether the deterministic set of report step `k` certainly holds its centre
-    /// ([`DetSet::center`]).
-    pub(crate) fn holds_center(&self, k: usize) -> bool {
-        match &self.steps[k].det {
-            DetSet::Ball { .. } => true,
+    /// The P-radius added to the zonotope of report step `k` in its PRS, `remainder + r_t`
+    /// (rounded down: membership tests ask for points within it).
+    pub(crate) fn zonotope_radius(&self, k: usize) -> f64 {
+        let st = &self.steps[k];
+        (Interval::point(st.r_t) + Interval::point(st.det.ball_added())).lo()
+    }
+
+    /// The radius of a P-ball around the centre of report step `k`'s deterministic set
+    /// ([`DetSet::center`]) that this result's own PRS certainly holds: the PRS radius of a
+    /// ball, `r_t` for a box or a parallelotope holding its centre, the zonotope's
+    /// `remainder + r_t` (rounded down); `None` when the set is not certain to hold its centre.
+    pub(crate) fn centre_radius(&self, k: usize) -> Option<f64> {
+        let st = &self.steps[k];
+        match &st.det {
+            DetSet::Ball { .. } => Some(st.prs_radius),
+            DetSet::Zonotope { .. } => Some(self.zonotope_radius(k)),
             DetSet::Box { lo, hi, center, .. } => center
                 .iter()
                 .zip(lo.iter().zip(hi))
-                .all(|(c, (l, h))| l <= c && c <= h),
-            DetSet::Parallelotope { lo, hi, center, .. } => {
-                self.transform.as_ref().is_some_and(|tr| {
+                .all(|(c, (l, h))| l <= c && c <= h)
+                .then_some(st.r_t),
+            DetSet::Parallelotope { lo, hi, center, .. } => self
+                .transform
+                .as_ref()
+                .is_some_and(|tr| {
                     let t: Vec<Vec<f64>> =
                         tr.matrix.chunks(self.n()).map(<[f64]>::to_vec).collect();
                     crate::engine::transform::inside(&t, center, lo, hi)
                 })
-            }
+                .then_some(st.r_t),
         }
     }
 
@@ -717,9 +844,10 @@ impl Prs {
     }
 
     /// A rigorous bounding box of the PRS at report step `k`: the deterministic set's hull
-    /// inflated by `r_t sqrt((P^-1)_ii)` (for a ball, the ball `B_P(x*, R_t + r_t)`'s own
-    /// hull), rounded outward; `None` if [`ConstantsUsed::spread`] is missing (a result built
-    /// by hand). Panics if `k` is out of range.
+    /// inflated by `r_t sqrt((P^-1)_ii)` (a zonotope's by `(remainder + r_t) sqrt((P^-1)_ii)`;
+    /// for a ball, the ball `B_P(x*, R_t + r_t)`'s own hull), rounded outward; `None` if
+    /// [`ConstantsUsed::spread`] is missing (a result built by hand). Panics if `k` is out of
+    /// range.
     pub fn hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
         let mut hull = self.own_hull_at(k)?;
         for m in &self.also {
@@ -754,7 +882,8 @@ impl Prs {
             }
             Some((lo, hi)) => (0..n)
                 .map(|i| {
-                    let d = spread(st.r_t, i);
+                    let r = Interval::point(st.r_t) + Interval::point(st.det.ball_added());
+                    let d = spread(r.hi(), i);
                     Bounds::new(
                         (Interval::point(lo[i]) - d).lo(),
                         (Interval::point(hi[i]) + d).hi(),

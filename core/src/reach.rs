@@ -7,7 +7,7 @@ use crate::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, Inclusion, InitialSet, Method, ModelInfo,
     Rate,
 };
-use crate::prs::Prs;
+use crate::prs::{Prs, Role};
 use crate::system::System;
 
 /// An analysis of a model, ready to run: its parameters checked, its certified constants
@@ -225,7 +225,11 @@ impl<'a> Reach<'a> {
             return best;
         }
         let first = first?;
-        let others = self.also.iter().map(run_with).collect::<Result<_, _>>()?;
+        let others = self
+            .also
+            .iter()
+            .map(|s| run_with(s).map(|p| p.with_role(Role::Metric)))
+            .collect::<Result<_, _>>()?;
         Ok(engine::intersect(
             self.info,
             &self.setup.checks,

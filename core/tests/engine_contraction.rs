@@ -1006,3 +1006,91 @@ fn reach_at_another_delta() {
         .with_delta(1.0)
         .is_err());
 }
+
+// ---------------------------------------------------------------------------------------------
+// Results that are not finite
+// ---------------------------------------------------------------------------------------------
+
+/// `dX = a X dt + dW` in `R^1` from `X0 = x0`, with the certified rate `c = a`.
+fn growing(a: f64, x0: f64, horizon: f64, guarantee: Guarantee) -> (Linear, ModelInfo) {
+    let sys = Linear { n: 1, a, s: 1.0 };
+    let mut inf = info("growing", &["x"], vec![(x0, x0)], vec![]);
+    let constants = Constants::given(&inf, vec![1.0], a, 1.0, 0.0);
+    let mut an = analysis(1e-2, horizon, 0.1, constants);
+    an.spec.guarantee = guarantee;
+    inf.analyses = vec![an];
+    (sys, inf)
+}
+
+/// `Psi_t = (e^(2 c t) - 1) / (2 c)` overflows once `2 c t > ln(2 c f64::MAX)`: with `c = 400`
+/// between 0.8 and 0.9 (`t = 0.8957`). The API refuses the result there instead of handing out
+/// `r_t = inf`, and says which quantity and from when.
+#[test]
+fn a_radius_that_overflows_is_an_error_not_an_infinite_set() {
+    let (sys, inf) = growing(400.0, 0.0, 2.0, Guarantee::Pointwise);
+    let t_over = (800.0f64.ln() + f64::MAX.ln()) / 800.0;
+    assert!(0.8 < t_over && t_over < 0.9, "{t_over}");
+    match Reach::new(&sys, &inf, "main").unwrap().run() {
+        Err(RunError::NonFinite(d)) => {
+            let m = &d.message;
+            assert!(
+                m.contains("the PRS is not finite from t = 0.9 on")
+                    && m.contains("r_t = inf")
+                    && m.contains("Psi_t overflowed (c = 400, sigma = 1"),
+                "{m}"
+            );
+            assert_eq!(
+                d.culprit,
+                Some(reachc_core::engine::Culprit::Setting(
+                    reachc_core::engine::Setting::Horizon
+                ))
+            );
+        }
+        other => panic!("expected NonFinite, got {other:?}"),
+    }
+    // A horizon before the overflow: a finite result, r_t = sqrt(Psi kappa) at 0.8.
+    let (sys, inf) = growing(400.0, 0.0, 0.8, Guarantee::Pointwise);
+    let res = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
+    let last = res.steps.last().unwrap();
+    let psi = (800.0f64 * 0.8).exp_m1() / 800.0;
+    assert!((last.psi / psi - 1.0).abs() < 1e-9, "{} vs {psi}", last.psi);
+    assert!(last.r_t.is_finite());
+}
+
+/// A nominal trajectory that overflows (`x' = 400 x` from 1) is an error of the run too, naming
+/// the time, and never a set with NaN or infinite numbers.
+#[test]
+fn a_nominal_that_blows_up_is_an_error() {
+    let (sys, inf) = growing(400.0, 1.0, 3.0, Guarantee::Uniform);
+    match Reach::new(&sys, &inf, "main").unwrap().run() {
+        Err(RunError::NonFinite(d)) => assert!(d.message.contains("t = "), "{d}"),
+        other => panic!("expected NonFinite, got {other:?}"),
+    }
+}
+
+/// Under the time-uniform guarantee the tube's radius `r_t` holds at each time alone too, so it
+/// bounds the pointwise radius: with `c = 40` the pointwise `Psi_t` overflows after
+/// `t = 8.95`, the tube's radius (`e^(psi_t)` times a bounded factor, `psi_t = 40 t`) does not,
+/// and `r_pointwise` is `r_t` there; before, it is the closed form `sqrt(Psi_t kappa)`.
+#[test]
+fn r_pointwise_is_at_most_the_uniform_radius() {
+    let (sys, inf) = growing(40.0, 0.0, 10.0, Guarantee::Uniform);
+    let res = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
+    let last = res.steps.last().unwrap();
+    assert_eq!(last.t, 10.0);
+    assert!(last.psi.is_infinite(), "Psi_10 = e^800 / 80 overflows");
+    assert!(last.r_t.is_finite() && last.r_t > 1e170, "{}", last.r_t);
+    assert_eq!(last.r_pointwise, last.r_t);
+    let k = kappa(1, 1e-2, RadiusRule::Amgf);
+    for st in &res.steps[1..] {
+        assert!(st.r_pointwise <= st.r_t, "t = {}", st.t);
+    }
+    let st = &res.steps[step_at(&res, 1.0)];
+    let closed = ((80.0f64).exp_m1() / 80.0 * k).sqrt();
+    assert!(
+        (st.r_pointwise / closed - 1.0).abs() < 1e-9,
+        "{} vs {closed}",
+        st.r_pointwise
+    );
+    assert!(st.r_pointwise < st.r_t);
+}

@@ -57,7 +57,7 @@ pub const SIMULATE_USAGE: &str =
   --paths N          number of sample paths (required)
   --analysis NAME    check only this analysis (default: all)
   --seed S           random seed (default 0); the same seed gives the same results
-  --dt H             largest Euler-Maruyama step (default: the analysis' step)
+  --dt H             largest Euler-Maruyama step (default: per report interval, h L <= 0.05)
   --delta D          recompute the PRS at this delta instead of the analysis' own
   --inputs MODE      random: uniform in the input box (default); corners: a random corner;
                      centre: the box centre. random and corners are redrawn every hold time
@@ -477,10 +477,6 @@ fn run_analyses<S: System + Sync>(
                 continue;
             }
         };
-        if let Some(why) = report::not_finite(&res) {
-            failures.report(Failure::not_finite(name, &why), err);
-            continue;
-        }
         if !opts.quiet {
             let _ = writeln!(out, "{}", report::summary(&res));
         }
@@ -652,10 +648,6 @@ fn simulate_analyses<S: System + Sync>(
                 continue;
             }
         };
-        if let Some(why) = report::not_finite(&result) {
-            failures.report(Failure::not_finite(name, &why), err);
-            continue;
-        }
         let started = std::time::Instant::now();
         let simulated = {
             let mut report_progress = |done: u64, total: u64| match progress.as_mut() {
@@ -687,6 +679,13 @@ fn simulate_analyses<S: System + Sync>(
         };
         let secs = started.elapsed().as_secs_f64();
         let threads = simulate::thread_count(opts.sim.threads);
+        let dt = match &simulated {
+            Simulated::Report(sim) => sim.dt,
+            Simulated::Part(part) => part.run.dt,
+        };
+        if let Some(w) = report::simulation::dt_warning(&dt) {
+            let _ = writeln!(err, "warning: analysis `{name}`: {w}");
+        }
         match simulated {
             Simulated::Report(sim) => {
                 if !opts.quiet {

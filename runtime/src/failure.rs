@@ -12,7 +12,7 @@
 //! in it replaced by spaces). The CLI reads these lines back ([`Failure::parse_line`]) and
 //! renders each as a diagnostic located in the spec; this is the only text parsed between them.
 
-use reachc_core::engine::{Culprit, RunError, Setting};
+use reachc_core::engine::{Culprit, RunError};
 use std::fmt;
 
 /// The prefix of a failure line.
@@ -24,7 +24,7 @@ pub struct Failure {
     /// The analysis' name.
     pub analysis: String,
     /// What happened, completing "analysis `NAME` ...": "could not run: ...", "cannot be
-    /// simulated: ...", "has no finite result: ...".
+    /// simulated: ...".
     pub message: String,
     /// The state or setting to look at, when known.
     pub culprit: Option<Culprit>,
@@ -37,16 +37,6 @@ impl Failure {
             analysis: analysis.to_string(),
             message: format!("could not run: {e}"),
             culprit: e.culprit(),
-        }
-    }
-
-    /// An analysis whose result is not finite (`why`: [`crate::report::not_finite`]); a
-    /// shorter horizon is the setting that bounds it.
-    pub fn not_finite(analysis: &str, why: &str) -> Failure {
-        Failure {
-            analysis: analysis.to_string(),
-            message: format!("has no finite result: {why}"),
-            culprit: Some(Culprit::Setting(Setting::Horizon)),
         }
     }
 
@@ -109,7 +99,7 @@ impl fmt::Display for Failure {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use reachc_core::engine::Detail;
+    use reachc_core::engine::{Detail, Setting};
 
     #[test]
     fn failures_round_trip_through_their_lines() {

@@ -271,7 +271,7 @@ fn results_do_not_depend_on_the_thread_count() {
     assert_ne!(to_json(&other), json(1, InputMode::Random));
 }
 
-/// `simulate` and `sample_paths` run the same paths: with one path, the quantile reported at
+/// `simulate` and `result_paths` run the same paths: with one path, the quantile reported at
 /// each time is that path's distance to the nominal, which equals (to the bit) the distance of
 /// the recorded path. Covers the fast loop for additive noise (no inputs, no unsafe set) and the
 /// general one (inputs, an unsafe set, Euler steps finer than the report step).
@@ -282,7 +282,6 @@ fn simulated_paths_are_the_recorded_sample_paths() {
     let general = info(&DRIVEN, 0.5, 0.2, 0.3, 0.05, 1.0);
     for (sys, info, dt) in [(&LINEAR, &additive, None), (&DRIVEN, &general, Some(0.004))] {
         let r = run(sys, info);
-        let times: Vec<f64> = r.steps.iter().map(|s| s.t).collect();
         for seed in 0..10 {
             let opts = Options {
                 paths: 1,
@@ -292,8 +291,7 @@ fn simulated_paths_are_the_recorded_sample_paths() {
                 ..Options::default()
             };
             let rep = simulate(sys, info, &r, &opts);
-            let sampled =
-                simulate::sample_paths(sys, info, &times, Some(&r.initial_center), &opts).unwrap();
+            let sampled = simulate::result_paths(sys, info, &r, &opts).unwrap();
             for (k, (st, res)) in rep.steps.iter().zip(&r.steps).enumerate() {
                 let x = &sampled[0][k * sys.n..][..sys.n];
                 // The identity metric's distance, summed as the simulation sums it.

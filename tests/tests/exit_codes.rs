@@ -70,7 +70,8 @@ fn generated_binaries_follow_the_exit_code_policy() {
     assert_eq!(code, EXIT_FAILED, "{err}");
     assert!(
         err.contains(
-            "error: analysis `long` has no finite result: the PRS is not finite from t = 1.8 on"
+            "error: analysis `long` could not run: numerical failure: the PRS is not finite from \
+             t = 1.8 on"
         ),
         "{err}"
     );
@@ -83,8 +84,8 @@ fn generated_binaries_follow_the_exit_code_policy() {
     assert_eq!(code, EXIT_FAILED, "{err}");
     assert!(
         err.starts_with(
-            "reachc-failure long setting:horizon has no finite result: the PRS is not finite \
-             from t = 1.8 on"
+            "reachc-failure long setting:horizon could not run: numerical failure: the PRS is \
+             not finite from t = 1.8 on"
         ),
         "{err}"
     );

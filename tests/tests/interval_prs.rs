@@ -38,7 +38,7 @@ fn placeholder(info: &ModelInfo) -> Constants {
 fn y_box(d: &DetSet) -> (&[f64], &[f64]) {
     match d {
         DetSet::Box { lo, hi, .. } | DetSet::Parallelotope { lo, hi, .. } => (lo, hi),
-        DetSet::Ball { .. } => panic!("not an interval result"),
+        DetSet::Ball { .. } | DetSet::Zonotope { .. } => panic!("not an interval result"),
     }
 }
 
@@ -185,6 +185,12 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
                 .map(|(lo, hi)| Some(Bounds::new(lo, hi)))
                 .to_vec();
             horizon = Some(1.0);
+        }
+        if path.ends_with("unicycle_lookahead.sde") {
+            // No metric contracts (issue 28): the embedding's box reaches 60x its start by
+            // t = 0.25 and 1e10 by t = 1, on 5e4 internal steps (30 s of the test's time per
+            // inclusion); the boxes' soundness is checked where they still say something.
+            horizon = Some(0.25);
         }
         for a in &info.analyses {
             for inclusion in [Inclusion::Natural, Inclusion::Jacobian, Inclusion::Mixed] {
@@ -339,19 +345,35 @@ fn final_half_widths(r: &Prs) -> Vec<f64> {
 }
 
 /// The mass-spring-damper (specs/msd.sde): in x and v the box wraps, grows far beyond the
-/// contraction PRS and says so; with `transform = auto` its PRS stays within 2x of the
-/// contraction PRS at the horizon, and no hint.
+/// contraction PRS; the first-order set (method.md 8.8, on by default) keeps the result within
+/// 2x of the contraction PRS and no hint is given. With `first_order = off` the box is the
+/// result and says so; with `transform = auto` its PRS stays within 2x of the contraction PRS
+/// at the horizon, and no hint.
 #[test]
 fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
-    let (sys, info) = interpreter(&workspace().join("specs/msd.sde"));
+    let (sys, mut info) = interpreter(&workspace().join("specs/msd.sde"));
+    let mut off = info
+        .analyses
+        .iter()
+        .find(|a| a.spec.name == "interval")
+        .unwrap()
+        .clone();
+    off.spec.name = "interval_off".into();
+    off.spec.first_order = false;
+    info.analyses.push(off);
     let run = |name: &str| Reach::new(&sys, &info, name).unwrap().run().unwrap();
-    let (contraction, plain, auto) = (run("contraction"), run("interval"), run("interval_auto"));
-    let (hc, hp, ha) = (
+    let (contraction, first, auto) = (run("contraction"), run("interval"), run("interval_auto"));
+    let plain = run("interval_off");
+    let (hc, hf, hp, ha) = (
         final_half_widths(&contraction),
+        final_half_widths(&first),
         final_half_widths(&plain),
         final_half_widths(&auto),
     );
-    eprintln!("half-widths at t = 5: contraction {hc:?}, interval {hp:?}, interval_auto {ha:?}");
+    eprintln!(
+        "half-widths at t = 5: contraction {hc:?}, interval {hf:?}, first_order = off {hp:?}, \
+         interval_auto {ha:?}"
+    );
     // `metric = auto` is chosen for the PRS volume (c = -0.86; the rate-optimal metric
     // certifies -0.99 but gives a larger PRS).
     assert!(
@@ -359,16 +381,28 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
         "c = {}",
         contraction.constants.c
     );
+    // The default's own box still wraps; the first-order member cuts it.
+    let (box_lo, box_hi) = first.steps.last().unwrap().det.box_hull().unwrap();
+    assert_eq!(first.also.len(), 1);
     for i in 0..2 {
         assert!(
             ha[i] <= 2.0 * hc[i],
             "state {i}: auto {ha:?} vs contraction {hc:?}"
         );
         assert!(
+            hf[i] <= 2.0 * hc[i],
+            "state {i}: first-order {hf:?} vs contraction {hc:?}"
+        );
+        assert!(
+            0.5 * (box_hi[i] - box_lo[i]) >= 5.0 * hc[i],
+            "state {i}: box [{box_lo:?}, {box_hi:?}] vs contraction {hc:?}"
+        );
+        assert!(
             hp[i] >= 5.0 * hc[i],
             "state {i}: plain {hp:?} vs contraction {hc:?}"
         );
     }
+    assert!(first.hints.is_empty(), "{:?}", first.hints);
     // The hint names the horizon, x and both widths (the wrapping box against a P-ball of the
     // same constants).
     match plain.hints.as_slice() {

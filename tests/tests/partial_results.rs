@@ -16,7 +16,7 @@ use reachc_runtime::failure::Failure;
 
 /// `x' = x^2` from [0.5, 0.6]: `good` (horizon 0.2) runs, `blows_up` (horizon 3) cannot.
 fn spec() -> PathBuf {
-    workspace().join("tests/run_errors/step_too_coarse.sde")
+    workspace().join("tests/run_errors/box_blows_up.sde")
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -93,7 +93,7 @@ fn check_failure(stderr: &str) {
     let f = failures(stderr);
     assert_eq!(f.len(), 1, "{stderr}");
     assert_eq!(f[0].analysis, "blows_up");
-    assert_eq!(f[0].culprit, Some(Culprit::Setting(Setting::Step)));
+    assert_eq!(f[0].culprit, Some(Culprit::Setting(Setting::Inclusion)));
     assert!(
         f[0].message
             .starts_with("could not run: numerical failure: the embedding system"),

@@ -6,7 +6,7 @@ use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::driver::{check_source, load};
 use reachc_e2e::{interpreter_of, shipped, shipped_specs, workspace};
 use reachc_runtime::model::{Method, ModelInfo};
-use reachc_runtime::prs::{Proved, UniformBound};
+use reachc_runtime::prs::{Proved, Role, UniformBound};
 use reachc_runtime::simulate::{
     self, clopper_pearson_lower as lower_bound, clopper_pearson_upper as upper_bound, Options,
 };
@@ -202,13 +202,15 @@ fn the_initial_box_is_the_set_at_time_zero() {
 fn several_metrics_intersect_their_sets() {
     let (sys, info) = shipped("pendulum.sde");
     let prs = Reach::new(&sys, &info, "per_state").unwrap().run().unwrap();
-    // The second metric's ball, and each metric's interval box (section 8.7).
-    let balls: Vec<&Prs> = prs
-        .also
-        .iter()
-        .filter(|m| m.method == Method::Contraction)
-        .collect();
-    assert_eq!((balls.len(), prs.also.len()), (1, 3));
+    // The second metric's ball, and each metric's interval box (section 8.7) and first-order
+    // set (8.8).
+    let balls: Vec<&Prs> = prs.also.iter().filter(|m| m.role == Role::Metric).collect();
+    let count = |role: Role| prs.also.iter().filter(|m| m.role == role).count();
+    assert_eq!(
+        (balls.len(), count(Role::Box), count(Role::FirstOrder)),
+        (1, 2, 2)
+    );
+    assert_eq!(balls[0].method, Method::Contraction);
     assert_eq!(prs.delta, 1e-3);
     for m in &prs.also {
         assert_eq!(m.delta, (1e-3f64 / 2.0).next_down());
@@ -259,7 +261,9 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
     let (sys, info) = shipped("pendulum.sde");
     let reach = Reach::new(&sys, &info, "contraction").unwrap();
     let prs = reach.run().unwrap();
-    assert_eq!(prs.also.len(), 1);
+    // The box, and the first-order set (method.md 8.8, tests/tests/tighter_sets.rs below).
+    let roles = |p: &Prs| p.also.iter().map(|m| m.role).collect::<Vec<_>>();
+    assert_eq!(roles(&prs), [Role::Box, Role::FirstOrder]);
     let boxes = &prs.also[0];
     assert_eq!((boxes.method, boxes.delta), (Method::Interval, prs.delta));
     // The same stochastic radii widen both sets.
@@ -288,7 +292,7 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
     assert!(prs.contains_at(k, &c));
 
     let prs = reach.with_delta(0.1).unwrap().run().unwrap();
-    assert_eq!(prs.also.len(), 1);
+    assert_eq!(roles(&prs), [Role::Box, Role::FirstOrder]);
     let paths = 4000;
     let opts = Options {
         paths,
@@ -304,4 +308,42 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
             step.outside
         );
     }
+}
+
+/// `first_order = on` (the default) cuts the pendulum's contraction ball by the first-order set
+/// (a member of role `FirstOrder`, method.md 8.8, beside the interval box of role `Box`), which
+/// makes omega's bound at the horizon tighter; `first_order = off` gives the paper's ball alone;
+/// a value other than `on` / `off` is refused (tests/bad/first_order_value.sde).
+#[test]
+fn first_order_sets_are_on_by_default_and_can_be_turned_off() {
+    let spec = |extra: &str| {
+        format!(
+            "model p\nconst g = 10\nstate theta in [-pi/10, pi/10]\nstate omega in [-0.2, 0.2]\n\
+             noise w\ndrift {{\n  theta' = omega\n  omega' = g * sin(theta) - 20 * theta - 20 * omega\n}}\n\
+             diffusion {{ omega: 0.1 * w }}\n\
+             analysis a {{ metric = auto  horizon = 2  step = 0.02 {extra} }}\n"
+        )
+    };
+    let run = |extra: &str| {
+        let (sys, info) = inline(&spec(extra));
+        assert_eq!(
+            info.analyses[0].spec.first_order,
+            extra != "first_order = off"
+        );
+        Reach::new(&sys, &info, "a").unwrap().run().unwrap()
+    };
+    let (on, written, off) = (run(""), run("first_order = on"), run("first_order = off"));
+    let roles = |p: &Prs| p.also.iter().map(|m| m.role).collect::<Vec<_>>();
+    // The interval box of the run (method.md 8.7) cuts the ball too.
+    assert_eq!(roles(&on), [Role::Box, Role::FirstOrder]);
+    assert_eq!(roles(&written), roles(&on));
+    assert_eq!(roles(&off), [Role::Box]);
+    assert_eq!(on.role, Role::Own);
+    let (h_on, h_off) = (on.hull(2.0).unwrap(), off.hull(2.0).unwrap());
+    eprintln!("omega at t = 2: on {:?}, off {:?}", h_on[1], h_off[1]);
+    // Every bound of the cut set inside the ball's, omega's at least a fifth tighter.
+    for (a, b) in h_on.iter().zip(&h_off) {
+        assert!(a.lo >= b.lo && a.hi <= b.hi, "{a:?} vs {b:?}");
+    }
+    assert!(h_on[1].hi - h_on[1].lo <= 0.8 * (h_off[1].hi - h_off[1].lo));
 }

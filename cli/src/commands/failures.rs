@@ -113,7 +113,7 @@ mod tests {
 
     fn locator() -> Locator {
         let spec = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../tests/run_errors/step_too_coarse.sde");
+            .join("../tests/run_errors/box_blows_up.sde");
         Locator::new(&load(&spec).unwrap(), false)
     }
 
@@ -125,11 +125,11 @@ mod tests {
             shown.starts_with("Error: analysis `blows_up` could not run: it blew up"),
             "{shown}"
         );
-        assert!(shown.contains("step_too_coarse.sde:18:5 ]"), "{shown}");
+        assert!(shown.contains("box_blows_up.sde:18:5 ]"), "{shown}");
         assert!(shown.contains("in analysis `blows_up`"), "{shown}");
         // A state, by index: its declaration.
         let shown = l.line("reachc-failure good state:0 could not run: left the domain");
-        assert!(shown.contains("step_too_coarse.sde:5:1 ]"), "{shown}");
+        assert!(shown.contains("box_blows_up.sde:5:1 ]"), "{shown}");
         assert!(shown.contains("state `x`"), "{shown}");
         // Other lines pass through; an analysis the spec does not have is printed as prose.
         assert_eq!(

@@ -4,9 +4,12 @@
 //!
 //! - A box or a parallelotope `{x = T^-1 y : lo <= y <= hi}` projects to a zonogon
 //!   `c + sum_j s_j g_j`, `|s_j| <= 1`, with one generator per column of `T^-1` (the box: per
-//!   state): `h(d) = c . d + sum_j |g_j . d|`.
+//!   state): `h(d) = c . d + sum_j |g_j . d|`. So does a zonotope, with its generators
+//!   projected.
 //! - A P-ball `{x : (x - c)' P (x - c) <= R^2}` projects to the ellipse with the same `R` and
 //!   shape `S`, the 2 x 2 block of `P^-1` on the plotted states: `h(d) = c . d + R sqrt(d' S d)`.
+//!   A first-order set, a zonotope plus `B_P(remainder)`, is the sum of its zonogon and that
+//!   ellipse.
 //!
 //! The PRS is the deterministic set plus `B_P(r_t)`, so its support function is the sum. Its
 //! boundary is drawn as the polygon cut out by the support lines in many directions, always
@@ -196,18 +199,28 @@ impl Plane {
         let rows = [&t_inv[self.states[0]], &t_inv[self.states[1]]];
         let mid: Vec<f64> = lo.iter().zip(hi).map(|(l, h)| 0.5 * (l + h)).collect();
         let center = [dot_n(rows[0], &mid), dot_n(rows[1], &mid)];
-        let generators = (0..lo.len())
-            .map(|j| {
+        zonogon(
+            center,
+            (0..lo.len()).map(|j| {
                 let half = 0.5 * (hi[j] - lo[j]);
                 [half * rows[0][j], half * rows[1][j]]
-            })
-            .filter(|g| g[0] != 0.0 || g[1] != 0.0)
-            .collect();
-        Projected {
-            center,
-            generators,
-            ellipse: None,
-        }
+            }),
+        )
+    }
+
+    /// The zonotope `{c + sum_j xi_j g_j : |xi_j| <= 1}` plus the P-ball `B_P(remainder)`.
+    pub fn zonotope(&self, center: &[f64], generators: &[Vec<f64>], remainder: f64) -> Projected {
+        let z = zonogon(self.point(center), generators.iter().map(|g| self.point(g)));
+        z.plus_ellipse(self.shape, remainder)
+    }
+}
+
+/// The zonogon `center + sum_j s_j g_j`, `|s_j| <= 1` (generators of length 0 dropped).
+fn zonogon(center: Point, generators: impl Iterator<Item = Point>) -> Projected {
+    Projected {
+        center,
+        generators: generators.filter(|g| g[0] != 0.0 || g[1] != 0.0).collect(),
+        ellipse: None,
     }
 }
 
@@ -350,26 +363,27 @@ mod tests {
         }
     }
 
-    #[test]
-    fn prs_polygon_contains_sampled_points_and_is_tight() {
-        // PRS = parallelotope (+) B_P(r): sample points of both parts, add, project.
-        let (lo, hi) = ([-1.0, 0.5, -0.2], [2.0, 1.5, 0.3]);
-        let p = metric();
-        let plane = Plane::new([0, 1], &p).unwrap();
-        let r = 0.4;
-        let prs = plane
-            .parallelotope(&lo, &hi, &t_inv())
-            .plus_ellipse(plane.shape, r);
+    /// Checks `prs`, the projection onto `plane` of `conv(vertices) (+) B_P(r)` (`p` the
+    /// metric, the vertices in three states, `sample` a random point of the polytope): its
+    /// polygon holds sampled points of the set (the ball's by `P = L L'`, `x = L^-T z` with
+    /// `|z| <= r`, half of them on its boundary); points on the set's boundary (a maximising
+    /// vertex plus the maximiser over `B_P(r)` of the lifted direction) are inside and near the
+    /// edges; no vertex of the polygon lies beyond the support function by more than the
+    /// angular spacing allows.
+    fn check_polygon(
+        plane: &Plane,
+        p: &[Vec<f64>],
+        prs: &Projected,
+        vertices: &[Vec<f64>],
+        r: f64,
+        sample: &mut dyn FnMut(&mut Rng) -> Vec<f64>,
+    ) {
         let poly = prs.polygon();
-        let chol = nalgebra::Cholesky::new(DMatrix::from_fn(3, 3, |i, j| p[i][j])).unwrap();
-        let l = chol.l();
+        let pm = DMatrix::from_fn(3, 3, |i, j| p[i][j]);
+        let l = nalgebra::Cholesky::new(pm.clone()).unwrap().l();
         let mut rng = Rng(11);
         for _ in 0..20_000 {
-            let y: Vec<f64> = (0..3)
-                .map(|j| lo[j] + (hi[j] - lo[j]) * rng.uniform())
-                .collect();
-            // A point of B_P(r): x = L^-T z with |z| <= r (P = L L'), half of them on its
-            // boundary.
+            let y = sample(&mut rng);
             let mut z = DVector::from_vec(vec![rng.sym(), rng.sym(), rng.sym()]);
             let scale = if rng.uniform() < 0.5 {
                 r
@@ -378,32 +392,21 @@ mod tests {
             };
             z *= scale / z.norm();
             let w = l.transpose().solve_upper_triangular(&z).unwrap();
-            let x: Vec<f64> = mat_vec(&t_inv(), &y)
-                .iter()
-                .zip(w.iter())
-                .map(|(a, b)| a + b)
-                .collect();
+            let x: Vec<f64> = y.iter().zip(w.iter()).map(|(a, b)| a + b).collect();
             let pt = plane.point(&x);
             assert!(inside(&poly, pt, 1e-9), "{pt:?} outside");
         }
-        // Points on the set's boundary (a maximising vertex of the parallelotope plus the
-        // maximiser over B_P(r) of the lifted direction) are inside and near the edges.
-        let pinv = DMatrix::from_fn(3, 3, |i, j| p[i][j])
-            .try_inverse()
-            .unwrap();
+        let pinv = pm.try_inverse().unwrap();
         for k in 0..500 {
             let a = std::f64::consts::TAU * (f64::from(k) + 0.5) / 500.0;
             let d = [a.cos(), a.sin()];
-            let lift = DVector::from_vec(vec![d[0], d[1], 0.0]);
+            let mut lift = DVector::zeros(3);
+            lift[plane.states[0]] = d[0];
+            lift[plane.states[1]] = d[1];
             let w = &pinv * &lift;
             let w = w.clone() * (r / lift.dot(&w).sqrt());
-            let vertex = (0..8)
-                .map(|mask: u32| {
-                    let y: Vec<f64> = (0..3)
-                        .map(|j| if mask >> j & 1 == 1 { hi[j] } else { lo[j] })
-                        .collect();
-                    mat_vec(&t_inv(), &y)
-                })
+            let vertex = vertices
+                .iter()
                 .max_by(|u, v| dot(plane.point(u), d).total_cmp(&dot(plane.point(v), d)))
                 .unwrap();
             let x: Vec<f64> = vertex.iter().zip(w.iter()).map(|(a, b)| a + b).collect();
@@ -411,7 +414,6 @@ mod tests {
             assert!(inside(&poly, pt, 1e-9), "{pt:?} outside");
             assert!(!inside(&poly, pt, -1e-4 * r), "{pt:?} far inside");
         }
-        // Tight: no vertex beyond the support function by more than the angular spacing allows.
         for k in 0..360 {
             let a = std::f64::consts::TAU * (k as f64 + 0.37) / 360.0;
             let d = [a.cos(), a.sin()];
@@ -425,6 +427,107 @@ mod tests {
                 "{k}: {h} vs {}",
                 prs.support(d)
             );
+        }
+    }
+
+    #[test]
+    fn prs_polygon_contains_sampled_points_and_is_tight() {
+        // PRS = parallelotope (+) B_P(r).
+        let (lo, hi) = ([-1.0, 0.5, -0.2], [2.0, 1.5, 0.3]);
+        let p = metric();
+        let plane = Plane::new([0, 1], &p).unwrap();
+        let r = 0.4;
+        let prs = plane
+            .parallelotope(&lo, &hi, &t_inv())
+            .plus_ellipse(plane.shape, r);
+        let corner = |mask: u32| -> Vec<f64> {
+            (0..3)
+                .map(|j| if mask >> j & 1 == 1 { hi[j] } else { lo[j] })
+                .collect()
+        };
+        let vertices: Vec<Vec<f64>> = (0..8).map(|m| mat_vec(&t_inv(), &corner(m))).collect();
+        check_polygon(&plane, &p, &prs, &vertices, r, &mut |rng| {
+            let y: Vec<f64> = (0..3)
+                .map(|j| lo[j] + (hi[j] - lo[j]) * rng.uniform())
+                .collect();
+            mat_vec(&t_inv(), &y)
+        });
+    }
+
+    /// A zonotope of four generators in three states (centre `c`, generators `g`).
+    fn zonotope() -> (Vec<f64>, Vec<Vec<f64>>) {
+        let g = vec![
+            vec![1.0, 0.2, -0.5],
+            vec![0.3, -0.8, 0.4],
+            vec![-0.2, 0.1, 0.9],
+            vec![0.5, 0.5, 0.5],
+        ];
+        (vec![0.5, -1.0, 2.0], g)
+    }
+
+    /// The point `c + sum_j xi_j g_j`.
+    fn zonotope_point(c: &[f64], g: &[Vec<f64>], xi: &[f64]) -> Vec<f64> {
+        (0..3)
+            .map(|i| c[i] + g.iter().zip(xi).map(|(g, v)| g[i] * v).sum::<f64>())
+            .collect()
+    }
+
+    /// A first-order set `Z (+) B_P(remainder)` plus `B_P(r_t)`: its support is the
+    /// zonotope's (the largest over its 16 vertices, projected) plus
+    /// `(remainder + r_t) sqrt(d' S d)` with `S` the block of `P^-1` computed independently; its
+    /// polygon holds the PRS's sampled points, is tight, and with no ball it is the zonogon
+    /// with its 8 vertices exactly.
+    #[test]
+    fn zonotope_prs_is_the_zonogon_plus_both_balls() {
+        let (c, g) = zonotope();
+        let p = metric();
+        let pinv = DMatrix::from_fn(3, 3, |i, j| p[i][j])
+            .try_inverse()
+            .unwrap();
+        let (remainder, r_t) = (0.25, 0.15);
+        let vertices: Vec<Vec<f64>> = (0..16)
+            .map(|mask: u32| {
+                let xi: Vec<f64> = (0..4)
+                    .map(|j| if mask >> j & 1 == 1 { 1.0 } else { -1.0 })
+                    .collect();
+                zonotope_point(&c, &g, &xi)
+            })
+            .collect();
+        for states in [[0, 2], [1, 0]] {
+            let plane = Plane::new(states, &p).unwrap();
+            let det = plane.zonotope(&c, &g, remainder);
+            let prs = det.plus_ellipse(plane.shape, r_t);
+            let mut rng = Rng(5);
+            for _ in 0..200 {
+                let d = [rng.sym(), rng.sym()];
+                let zonogon = vertices
+                    .iter()
+                    .map(|v| dot(plane.point(v), d))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                let (a, b) = (states[0], states[1]);
+                let sds = pinv[(a, a)] * d[0] * d[0]
+                    + 2.0 * pinv[(a, b)] * d[0] * d[1]
+                    + pinv[(b, b)] * d[1] * d[1];
+                let exact = zonogon + (remainder + r_t) * sds.sqrt();
+                assert!((prs.support(d) - exact).abs() < 1e-12, "{d:?}");
+                let exact = zonogon + remainder * sds.sqrt();
+                assert!((det.support(d) - exact).abs() < 1e-12, "{d:?}");
+            }
+            check_polygon(&plane, &p, &prs, &vertices, remainder + r_t, &mut |rng| {
+                let xi: Vec<f64> = (0..4).map(|_| rng.sym()).collect();
+                zonotope_point(&c, &g, &xi)
+            });
+            let zonogon = plane.zonotope(&c, &g, 0.0).polygon();
+            assert_eq!(zonogon.len(), 8, "{zonogon:?}");
+            for v in &zonogon {
+                assert!(
+                    vertices.iter().any(|u| {
+                        let u = plane.point(u);
+                        (u[0] - v[0]).abs() + (u[1] - v[1]).abs() < 1e-12
+                    }),
+                    "{v:?}"
+                );
+            }
         }
     }
 

@@ -38,9 +38,28 @@ pub struct ResultFile {
     pub rate: Option<RateKind>,
     /// One record per report time.
     pub steps: Vec<Step>,
-    /// The analysis' further metrics' results (the PRS is the intersection of all sets).
+    /// The members of the intersection (the PRS is the intersection of all sets).
     #[serde(default)]
     pub also: Vec<ResultFile>,
+    /// A member's kind; [`Role::Own`] for the result itself (no `role` in the file).
+    #[serde(default)]
+    pub role: Role,
+}
+
+/// What a result is within an intersection (`"metric"`, `"box"`, `"first_order"`; none for
+/// the result itself).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// The analysis' own result.
+    #[default]
+    Own,
+    /// A further metric's result, of the same method, at `δ / K`.
+    Metric,
+    /// The interval method's box of a contraction run.
+    Box,
+    /// The first-order sets (zonotopes plus a remainder ball).
+    FirstOrder,
 }
 
 /// The guarantee of a result (`"uniform"` or `"pointwise"`).
@@ -64,7 +83,7 @@ pub enum Method {
     Interval,
 }
 
-/// The shape of a deterministic set (`"p_ball"`, `"box"` or `"parallelotope"`).
+/// The shape of a deterministic set (`"p_ball"`, `"box"`, `"parallelotope"` or `"zonotope"`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Shape {
@@ -74,6 +93,8 @@ pub enum Shape {
     Box,
     /// `{x : lo <= T x <= hi}`.
     Parallelotope,
+    /// `{center + sum_j xi_j g_j : |xi_j| <= 1} (+) B_P(remainder)`.
+    Zonotope,
 }
 
 /// Where a result's rates come from.
@@ -144,12 +165,12 @@ pub struct Step {
     pub sigma: Option<f64>,
 }
 
-/// A deterministic set: `p_ball`, `box` or `parallelotope` (see docs/results.md).
+/// A deterministic set: `p_ball`, `box`, `parallelotope` or `zonotope` (see docs/results.md).
 #[derive(Clone, Debug, Deserialize)]
 pub struct DetSet {
     /// Its shape.
     pub shape: Shape,
-    /// Centre of the P-ball (`p_ball`).
+    /// Centre of the P-ball (`p_ball`) or of the zonotope.
     pub center: Vec<f64>,
     /// Radius `R_t` of the P-ball.
     pub radius: f64,
@@ -159,6 +180,37 @@ pub struct DetSet {
     /// Upper corner.
     #[serde(default)]
     pub hi: Option<Vec<f64>>,
+    /// A zonotope's generators, one array of `n` values each.
+    #[serde(default)]
+    pub generators: Option<Vec<Vec<f64>>>,
+    /// The P-radius of the ball added to a zonotope.
+    #[serde(default)]
+    pub remainder: Option<f64>,
+}
+
+impl DetSet {
+    /// Whether the set is well formed in `n` states (every number finite; the transform, which
+    /// a parallelotope needs, is checked by the caller).
+    fn valid(&self, n: usize) -> bool {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let corners = match (&self.lo, &self.hi) {
+            (Some(lo), Some(hi)) => lo.len() == n && hi.len() == n && finite(lo) && finite(hi),
+            _ => false,
+        };
+        let centre = self.center.len() == n && finite(&self.center);
+        match self.shape {
+            Shape::PBall => centre && self.radius.is_finite(),
+            Shape::Box | Shape::Parallelotope => corners,
+            Shape::Zonotope => {
+                let generators = self
+                    .generators
+                    .as_ref()
+                    .is_some_and(|g| g.iter().all(|g| g.len() == n && finite(g)));
+                let remainder = self.remainder.is_some_and(|r| r.is_finite() && r >= 0.0);
+                centre && generators && remainder
+            }
+        }
+    }
 }
 
 /// The parts of a Monte Carlo report the plots use.
@@ -202,8 +254,26 @@ impl ResultFile {
         Ok(r)
     }
 
-    /// Dimensions, shapes and times agree, every number is finite.
+    /// Dimensions, shapes and times agree, every number is finite; and so for the members of
+    /// an intersection, on the same report times.
     fn check(&self) -> Result<(), String> {
+        self.check_own()?;
+        for (j, m) in self.also.iter().enumerate() {
+            let times = m.steps.len() == self.steps.len()
+                && m.steps.iter().zip(&self.steps).all(|(a, b)| a.t == b.t);
+            m.check_own()
+                .and_then(|()| {
+                    (m.states.len() == self.states.len() && times)
+                        .then_some(())
+                        .ok_or_else(|| "other states or report times".to_string())
+                })
+                .map_err(|e| format!("member {} of the intersection: {e}", j + 1))?;
+        }
+        Ok(())
+    }
+
+    /// [`ResultFile::check`] of the result's own sets.
+    fn check_own(&self) -> Result<(), String> {
         let n = self.states.len();
         let square = |m: &[Vec<f64>]| m.len() == n && m.iter().all(|r| r.len() == n);
         if n == 0 || self.steps.is_empty() {
@@ -223,15 +293,8 @@ impl ResultFile {
         let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         for (k, s) in self.steps.iter().enumerate() {
             let d = &s.det_set;
-            let corners = match (&d.lo, &d.hi) {
-                (Some(lo), Some(hi)) => lo.len() == n && hi.len() == n && finite(lo) && finite(hi),
-                _ => false,
-            };
-            let shape_ok = match d.shape {
-                Shape::PBall => d.center.len() == n && finite(&d.center) && d.radius.is_finite(),
-                Shape::Box => corners,
-                Shape::Parallelotope => corners && self.transform.is_some(),
-            };
+            let shape_ok =
+                d.valid(n) && (d.shape != Shape::Parallelotope || self.transform.is_some());
             if !shape_ok {
                 return Err(format!("step {k}: malformed {:?} set", d.shape));
             }
@@ -289,5 +352,80 @@ impl SimFile {
         } else {
             None
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// A result in two states whose one report time holds `det_set`, with `also`.
+    fn result(det_set: serde_json::Value, also: serde_json::Value) -> serde_json::Value {
+        json!({
+            "model": "m", "analysis": "a", "method": "contraction", "delta": 0.01,
+            "states": ["x", "y"], "outputs": [0, 1],
+            "constants": {"metric": [[2.0, 0.5], [0.5, 1.0]]},
+            "initial_center": [0.0, 0.0],
+            "steps": [{"t": 0.0, "nominal": [1.0, 0.0], "det_set": det_set, "r_t": 0.1,
+                       "prs_radius": 1.0}],
+            "also": also,
+        })
+    }
+
+    fn zonotope(generators: serde_json::Value, remainder: serde_json::Value) -> serde_json::Value {
+        json!({"shape": "zonotope", "center": [1.0, 0.0], "radius": 0.9,
+               "hull_lo": [0.5, -0.5], "hull_hi": [1.5, 0.5],
+               "generators": generators, "remainder": remainder})
+    }
+
+    fn check(v: serde_json::Value) -> Result<(), String> {
+        serde_json::from_value::<ResultFile>(v)
+            .map_err(|e| e.to_string())?
+            .check()
+    }
+
+    /// Zonotopes are read with their generators and remainder, as the main sets or a member's;
+    /// generators of the wrong length or not finite (null), a missing or negative remainder,
+    /// and a member on other report times are refused.
+    #[test]
+    fn zonotopes_are_read_and_checked() {
+        let good = zonotope(json!([[0.3, 0.1], [-0.1, 0.4]]), json!(0.05));
+        let ball = json!({"shape": "p_ball", "center": [1.0, 0.0], "radius": 0.5});
+        let r: ResultFile = serde_json::from_value(result(good.clone(), json!([]))).unwrap();
+        r.check().unwrap();
+        let d = &r.steps[0].det_set;
+        assert_eq!(d.shape, Shape::Zonotope);
+        assert_eq!(d.generators, Some(vec![vec![0.3, 0.1], vec![-0.1, 0.4]]));
+        assert_eq!(d.remainder, Some(0.05));
+        check(result(
+            ball.clone(),
+            json!([result(good.clone(), json!([]))]),
+        ))
+        .unwrap();
+        // A member's role, as the engine set it; the result itself has none.
+        let mut member = result(good.clone(), json!([]));
+        member["role"] = json!("first_order");
+        let cut: ResultFile =
+            serde_json::from_value(result(ball.clone(), json!([member]))).unwrap();
+        assert_eq!((cut.role, cut.also[0].role), (Role::Own, Role::FirstOrder));
+        for bad in [
+            zonotope(json!([[0.3, 0.1, 0.0]]), json!(0.05)),
+            zonotope(json!([[0.3, 0.1]]), json!(-1.0)),
+            zonotope(json!([[0.3, 0.1]]), json!(null)),
+        ] {
+            let e = check(result(bad.clone(), json!([]))).unwrap_err();
+            assert!(e.contains("malformed Zonotope set"), "{e}");
+            let e = check(result(ball.clone(), json!([result(bad, json!([]))]))).unwrap_err();
+            assert!(e.contains("member 1 of the intersection: step 0"), "{e}");
+        }
+        // A generator that was not finite (written as null) is not a number.
+        let null = zonotope(json!([[0.3, null]]), json!(0.05));
+        let e = check(result(null, json!([]))).unwrap_err();
+        assert!(e.contains("invalid type: null"), "{e}");
+        let mut later = result(good, json!([]));
+        later["steps"][0]["t"] = json!(1.0);
+        let e = check(result(ball, json!([later]))).unwrap_err();
+        assert!(e.contains("other states or report times"), "{e}");
     }
 }

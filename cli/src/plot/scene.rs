@@ -4,7 +4,7 @@
 //! pixels.
 
 use super::geometry::{clip, Plane, Point, Projected};
-use super::input::{Guarantee, Method, RateSource, ResultFile, Shape, Step};
+use super::input::{Guarantee, Method, RateSource, ResultFile, Role, Shape, Step};
 use super::regions::Region;
 use reachc_runtime::model::{Analysis, ModelInfo};
 use reachc_runtime::report::count;
@@ -131,7 +131,8 @@ pub fn rates_scene(result: &ResultFile) -> Option<RatesScene> {
 /// The deterministic set of a step in the plane.
 fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
     let d = &step.det_set;
-    // ResultFile::read checked the shapes: lo and hi exist for boxes and parallelotopes.
+    // ResultFile::read checked the shapes: lo and hi exist for boxes and parallelotopes, the
+    // generators and the remainder for zonotopes.
     let corners = || {
         (
             d.lo.as_deref().unwrap_or(&[]),
@@ -147,8 +148,19 @@ fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
             let (lo, hi) = corners();
             plane.parallelotope(lo, hi, &t.inverse)
         }
+        (Shape::Zonotope, _) => plane.zonotope(
+            &d.center,
+            d.generators.as_deref().unwrap_or(&[]),
+            d.remainder.unwrap_or(0.0),
+        ),
         _ => plane.p_ball(&d.center, d.radius),
     }
+}
+
+/// Whether a result's own sets are first-order zonotopes (a member of role
+/// [`Role::FirstOrder`]; its set at `t = 0` is the initial box).
+fn zonotopes(result: &ResultFile) -> bool {
+    result.role == Role::FirstOrder
 }
 
 /// The projected PRS `poly` of report step `k` clipped by the projected PRS of each further
@@ -245,6 +257,7 @@ pub fn sets_scene(
     let contraction = result.method == Method::Contraction;
     let [a, b] = plane.states;
     let shape = match result.transform {
+        _ if zonotopes(result) => "zonotope + B_P(remainder)",
         Some(_) => "parallelotope",
         None if contraction => "P-ball",
         None => "box",
@@ -261,10 +274,24 @@ pub fn sets_scene(
         "projections onto the plotted states: exact".into(),
     ];
     if !result.also.is_empty() {
-        let k = 1 + result.also.len();
+        let of = |role: Role| result.also.iter().filter(|m| m.role == role).count();
+        let k = 1 + of(Role::Metric);
+        let mut parts = Vec::new();
+        if k > 1 {
+            parts.push(format!("the sets of {k} metrics, each at δ / {k}"));
+        } else {
+            parts.push("its set".to_string());
+        }
+        if of(Role::Box) > 0 {
+            parts.push("the interval box".to_string());
+        }
+        if of(Role::FirstOrder) > 0 {
+            parts.push("the first-order zonotope + B_P(remainder + r_t)".to_string());
+        }
         notes[1] = format!(
-            "PRS: the intersection of the sets of {k} metrics, each at δ / {k} (dashed: the \
-             first metric's deterministic set); drawn: the intersection of their projections"
+            "PRS: the intersection of {} (dashed: the first deterministic set); drawn: the \
+             intersection of their projections",
+            parts.join(" and ")
         );
     }
     SetsScene {
@@ -361,7 +388,13 @@ pub fn radius_scene(
                 .into(),
         );
     }
-    if !contraction {
+    if zonotopes(result) {
+        notes.push(
+            "first-order sets: the PRS is a zonotope + B_P(remainder + r_t); its P-radius \
+             bounds it coarsely, so the quantile is only indicative"
+                .into(),
+        );
+    } else if !contraction {
         notes.push(
             "interval method: the PRS is a box or parallelotope + B_P(r_t); its P-radius \
              bounds it coarsely, so the quantile is only indicative"
@@ -380,5 +413,152 @@ pub fn radius_scene(
         },
         quantile,
         notes,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::input::{Constants, DetSet};
+    use super::*;
+
+    const P: [[f64; 2]; 2] = [[2.0, 0.5], [0.5, 1.0]];
+    /// `P^-1`.
+    const S: [[f64; 2]; 2] = [[1.0 / 1.75, -0.5 / 1.75], [-0.5 / 1.75, 2.0 / 1.75]];
+    const CENTER: [f64; 2] = [1.0, 0.0];
+    const GENS: [[f64; 2]; 3] = [[0.3, 0.1], [-0.1, 0.4], [0.2, -0.2]];
+
+    /// The zonotope of [`GENS`] around [`CENTER`] plus `B_P(remainder)`.
+    fn zonotope(remainder: f64) -> DetSet {
+        DetSet {
+            shape: Shape::Zonotope,
+            center: CENTER.to_vec(),
+            radius: 2.0,
+            lo: None,
+            hi: None,
+            generators: Some(GENS.iter().map(|g| g.to_vec()).collect()),
+            remainder: Some(remainder),
+        }
+    }
+
+    /// A result in two states with one report time holding `det` and `r_t`, and `also`.
+    fn result(method: Method, det: DetSet, r_t: f64, also: Vec<ResultFile>) -> ResultFile {
+        ResultFile {
+            model: "m".into(),
+            analysis: "a".into(),
+            method,
+            delta: 0.01,
+            guarantee: Guarantee::Uniform,
+            states: vec!["x".into(), "y".into()],
+            outputs: vec![0, 1],
+            constants: Constants {
+                metric: P.iter().map(|r| r.to_vec()).collect(),
+            },
+            transform: None,
+            initial_center: CENTER.to_vec(),
+            rate: None,
+            steps: vec![Step {
+                t: 1.0,
+                nominal: CENTER.to_vec(),
+                det_set: det,
+                r_t,
+                prs_radius: 2.0,
+                c: None,
+                sigma: None,
+            }],
+            also,
+            role: Role::Own,
+        }
+    }
+
+    /// `sqrt(d' P^-1 d)`: the support of `B_P(1)`.
+    fn dual(d: [f64; 2]) -> f64 {
+        (S[0][0] * d[0] * d[0] + 2.0 * S[0][1] * d[0] * d[1] + S[1][1] * d[1] * d[1]).sqrt()
+    }
+
+    /// `c . d + sum_j |g_j . d| + r sqrt(d' P^-1 d)`: the support of the zonotope plus
+    /// `B_P(r)`.
+    fn support(d: [f64; 2], r: f64) -> f64 {
+        let dot = |a: [f64; 2]| a[0] * d[0] + a[1] * d[1];
+        dot(CENTER) + GENS.iter().map(|&g| dot(g).abs()).sum::<f64>() + r * dual(d)
+    }
+
+    /// The largest `d . v` over the polygon's vertices.
+    fn reach(poly: &[Point], d: [f64; 2]) -> f64 {
+        poly.iter()
+            .map(|v| v[0] * d[0] + v[1] * d[1])
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    fn directions() -> impl Iterator<Item = [f64; 2]> {
+        (0..360).map(|k| {
+            let a = std::f64::consts::TAU * (f64::from(k) + 0.29) / 360.0;
+            [a.cos(), a.sin()]
+        })
+    }
+
+    /// A zonotope result: the dashed set is the zonogon plus `B_P(remainder)`, the PRS the
+    /// zonogon plus `B_P(remainder + r_t)`, each polygon's support within the angular
+    /// spacing above the exact one; the legend and the radius figure say what they are.
+    #[test]
+    fn zonotopes_are_drawn_as_zonogons_plus_their_balls() {
+        let (remainder, r_t) = (0.05, 0.1);
+        let mut r = result(Method::Interval, zonotope(remainder), r_t, vec![]);
+        r.role = Role::FirstOrder;
+        let plane = Plane::new([0, 1], &r.constants.metric).unwrap();
+        let scene = sets_scene(&r, &plane, &[0], &[], vec![]);
+        let slice = &scene.slices[0];
+        for d in directions() {
+            let (det, prs) = (support(d, remainder), support(d, remainder + r_t));
+            assert!((det..det + 1e-4 * remainder).contains(&reach(&slice.det, d)));
+            assert!((prs..prs + 1e-4 * (remainder + r_t)).contains(&reach(&slice.prs, d)));
+        }
+        assert!(
+            scene.notes[0].starts_with("PRS (solid) = deterministic zonotope + B_P(remainder)"),
+            "{:?}",
+            scene.notes
+        );
+        let radius = radius_scene(&r, None);
+        assert!(radius
+            .notes
+            .iter()
+            .any(|n| n.starts_with("first-order sets")));
+    }
+
+    /// A P-ball cut by a zonotope member: the drawn PRS lies in both projections, and is the
+    /// zonotope's where that is the smaller (the ball's radius is larger than the zonotope's
+    /// reach in every direction here); the legend names the zonotope.
+    #[test]
+    fn a_zonotope_member_cuts_the_drawn_prs() {
+        let (remainder, r_t) = (0.05, 0.1);
+        let mut member = result(Method::Contraction, zonotope(remainder), r_t, vec![]);
+        member.role = Role::FirstOrder;
+        let ball = DetSet {
+            shape: Shape::PBall,
+            center: CENTER.to_vec(),
+            radius: 1.2,
+            lo: None,
+            hi: None,
+            generators: None,
+            remainder: None,
+        };
+        let r = result(Method::Contraction, ball, r_t, vec![member]);
+        let plane = Plane::new([0, 1], &r.constants.metric).unwrap();
+        let scene = sets_scene(&r, &plane, &[0], &[], vec![]);
+        let prs = &scene.slices[0].prs;
+        for d in directions() {
+            let ball = CENTER[0] * d[0] + CENTER[1] * d[1] + (1.2 + r_t) * dual(d);
+            let zonotope = support(d, remainder + r_t);
+            assert!(zonotope < ball, "{d:?}");
+            let got = reach(prs, d);
+            assert!(
+                (zonotope - 1e-9..zonotope + 1e-4 * (remainder + r_t)).contains(&got),
+                "{d:?}: {got} vs {zonotope}"
+            );
+        }
+        assert!(
+            scene.notes[1].contains("its set and the first-order zonotope"),
+            "{:?}",
+            scene.notes
+        );
     }
 }

@@ -12,7 +12,8 @@
 //! Candidates: the identity, the rate-optimal metric `P_c` of [`super::metric`] and the
 //! geodesic between them (`P_c^a`, `a` in `(0, 1)`), diagonal geometric scalings
 //! `diag(s^(2i))`, then a Nelder-Mead search over `P = R'R` (`R` upper triangular, `R_00 = 1`)
-//! from the best of those for small `n`. The identity is a candidate, so the chosen metric never
+//! from the best of those for small `n`. Candidates whose condition number exceeds
+//! [`MAX_CONDITION`] are not considered. The identity is a candidate, so the chosen metric never
 //! predicts a larger PRS than the identity. The result is normalised to `lambda_min(P) = 1`.
 
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -31,6 +32,15 @@ const SEARCH_EVALS: usize = 300;
 
 /// Up to this many initial-box coordinates `r1` is the maximum over the vertices.
 const VERTEX_MAX: usize = 12;
+
+/// The largest condition number `lambda_max(P) / lambda_min(P)` of a candidate. The predicted
+/// volume is unbounded below along a direction none of the constants sees: a state with a
+/// point start, no noise and no input, whose couplings into the others a heavy weight damps,
+/// lets `P_ii -> infinity` shrink `-ln det(P) / 2` for nothing (the search stops at `e^60`).
+/// Such a metric is flat beyond any use and out of reach of the engine's floating point: the
+/// nominal's defect in that state is weighed by `sqrt(P_ii)`, so no step validates it
+/// (method.md section 8.5).
+const MAX_CONDITION: f64 = 1e4;
 
 /// What a metric is chosen for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,6 +69,9 @@ pub fn metric_for_result(
 ) -> Vec<f64> {
     let n = model.states.len();
     let score = |p: &[f64]| -> f64 {
+        if !conditioned(p, n) {
+            return f64::INFINITY;
+        }
         constants(model, d, p).map_or(f64::INFINITY, |k| predicted(model, spec, p, &k, objective))
     };
     let mut best = (score(&identity(n)), identity(n));
@@ -202,6 +215,23 @@ impl Geodesic {
     }
 }
 
+/// Whether the symmetric `p` is positive definite with a condition number at most
+/// [`MAX_CONDITION`] (from the diagonal when `p` is diagonal, else from its eigenvalues).
+fn conditioned(p: &[f64], n: usize) -> bool {
+    let diagonal = (0..n * n).all(|k| k / n == k % n || p[k] == 0.0);
+    let (lo, hi) = if diagonal {
+        (0..n)
+            .map(|i| p[i * n + i])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+    } else {
+        let e = SymmetricEigen::new(DMatrix::from_row_slice(n, n, p)).eigenvalues;
+        (e.min(), e.max())
+    };
+    lo > 0.0 && hi <= MAX_CONDITION * lo
+}
+
 /// `diag(s^(2i))`: weights falling (or rising) geometrically along the states.
 fn geometric(n: usize, s: f64) -> Vec<f64> {
     let mut p = vec![0.0; n * n];
@@ -311,4 +341,23 @@ fn nelder_mead(x0: &[f64], evals: usize, mut f: impl FnMut(&[f64]) -> f64) -> Ve
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, x)| x)
         .unwrap_or_else(|| x0.to_vec())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_condition_bound_is_exact_for_diagonal_and_full_metrics() {
+        // Diagonal: the ratio of the extreme diagonal entries.
+        assert!(conditioned(&[1.0, 0.0, 0.0, 1e4], 2));
+        assert!(!conditioned(&[1.0, 0.0, 0.0, 1.0001e4], 2));
+        assert!(!conditioned(&[1.0, 0.0, 0.0, 0.0], 2));
+        // [[a, b], [b, a]] has the eigenvalues a - b and a + b: a = 1, b = 0.9998 gives
+        // 1.9998 / 0.0002 = 9999, b = 0.99985 gives 13332.3.
+        assert!(conditioned(&[1.0, 0.9998, 0.9998, 1.0], 2));
+        assert!(!conditioned(&[1.0, 0.99985, 0.99985, 1.0], 2));
+        // Not positive definite.
+        assert!(!conditioned(&[1.0, 2.0, 2.0, 1.0], 2));
+    }
 }

@@ -1611,6 +1611,7 @@ impl InfoWriter {
             Inclusion::Mixed => quote!(Inclusion::Mixed),
         };
         let outputs = indices(&a_spec.outputs);
+        let first_order = a_spec.first_order;
         let transform = option(&a_spec.transform, |t| {
             let (matrix, inverse, frame) = (
                 self.floats(&t.matrix),
@@ -1663,6 +1664,7 @@ impl InfoWriter {
                     guarantee: #guarantee,
                     transform: #transform,
                     outputs: #outputs,
+                    first_order: #first_order,
                 },
                 constants: #constants,
             }

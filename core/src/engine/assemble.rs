@@ -13,8 +13,8 @@ use super::Run;
 use crate::interval::Interval;
 use crate::model::{Guarantee, Inclusion, Method, ModelInfo, RadiusRule, Rate};
 use crate::prs::{
-    ConstantsUsed, DetSet, GaussianUsed, Proved, Prs, R1Bound, RateUsed, RuleUsed, Span, Step,
-    TransformUsed, UniformBound, Unproved, UnsafeVerdict, Validation, Verdict,
+    ConstantsUsed, DetSet, GaussianUsed, Proved, Prs, R1Bound, RateUsed, Role, RuleUsed, Span,
+    Step, TransformUsed, UniformBound, Unproved, UnsafeVerdict, Validation, Verdict,
 };
 
 /// One internal step `[t0, t1]` of the deterministic part.
@@ -43,6 +43,7 @@ pub(super) struct Deterministic {
 }
 
 /// What the result says besides the sets, as the engine determined it.
+#[derive(Clone)]
 pub(super) struct Header {
     pub(super) method: Method,
     pub(super) inclusion: Option<Inclusion>,
@@ -129,6 +130,13 @@ impl Radii {
                     Some((mix, k)) if sum(&mix) < sum(&tube) => (mix, (UniformBound::Mixture, k)),
                     _ => (tube, (UniformBound::AmgfTube, epochs)),
                 };
+                // The time-uniform radius at a report time holds for that time alone too
+                // (method.md 8.2): it bounds the pointwise one, which can overflow where it
+                // does not.
+                let mut pointwise = pointwise;
+                for (pw, &(r, _)) in pointwise.iter_mut().zip(&guaranteed) {
+                    pw.1 = pw.1.min(r);
+                }
                 Radii {
                     guaranteed,
                     pointwise,
@@ -169,15 +177,9 @@ fn amgf_tube(run: &Run, det: &Deterministic) -> (Vec<(f64, f64)>, usize) {
     (guaranteed, tube.epochs())
 }
 
-/// The result of a run: the radii along the internal steps, the PRS at each report time and
-/// over each report interval, the margins over the intervals, and the verdicts.
-pub(super) fn assemble(run: &Run, det: Deterministic, header: Header, local: Option<Found>) -> Prs {
-    let radii = Radii::new(run, &det, header.kappa);
-    assemble_with(run, det, header, local, radii)
-}
-
-/// [`assemble`] with the stochastic radii of another deterministic part of the same run (they
-/// bound the same process, so they hold for any set holding the noise-free solutions).
+/// The result of a run's deterministic part `det` with the stochastic radii `radii` (those of
+/// its own pieces, [`Radii::new`], or of another deterministic part of the same run: they bound
+/// the same process, so they hold for any set holding the noise-free solutions).
 pub(super) fn assemble_with(
     run: &Run,
     det: Deterministic,
@@ -306,6 +308,7 @@ pub(super) fn assemble_with(
         },
         regions: local.map(|found| found.regions).unwrap_or_default(),
         also: Vec::new(),
+        role: Role::Own,
         hints: Vec::new(),
     }
 }
@@ -351,7 +354,7 @@ pub(super) fn span_of(set: &DetSet, r: f64) -> Span {
         Some((lo, hi)) => Span {
             lo: lo.to_vec(),
             hi: hi.to_vec(),
-            radius: r,
+            radius: (Interval::point(set.ball_added()) + Interval::point(r)).hi(),
         },
         None => Span {
             lo: set.center().to_vec(),

@@ -7,17 +7,25 @@ use super::assemble::{
     assemble_with, constants_used, rate_used, Deterministic, Header, Piece, Radii,
 };
 use super::defect::{Nominal, NominalStep};
-use super::intersect::intersect;
+use super::intersect::cut_by;
 use super::radius::expm1_over;
-use super::{interval, local, nominal, r1, radius, rates, Detail, Run, RunError, Setting};
+use super::{
+    first_order, interval, local, nominal, r1, radius, rates, Detail, Run, RunError, Setting,
+};
 use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
-use crate::prs::{DetSet, Proved, Prs, Span, Unproved};
+use crate::prs::{DetSet, Proved, Prs, Role, Span, Unproved};
 
 /// The largest model whose contraction runs also compute the interval box (method.md 8.7):
 /// the embedding evaluates `2 n` faces per step, beyond this it costs far more than the ball.
 pub const MAX_BOX_STATES: usize = 100;
+
+/// The most internal steps the interval box of a contraction run may take per report interval,
+/// on average (method.md 8.7): it is an extra cut of the ball, not worth many times the ball's
+/// own cost. (The shipped specs' boxes take at most 59; boxes of no width driven by `t` take
+/// the embedding's floor of 4096.)
+const BOX_STEPS_PER_REPORT: usize = 256;
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -137,40 +145,36 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     // (method.md section 8.7): both sets hold the noise-free solutions, so the same stochastic
     // radii widen both and the PRS is their intersection at the same delta.
     // (Validated runs only: the box must not add an unproved step.)
+    // (Within BOX_STEPS_PER_REPORT: where the embedding needs far more, the ball alone is the
+    // result.)
     let boxes = (validated && n <= MAX_BOX_STATES)
-        .then(|| interval::deterministic(run, spec.inclusion).ok())
+        .then(|| {
+            let budget = BOX_STEPS_PER_REPORT * grid.len().saturating_sub(1).max(1);
+            interval::deterministic(run, spec.inclusion, budget).ok()
+        })
+        .flatten();
+    // The first-order sets (method.md 8.8), on the same nominal, with the same radii.
+    let first = validated
+        .then(|| {
+            first_order::deterministic(run, &steps, &header.initial_center, &grid, &inputs, r2)
+        })
         .flatten();
     let radii = Radii::new(run, &det, header.kappa);
     let rate = header.rate;
     let rates_proved = header.rigorous[0].clone();
+    let first_header = header.clone();
     let ball = assemble_with(run, det, header, local, radii.clone());
-    let Some((det, mut header)) = boxes else {
-        return Ok(ball);
-    };
-    header.rate = rate;
-    header.rigorous[0] = rates_proved;
-    let boxes = assemble_with(run, det, header, None, radii);
-    Ok(if cuts(&ball, &boxes) {
-        intersect(run.info, &run.setup.checks, spec.delta, ball, vec![boxes])
-    } else {
-        ball
-    })
-}
-
-/// Whether `boxes` makes `ball` smaller somewhere: a tighter bound of a coordinate at a report
-/// time, or a larger safety margin.
-fn cuts(ball: &Prs, boxes: &Prs) -> bool {
-    ball.steps
-        .iter()
-        .zip(&boxes.steps)
-        .enumerate()
-        .any(|(k, (a, b))| {
-            let tighter = match (ball.own_hull_at(k), boxes.own_hull_at(k)) {
-                (Some(x), Some(y)) => x.iter().zip(&y).any(|(x, y)| y.lo > x.lo || y.hi < x.hi),
-                _ => false,
-            };
-            tighter || a.margins.iter().zip(&b.margins).any(|(x, y)| y > x)
-        })
+    let mut members = Vec::new();
+    if let Some((det, mut header)) = boxes {
+        header.rate = rate;
+        header.rigorous[0] = rates_proved;
+        members.push(assemble_with(run, det, header, None, radii.clone()).with_role(Role::Box));
+    }
+    if let Some(det) = first {
+        members
+            .push(assemble_with(run, det, first_header, None, radii).with_role(Role::FirstOrder));
+    }
+    Ok(cut_by(run, ball, members))
 }
 
 /// The pieces along the nominal's steps, `R` following `R' = c R + rho r2 + |d|_P` with the
@@ -221,7 +225,7 @@ fn advance(r: Interval, (c, rho): (f64, f64), r2: f64, defect: f64, h: Interval)
 
 /// The nominal's steps with their report interval: validated internal steps, or one step of
 /// the unvalidated integrator per report step (defect taken as 0, labelled so).
-fn nominal_steps(
+pub(super) fn nominal_steps(
     run: &Run,
     x0: &[f64],
     r1: f64,
@@ -231,18 +235,24 @@ fn nominal_steps(
     let spec = run.spec;
     if spec.integrator == Integrator::Validated {
         let consts = run.setup.consts;
-        // The defect may add about 1% of the PRS's natural size (the initial radius, or the
-        // stochastic radius sqrt(sigma^2 T kappa)) over the horizon.
+        // The defect may add about 1% of the PRS's natural size (the initial radius, the
+        // stochastic radius sqrt(sigma^2 T kappa), or what the input adds, rho r2 T) over the
+        // horizon, or a floor at the nominal's floating point for a spec without any of them
+        // (method.md section 8.4).
         let (kappa, _) = radius::stochastic_factor(run.setup.n, spec);
         let sigma = if consts.sigma.is_finite() {
             consts.sigma
         } else {
             noise_scale(run, x0)
         };
+        // (rho r2 is 0 without inputs or with a known input plan; an unbounded global rho,
+        // left to the local rates, sets no scale.)
+        let input = run.input_radius() * consts.rho * spec.horizon;
         let scale = r1
             .max(sigma * (spec.horizon * kappa).sqrt())
-            .max(1e-9 * x0.iter().fold(1.0f64, |m, v| m.max(v.abs())));
-        let tolerance = 1e-2 * scale / spec.horizon.max(f64::MIN_POSITIVE);
+            .max(if input.is_finite() { input } else { 0.0 });
+        let tolerance =
+            (1e-2 * scale).max(floor(&consts.metric, x0)) / spec.horizon.max(f64::MIN_POSITIVE);
         // Local rates need no domain (the regions follow the tube).
         let domain =
             (run.info.has_domain && spec.rate != Rate::Local).then_some(&run.info.domain[..]);
@@ -278,6 +288,17 @@ fn nominal_steps(
             )
         })
         .collect())
+}
+
+/// The smallest defect integral the nominal is asked for: `1e-9 max(1, |x0|_inf)` in the
+/// heaviest coordinate of the metric `p`, `sqrt(max_i P_ii)` times that (a relative error
+/// of `1e-9` in the state, a thousand times what RK4's cubic can be validated to in double
+/// precision near such steps; without it a spec with no uncertainty asked for `1e-11` and
+/// stopped, the rounding of `p'` growing like `1 / h` as the steps shrank).
+fn floor(p: &[f64], x0: &[f64]) -> f64 {
+    let n = x0.len();
+    let heaviest = (0..n).map(|i| p[i * n + i]).fold(0.0f64, f64::max);
+    1e-9 * x0.iter().fold(1.0f64, |m, v| m.max(v.abs())) * heaviest.sqrt()
 }
 
 /// A noise level for accuracy targets when the compiler could not bound `sigma`:

@@ -31,11 +31,13 @@ pub enum Setting {
     Transform,
     /// `outputs = [...]`.
     Outputs,
+    /// `first_order = on | off`.
+    FirstOrder,
 }
 
 impl Setting {
     /// Every setting, in the order docs/language.md lists them.
-    pub const ALL: [Setting; 12] = [
+    pub const ALL: [Setting; 13] = [
         Setting::Method,
         Setting::Delta,
         Setting::Horizon,
@@ -48,6 +50,7 @@ impl Setting {
         Setting::Guarantee,
         Setting::Transform,
         Setting::Outputs,
+        Setting::FirstOrder,
     ];
 
     /// The setting's key as a spec writes it: `horizon`, `step`, ...
@@ -65,6 +68,7 @@ impl Setting {
             Setting::Guarantee => "guarantee",
             Setting::Transform => "transform",
             Setting::Outputs => "outputs",
+            Setting::FirstOrder => "first_order",
         }
     }
 

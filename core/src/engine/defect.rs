@@ -33,6 +33,8 @@ pub(crate) struct StepBudget {
     hint: &'static str,
     total: usize,
     in_interval: usize,
+    /// The most steps in all ([`MAX_STEPS`] unless [`StepBudget::at_most`] lowers it).
+    limit: usize,
 }
 
 impl StepBudget {
@@ -42,6 +44,15 @@ impl StepBudget {
             hint,
             total: 0,
             in_interval: 0,
+            limit: MAX_STEPS,
+        }
+    }
+
+    /// The same budget with at most `limit` steps in all (never more than [`MAX_STEPS`]).
+    pub(crate) fn at_most(self, limit: usize) -> Self {
+        StepBudget {
+            limit: limit.min(MAX_STEPS),
+            ..self
         }
     }
 
@@ -53,10 +64,11 @@ impl StepBudget {
     /// Takes one step at `t` in the report interval `window`, or says why not.
     pub(crate) fn take(&mut self, t: f64, window: &[f64]) -> Result<(), RunError> {
         let (what, hint) = (self.what, self.hint);
-        if self.total >= MAX_STEPS {
+        if self.total >= self.limit {
             return Err(RunError::NonFinite(
                 Detail::from(format!(
-                    "{what} needs more than {MAX_STEPS} validated steps before t = {} ({hint})",
+                    "{what} needs more than {} validated steps before t = {} ({hint})",
+                    self.limit,
                     time(t)
                 ))
                 .at_setting(Setting::Horizon),

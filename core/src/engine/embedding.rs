@@ -200,6 +200,7 @@ impl<'a> Embedding<'a> {
         grid: &[f64],
         inputs: &[Vec<Interval>],
         accuracy: f64,
+        max_steps: usize,
     ) -> Result<Vec<BoxStep>, RunError> {
         let mut out = Vec::new();
         let (mut lo, mut hi) = (lo.to_vec(), hi.to_vec());
@@ -209,7 +210,8 @@ impl<'a> Embedding<'a> {
             "the embedding system",
             "the other inclusion, a coordinate transform, the contraction method, a smaller \
              report step or a shorter horizon may help",
-        );
+        )
+        .at_most(max_steps);
         for (k, w) in grid.windows(2).enumerate() {
             if self.field.ubox != inputs[k] {
                 self.field.set_inputs(&inputs[k]);
@@ -258,7 +260,7 @@ impl<'a> Embedding<'a> {
             .map(|(a, b)| {
                 let scale = (b - a)
                     .max(1e-3 * wmax)
-                    .max(1e-12 * (1.0 + a.abs().max(b.abs())));
+                    .max(1e-9 * (1.0 + a.abs().max(b.abs())));
                 accuracy * scale
             })
             .collect();
@@ -280,10 +282,18 @@ impl<'a> Embedding<'a> {
                     .fold(0.0f64, f64::max);
                 // It grows about like the square of the step: aim at 0.8 of the allowance.
                 let next = 0.9 / ratio.sqrt();
-                if ratio <= 1.0 || used <= floor {
-                    return Ok((step.into_box(t1, interval), used * next.min(2.0)));
+                if ratio <= 1.0 || used.min(h) <= floor {
+                    // (`h`, the length asked for: a step asked at the floor may land on the
+                    // report time a little beyond it.)
+                    // Accuracy shortens steps down to the floor only: a step the accuracy
+                    // target cannot meet there is kept, and so is the floor for the next one
+                    // (else the steps decay geometrically towards `min_h`; a zero-width
+                    // coordinate driven by `t` keeps the ratio above 1 at every length).
+                    let next_h = (used * next.min(2.0)).max(floor);
+                    return Ok((step.into_box(t1, interval), next_h));
                 }
-                shrink = next.clamp(0.1, 0.5);
+                // Not below the floor for accuracy alone.
+                shrink = next.clamp(0.1, 0.5).max(floor / used);
             }
             h = shrink * used;
             if h < min_h {

@@ -21,8 +21,9 @@ pub(super) fn interval(run: &Run, prs: &Prs) -> Vec<Hint> {
     hints
 }
 
-/// The report time and state where the PRS's bounding box exceeds the P-ball's the most, if by
-/// more than [`WRAPPING_FACTOR`]. The P-ball has the contraction method's radius
+/// The report time and state where the PRS's bounding box (of the intersection with its
+/// members, [`Prs::hull_at`]) exceeds the P-ball's the most, if by more than
+/// [`WRAPPING_FACTOR`]. The P-ball has the contraction method's radius
 /// `R_t = e^(ct) r1 + rho r2 (e^(ct) - 1) / c` plus the result's own `r_t` (both sets carry the
 /// same stochastic part), so only the deterministic parts' growth can tell them apart.
 fn wrapping(prs: &Prs, r2: f64) -> Option<Hint> {
@@ -38,13 +39,16 @@ fn wrapping(prs: &Prs, r2: f64) -> Option<Hint> {
         prs.r1 * ct.exp() + forcing * growth
     };
     let mut worst: Option<(f64, Hint)> = None;
-    for st in prs.steps.iter().skip(1) {
-        let Some((lo, hi)) = st.det.box_hull() else {
+    for (step, st) in prs.steps.iter().enumerate().skip(1) {
+        if st.det.box_hull().is_none() {
+            continue;
+        }
+        let Some(hull) = prs.hull_at(step) else {
             continue;
         };
         let radius = ball(st.t) + st.r_t;
-        for (i, ((&a, &b), &w)) in lo.iter().zip(hi).zip(&k.spread).enumerate() {
-            let half_width = 0.5 * (b - a) + st.r_t * w;
+        for (i, (b, &w)) in hull.iter().zip(&k.spread).enumerate() {
+            let half_width = 0.5 * (b.hi - b.lo);
             let ball_half_width = radius * w;
             // A point initial set without noise has no ball to compare with (a zero or NaN
             // width gives no finite ratio).

@@ -4,6 +4,7 @@
 
 use super::assemble::verdicts;
 use super::safety::Check;
+use super::Run;
 use crate::model::ModelInfo;
 use crate::prs::Prs;
 
@@ -54,4 +55,32 @@ pub(crate) fn intersect(
     first.delta = delta;
     first.also = others;
     first
+}
+
+/// `main` intersected with those of `members` that cut it somewhere (results of the same run
+/// with the same stochastic radii, so at the same delta: method.md 8.7, 8.8); `main` itself
+/// when none does.
+pub(crate) fn cut_by(run: &Run, main: Prs, mut members: Vec<Prs>) -> Prs {
+    members.retain(|m| cuts(&main, m));
+    if members.is_empty() {
+        main
+    } else {
+        intersect(run.info, &run.setup.checks, run.spec.delta, main, members)
+    }
+}
+
+/// Whether `boxes` makes `ball` smaller somewhere: a tighter bound of a coordinate at a report
+/// time, or a larger safety margin.
+fn cuts(ball: &Prs, boxes: &Prs) -> bool {
+    ball.steps
+        .iter()
+        .zip(&boxes.steps)
+        .enumerate()
+        .any(|(k, (a, b))| {
+            let tighter = match (ball.own_hull_at(k), boxes.own_hull_at(k)) {
+                (Some(x), Some(y)) => x.iter().zip(&y).any(|(x, y)| y.lo > x.lo || y.hi < x.hi),
+                _ => false,
+            };
+            tighter || a.margins.iter().zip(&b.margins).any(|(x, y)| y > x)
+        })
 }

@@ -26,19 +26,26 @@
 //! integrated numerically (RK4 or Euler, no remainder bound), so the box is an enclosure only
 //! up to the time-discretisation error. The result says so.
 
-use super::assemble::{assemble, constants_used, rate_used, Deterministic, Header, Piece};
+use super::assemble::{
+    assemble_with, constants_used, rate_used, Deterministic, Header, Piece, Radii,
+};
+use super::defect::MAX_STEPS;
 use super::embedding::{BoxStep, Embedding};
+use super::intersect::cut_by;
 use super::transform::{self, with_buffer, Frame};
-use super::{hints, local, nominal, r1, radius, validate, Detail, Run, RunError, Setting};
+use super::{
+    contraction, first_order, hints, local, nominal, r1, radius, validate, Detail, Run, RunError,
+    Setting,
+};
 use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
-use crate::prs::{DetSet, Proved, Prs, R1Bound, Span, TransformUsed, Unproved};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, Role, Span, TransformUsed, Unproved};
 use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
 pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
-    let (mut det, mut header) = deterministic(run, inclusion)?;
+    let (mut det, mut header) = deterministic(run, inclusion, MAX_STEPS)?;
     // Local rates: certified per step on the box widened by the tube.
     let local = if run.spec.rate == Rate::Local {
         let pieces = &mut det.pieces;
@@ -63,9 +70,32 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
     } else {
         None
     };
-    let mut prs = assemble(run, det, header, local);
+    // The first-order sets on the validated nominal (method.md 8.8), with the same radii.
+    let first = first_order::wanted(run)
+        .then(|| first_order_of(run, header.r1, &header.initial_center))
+        .flatten();
+    let radii = Radii::new(run, &det, header.kappa);
+    let first_header = header.clone();
+    let prs = assemble_with(run, det, header, local, radii.clone());
+    let members = first
+        .map(|det| assemble_with(run, det, first_header, None, radii).with_role(Role::FirstOrder))
+        .into_iter()
+        .collect();
+    // Hints on what the user gets: the intersection (a box that wraps is no news where the
+    // first-order set keeps the result tight).
+    let mut prs = cut_by(run, prs, members);
     prs.hints = hints::interval(run, &prs);
     Ok(prs)
+}
+
+/// The first-order sets of an interval run: the validated nominal from the initial set's
+/// centre `x0` (the contraction method's, `r1` setting its accuracy), then
+/// [`first_order::deterministic`]; `None` where either cannot be computed.
+fn first_order_of(run: &Run, r1: f64, x0: &[f64]) -> Option<Deterministic> {
+    let grid = nominal::time_grid(run.spec.horizon, run.spec.step);
+    let (inputs, r2) = run.nominal_inputs(&grid);
+    let steps = contraction::nominal_steps(run, x0, r1, &grid, &inputs).ok()?;
+    first_order::deterministic(run, &steps, x0, &grid, &inputs, r2)
 }
 
 /// The deterministic part of an interval run (the embedding's boxes on its steps, with the
@@ -73,6 +103,7 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
 pub(super) fn deterministic(
     run: &Run,
     inclusion: Inclusion,
+    max_steps: usize,
 ) -> Result<(Deterministic, Header), RunError> {
     let (spec, consts, n) = (run.spec, run.setup.consts, run.setup.n);
     let metric = &consts.metric;
@@ -91,7 +122,7 @@ pub(super) fn deterministic(
         run.initial,
         &grid,
         &run_inputs(run, &inputs),
-        inclusion,
+        (inclusion, max_steps),
     )?;
     let (r1, r1_bound) = r1::bound(metric, run.initial, &half0);
     let (kappa, radius_rule) = radius::stochastic_factor(n, spec);
@@ -251,7 +282,7 @@ fn boxes(
     initial: &InitialSet,
     grid: &[f64],
     inputs: &[Vec<Interval>],
-    inclusion: Inclusion,
+    (inclusion, max_steps): (Inclusion, usize),
 ) -> Result<Boxes, RunError> {
     let (n, p) = (sys.n(), sys.p());
     validate(info, spec, n, p)?;
@@ -308,6 +339,7 @@ fn boxes(
             grid,
             inputs,
             1e-2 / spec.horizon.max(f64::MIN_POSITIVE),
+            max_steps,
         )?
     } else {
         embedding
@@ -361,7 +393,7 @@ pub fn interval_boxes(
         &info.initial,
         &grid,
         &inputs,
-        spec.inclusion,
+        (spec.inclusion, MAX_STEPS),
     )?;
     let mut out = vec![(0.0, d.start.0, d.start.1)];
     out.extend(

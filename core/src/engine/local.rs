@@ -91,7 +91,7 @@ pub(super) struct Certifier<'a> {
 }
 
 /// Why no rates: the Jacobian entry with the largest magnitude over the region.
-struct Grew {
+pub(super) struct Grew {
     entry: Option<(usize, usize, Interval)>,
 }
 
@@ -196,7 +196,12 @@ impl<'a> Certifier<'a> {
     /// above the global ones.
     ///
     /// `lean`: whether the step may lean on the domain ([`Certifier::may_lean`]).
-    fn rates(&self, x: &[Interval], t: Interval, lean: bool) -> Result<(Rates, bool), Grew> {
+    pub(super) fn rates(
+        &self,
+        x: &[Interval],
+        t: Interval,
+        lean: bool,
+    ) -> Result<(Rates, bool), Grew> {
         let (global, inside) = match &self.global {
             Some((g, domain)) if g.is_finite() => {
                 let inside = domain.as_ref().is_none_or(|d| within(x, d));
@@ -236,7 +241,7 @@ impl<'a> Certifier<'a> {
 
     /// Whether a step whose deterministic hull is `[lo, hi]` may lean on the domain's constants:
     /// what `rate = global` requires of a run (see `lean_start`, `lean_hull`).
-    fn may_lean(&self, lo: &[f64], hi: &[f64], w: &[f64]) -> bool {
+    pub(super) fn may_lean(&self, lo: &[f64], hi: &[f64], w: &[f64]) -> bool {
         let Some((_, Some(domain))) = &self.global else {
             return false;
         };

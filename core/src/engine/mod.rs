@@ -22,6 +22,8 @@ mod contraction;
 mod culprit;
 mod defect;
 mod embedding;
+mod finite;
+mod first_order;
 mod gaussian;
 mod hermite;
 mod hints;
@@ -36,9 +38,11 @@ mod rates;
 mod safety;
 pub(crate) mod transform;
 mod uniform;
+pub(crate) mod zonotope;
 
 pub use contraction::MAX_BOX_STATES;
 pub use culprit::{Culprit, Detail, Setting};
+pub use first_order::MAX_FIRST_ORDER_STATES;
 pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
 pub use r1::MAX_BALL_STATES;
@@ -71,8 +75,9 @@ pub enum RunError {
     /// The analysis or model data is inconsistent (bad delta, step, dimensions, metric...), or
     /// not covered by the certified constants.
     Invalid(Detail),
-    /// The nominal trajectory or the embedding system left the finite numbers, or could not
-    /// be validated.
+    /// A number of the run left the finite numbers (the nominal trajectory, a bound the engine
+    /// needed, or a quantity of the result: the message says which, at which time and, where it
+    /// has one, in which state), or the nominal could not be validated.
     NonFinite(Detail),
 }
 
@@ -276,12 +281,15 @@ pub fn run(sys: &dyn System, info: &ModelInfo, analysis: &Analysis) -> Result<Pr
 
 pub(crate) use intersect::intersect;
 
-/// Runs the engine of the analysis' method.
+/// Runs the engine of the analysis' method; a result with a number that is not finite is a
+/// [`RunError::NonFinite`].
 pub(crate) fn run_engine(run: &Run) -> Result<Prs, RunError> {
-    match run.spec.method {
+    let prs = match run.spec.method {
         Method::Contraction => contraction::run(run),
         Method::Interval => interval::run(run, run.spec.inclusion),
-    }
+    }?;
+    finite::check(&prs)?;
+    Ok(prs)
 }
 
 /// Shortest report step an analysis may have: the integrators subdivide a report step down to

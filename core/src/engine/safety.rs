@@ -1,6 +1,6 @@
 //! Sound safety checks of a PRS `Rbar_t (+) B_P(r_t)` against the spec's unsafe sets, for every
 //! shape of deterministic set: a P-ball `B_P(x*, R)` (the PRS is then `B_P(x*, R + r_t)`), a
-//! box, or a parallelotope.
+//! box, a parallelotope, or a zonotope plus a P-ball.
 //!
 //! "Sound" means one-sided: a check may fail to show safety for a set that is safe, never the
 //! reverse. Everything depending on `P^-1` is enclosed rigorously (interval Cholesky, see
@@ -9,6 +9,7 @@
 
 use super::linalg;
 use super::transform::Frame;
+use super::zonotope;
 use crate::interval::Interval;
 use crate::model::{UnsafeSet, UnsafeShape};
 use crate::prs::{DetSet, Span, UnsafeKind};
@@ -84,6 +85,25 @@ impl Check {
                     _ => None,
                 };
                 box_margin(self, hull_lo, hull_hi, r_t, context.w, support)
+            }
+            // Z (+) B_P(remainder) (+) B_P(r_t): the zonotope's hull and support function, the
+            // two balls as one.
+            DetSet::Zonotope {
+                center,
+                generators,
+                remainder,
+                hull_lo,
+                hull_hi,
+                ..
+            } => {
+                let support = match self {
+                    Check::HalfSpace { normal, .. } => {
+                        Some(zonotope::support(center, generators, normal))
+                    }
+                    _ => None,
+                };
+                let r = (Interval::point(*remainder) + Interval::point(r_t)).hi();
+                box_margin(self, hull_lo, hull_hi, r, context.w, support)
             }
         }
     }

@@ -513,7 +513,7 @@ mod tests {
         version[MAGIC_LEN] = 9;
         assert_eq!(
             read(&version),
-            "part file format version 9; this reachc reads version 1"
+            "part file format version 9; this reachc reads version 2"
         );
         let mut longer = bytes.clone();
         longer.extend_from_slice(&[0; 8]);

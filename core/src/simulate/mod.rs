@@ -31,6 +31,7 @@
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 mod binomial;
+mod dt;
 mod initial;
 mod inputs;
 mod merge;
@@ -49,6 +50,7 @@ mod topk;
 mod workers;
 
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
+pub use dt::{DtSource, DtUsed, MAX_STEPS, RULE as DT_RULE};
 pub use inputs::InputMode;
 pub use merge::{merge, MergeError, Merger};
 pub use part::{Part, PartStats, RunInfo, StepInfo};
@@ -57,7 +59,7 @@ pub use report::{
     Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SimReport, SimStep,
     TubeReport, UnsafeHits,
 };
-pub use sample::{sample_paths, sample_substeps, Substeps, MAX_SAMPLE_PATHS};
+pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
 pub use shard::Shard;
 pub use workers::thread_count;
 
@@ -86,7 +88,8 @@ pub struct Options {
     pub paths: u64,
     /// Random seed: the same seed gives the same report.
     pub seed: u64,
-    /// Largest Euler-Maruyama step (`None`: the analysis' report step).
+    /// Largest Euler-Maruyama step (`None`: chosen per report interval from the drift's
+    /// Jacobian over the analysis' sets, `h L_k <=` [`DT_RULE`], see [`DtUsed`]).
     pub dt: Option<f64>,
     /// How inputs are drawn.
     pub inputs: InputMode,
@@ -245,7 +248,7 @@ fn run_info<S: System + ?Sized>(
         inputs: opts.inputs,
         hold_option: opts.hold,
         confidence: opts.confidence,
-        dt: plan.spans.iter().map(|s| s.h).fold(0.0, f64::max),
+        dt: plan.dt,
         steps_per_path: plan.steps_per_path(),
         initial_states: plan.initial.describe(),
         noise: plan.noise.describe(),
@@ -292,8 +295,7 @@ fn make_plan<'a, S: System + ?Sized>(
             opts.paths
         ));
     }
-    let dt = opts.dt.unwrap_or(result.step);
-    if !(dt > 0.0 && dt.is_finite()) {
+    if let Some(dt) = opts.dt.filter(|dt| !(*dt > 0.0 && dt.is_finite())) {
         return usage(format!("dt = {dt} must be positive and finite"));
     }
     let hold = opts.hold.unwrap_or(result.step);
@@ -335,15 +337,12 @@ fn make_plan<'a, S: System + ?Sized>(
         return invalid(format!("the input box [{}, {}] is not bounded", b.lo, b.hi));
     }
     let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
-    let mut spans = Vec::with_capacity(times.len().saturating_sub(1));
-    for w in times.windows(2) {
-        // The slack keeps a step of exactly dt (up to rounding) from being split in two.
-        let s = ((w[1] - w[0]) / dt * (1.0 - 1e-12)).ceil().max(1.0);
-        if s.is_nan() || s > 1e9 {
-            return usage(format!("dt = {dt} gives too many Euler steps"));
-        }
-        spans.push(Span::new(w[0], w[1], s as u32));
-    }
+    let (steps, dt) = dt::choose(sys, info, result, &times, opts.dt).map_err(SimError::Usage)?;
+    let spans: Vec<Span> = times
+        .windows(2)
+        .zip(steps)
+        .map(|(w, s)| Span::new(w[0], w[1], s))
+        .collect();
     let per_path: u64 = spans.iter().map(|s| u64::from(s.steps)).sum();
     // Draws per Euler step: m normals (about 1% need a second draw), p inputs at most.
     if per_path.saturating_mul(2 * (m + p + 1) as u64) >= rng::DRAWS_PER_PATH {
@@ -374,6 +373,7 @@ fn make_plan<'a, S: System + ?Sized>(
         sys,
         seed: opts.seed,
         spans,
+        dt,
         nominal,
         membership: prs::Membership::new(result, &metric),
         tube,
@@ -615,12 +615,12 @@ mod tests {
     }
 
     /// The paths that first left the tube of `r` in each report interval, recounted from every
-    /// Euler-Maruyama state ([`sample_substeps`]) with `Prs::span_contains` and, at report
+    /// Euler-Maruyama state ([`result_substeps`]) with `Prs::span_contains` and, at report
     /// times, `Prs::contains_at` alone; and how many of those first exits were at a state
     /// between report times.
     fn recount<S: System>(sys: &S, info: &ModelInfo, r: &Prs, opts: &Options) -> (Vec<u64>, u64) {
         let times: Vec<f64> = r.steps.iter().map(|s| s.t).collect();
-        let fine = sample_substeps(sys, info, &times, Some(&r.initial_center), opts).unwrap();
+        let fine = result_substeps(sys, info, r, opts).unwrap();
         let n = r.n();
         let mut left = vec![0; times.len()];
         let mut between = 0;
@@ -664,8 +664,7 @@ mod tests {
             dt: Some(0.001),
             ..Options::default()
         };
-        let times: Vec<f64> = r.steps.iter().map(|s| s.t).collect();
-        let fine = sample_substeps(&sys, &info, &times, Some(&r.initial_center), &opts).unwrap();
+        let fine = result_substeps(&sys, &info, &r, &opts).unwrap();
         assert_eq!(fine.per_interval, vec![10; 50]);
         let k = 20;
         let first = 1 + (k - 1) * 10;
@@ -798,6 +797,64 @@ mod tests {
         assert!(rep.passed() && rep.tube.is_none());
         assert_eq!(rep.verdict.decided_by, Guarantee::Pointwise);
         assert!(rep.steps.iter().all(|s| s.left_tube.is_none()));
+    }
+
+    /// The contraction ball cut by a zonotope member (the interval run's boxes as zonotopes of
+    /// two generators, smaller than the ball, so that paths leave it), checked pointwise, with the
+    /// identity and a skewed metric: the eight-lane, AVX2 and baseline loops give the same
+    /// statistics (every state recorded, and with the quiet bounds), and the paths outside at
+    /// each report time are those `Prs::contains_at` finds outside among the same paths'
+    /// states ([`result_paths`]).
+    #[test]
+    fn a_zonotope_member_is_counted_as_contains_at_decides() {
+        let sorted = |mut s: ChunkStats| {
+            s.candidates
+                .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+            s
+        };
+        for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
+            let (sys, info) = (Sys { b: 0.0 }, info_in(0.0, metric.clone()));
+            let mut r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            r.guarantee = Guarantee::Pointwise;
+            let mut boxes = info.clone();
+            boxes.analyses[0].spec.method = Method::Interval;
+            let b = engine::run(&sys, &boxes, &boxes.analyses[0]).unwrap();
+            r.also = vec![prs::tests::boxes_to_zonotopes(b, prs::tests::SQUARE, 0.2)];
+            let opts = Options {
+                paths: 300,
+                seed: 5,
+                dt: Some(0.004),
+                ..Options::default()
+            };
+            for threshold in [f64::NEG_INFINITY, 0.05] {
+                let mut plan = make_plan(&sys, &info, &r, &opts).unwrap();
+                let thresholds = vec![threshold; plan.times.len()];
+                let detected = sorted(plan.run_chunk(0..300, &thresholds));
+                plan.avx512 = false;
+                let avx2 = sorted(plan.run_chunk(0..300, &thresholds));
+                plan.avx2 = false;
+                let baseline = sorted(plan.run_chunk(0..300, &thresholds));
+                assert_eq!(detected, baseline, "{metric:?}, {threshold}");
+                assert_eq!(avx2, baseline, "{metric:?}, {threshold}");
+            }
+            let rep = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+            let paths = result_paths(&sys, &info, &r, &opts).unwrap();
+            let outside: Vec<u64> = (0..r.steps.len())
+                .map(|k| {
+                    let outside = paths.iter().filter(|p| !r.contains_at(k, &p[k * 2..][..2]));
+                    outside.count() as u64
+                })
+                .collect();
+            let counted: Vec<u64> = rep.steps.iter().map(|s| s.outside).collect();
+            assert_eq!(counted, outside, "{metric:?}");
+            // Not vacuous: the member cuts some paths off, not most.
+            let all: u64 = outside.iter().sum();
+            let states = 300 * r.steps.len() as u64;
+            assert!(
+                all > 30 && all < states / 2,
+                "{metric:?}: {all} of {states}"
+            );
+        }
     }
 
     /// Malformed spans are refused with a message, not a panic.

@@ -2,6 +2,7 @@
 //! and everything the report needs besides them ([`RunInfo`]), so that parts merge into the
 //! report without the system (see `merge.rs`; the file format is in `part_file.rs`).
 
+use super::dt::DtUsed;
 use super::inputs::InputMode;
 use super::paths::ChunkStats;
 use super::report::{InitialSampling, NoiseKind};
@@ -48,7 +49,7 @@ pub struct RunInfo {
     pub paths: u64,
     /// Random seed.
     pub seed: u64,
-    /// The `dt` option (`None`: the analysis' step).
+    /// The `dt` option (`None`: the rule's steps).
     pub dt_option: Option<f64>,
     /// How inputs were drawn.
     pub inputs: InputMode,
@@ -56,8 +57,8 @@ pub struct RunInfo {
     pub hold_option: Option<f64>,
     /// Confidence level of the bounds and the check.
     pub confidence: f64,
-    /// Largest Euler-Maruyama step used.
-    pub dt: f64,
+    /// The Euler-Maruyama steps used and how they compare with the rule.
+    pub dt: DtUsed,
     /// Euler-Maruyama steps per path.
     pub steps_per_path: u64,
     /// How initial states were drawn.

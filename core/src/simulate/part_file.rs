@@ -9,6 +9,7 @@
 //! nothing follows the checksum; a well-formed file can still hold a part [`Part::malformed`]
 //! refuses.
 
+use super::dt::{DtSource, DtUsed};
 use super::inputs::InputMode;
 use super::part::{Part, PartStats, RunInfo, StepInfo};
 use super::report::{InitialSampling, NoiseKind};
@@ -19,7 +20,7 @@ use crate::prs::UnsafeKind;
 /// The first bytes of a part file.
 pub const MAGIC: &[u8] = b"reachc simulate part\n";
 /// The version of the layout this reachc writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// FNV-1a, 64 bits.
 pub(crate) fn checksum(bytes: &[u8]) -> u64 {
@@ -141,6 +142,7 @@ const INITIAL: [InitialSampling; 4] = [
     InitialSampling::Balls,
     InitialSampling::BoxAndBalls,
 ];
+const DT_SOURCES: [DtSource; 2] = [DtSource::Rule, DtSource::Option];
 const UNSAFE: [UnsafeKind; 3] = [UnsafeKind::HalfSpace, UnsafeKind::Box, UnsafeKind::Ball];
 
 /// The code of `v` among `all`.
@@ -249,7 +251,13 @@ fn write_run(w: &mut Writer, run: &RunInfo) {
     w.u8(code_of(&INPUTS, &run.inputs));
     w.opt_f64(run.hold_option);
     w.f64(run.confidence);
-    w.f64(run.dt);
+    let dt = &run.dt;
+    w.u8(code_of(&DT_SOURCES, &dt.source));
+    w.f64(dt.min);
+    w.f64(dt.max);
+    w.f64(dt.rule_min);
+    w.f64(dt.hl_max);
+    w.u64(dt.coarse);
     w.u64(run.steps_per_path);
     w.u8(code_of(&INITIAL, &run.initial_states));
     let (noise, entries) = match run.noise {
@@ -293,7 +301,14 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
         inputs: r.code("inputs", &INPUTS)?,
         hold_option: r.opt_f64()?,
         confidence: r.f64()?,
-        dt: r.f64()?,
+        dt: DtUsed {
+            source: r.code("dt source", &DT_SOURCES)?,
+            min: r.f64()?,
+            max: r.f64()?,
+            rule_min: r.f64()?,
+            hl_max: r.f64()?,
+            coarse: r.u64()?,
+        },
         steps_per_path: r.u64()?,
         initial_states: r.code("initial sampling", &INITIAL)?,
         noise: {

@@ -13,7 +13,7 @@
 //! other models of at most 4 states, inputs and noise channels (the inputs, normals, drift,
 //! diffusion, update, unsafe sets, domain and the PRS shortcuts in lanes, the rest of the
 //! checks and records in the scalar code); and `step_lanes` for everything else.
-//! All compute the same operations in the same order as [`sample_paths`](super::sample_paths),
+//! All compute the same operations in the same order as [`result_paths`](super::result_paths),
 //! so the paths are the same whichever loop runs them.
 //!
 //! For a time-uniform result every loop also checks each path's state after every Euler step
@@ -24,6 +24,7 @@
 //! the loops agree on every decision. A state at a report time outside that time's PRS has
 //! left the tube too (the tube there is that PRS).
 
+use super::dt::DtUsed;
 use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
 use super::noise::Noise;
@@ -82,6 +83,8 @@ pub(crate) struct Plan<'a, S: ?Sized> {
     pub(crate) times: Vec<f64>,
     /// The Euler steps of report interval `k` (index `k - 1`).
     pub(crate) spans: Vec<Span>,
+    /// How the steps were chosen.
+    pub(crate) dt: DtUsed,
     /// `x*_{t_k}`, flat (`n` per step).
     pub(crate) nominal: Vec<f64>,
     pub(crate) metric: Metric,
@@ -472,7 +475,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
 
     /// One Euler-Maruyama step of the block's paths, then (at a report time) their records. A
     /// path draws its inputs, then its `m` normals in channel order (as
-    /// [`sample_paths`](super::sample_paths) does). `DIAG`: `G` is constant and diagonal.
+    /// [`result_paths`](super::result_paths) does). `DIAG`: `G` is constant and diagonal.
     ///
     /// Everything a path does in a step happens in one pass over the lanes, with its state and
     /// stream in registers.

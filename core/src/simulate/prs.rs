@@ -5,14 +5,18 @@
 //! shortcuts answer the clear cases first, each only where it provably agrees with `contains`:
 //!
 //! * outside: `|x - x*_t|_P` clearly above the PRS radius. For the shapes whose PRS lies in the
-//!   P-ball `B_P(x*_t, prs_radius)` (`"p_ball"`, and `"box"` and `"parallelotope"` with `x*_t`
-//!   the centre of the box or of the parallelotope's hull), a point outside that ball is
-//!   outside the PRS;
+//!   P-ball `B_P(x*_t, prs_radius)` (`"p_ball"`, and `"box"`, `"parallelotope"` and
+//!   `"zonotope"` with `x*_t` the centre of the box, of the parallelotope's hull or of the
+//!   zonotope), a point outside that ball is outside the PRS;
 //! * inside: for `"p_ball"`, `|x - x*_t|_P` clearly below the radius; for `"box"`, `x` in the
 //!   box (a subset of the PRS `box (+) B_P(r_t)`); for `"parallelotope"`, `T x` clearly in the
-//!   box `[lo, hi]` of `y = T x` (where `contains` also answers at once); for both, also
-//!   `|x - c|_P` clearly below `r_t` when the deterministic set certainly holds its centre `c`
-//!   (then `B_P(c, r_t)` lies in the PRS, and `contains` asks that ball too).
+//!   box `[lo, hi]` of `y = T x` (where `contains` also answers at once); for `"zonotope"`,
+//!   the bound of `x`'s P-distance to the zonotope by the inverse of a basis of its generators
+//!   (`ZonotopeTest::excess`, `O(n^2)` with a per-step inverse, the first thing `contains`
+//!   asks) at most `remainder + r_t`; for all three, also `|x - c|_P` clearly below the
+//!   radius of the P-ball around the centre `c` that the PRS holds (`r_t` when a box or a
+//!   parallelotope certainly holds `c`, `remainder + r_t` for a zonotope; `contains` asks that
+//!   ball too).
 //!
 //! The shortcuts are also computed for eight states at once in vector lanes
 //! ([`Membership::inside_by_shortcut_x8`]), with the same operations per lane.
@@ -45,9 +49,10 @@
 
 use super::paths::SMALL;
 use crate::engine::interval::ParallelotopeTest;
+use crate::engine::zonotope::ZonotopeTest;
 use crate::interval::Interval;
 use crate::lanes::{Real, X8};
-use crate::prs::{DetSet, Prs};
+use crate::prs::{DetSet, Prepared, Prs};
 
 /// The quadratic form `d' P d` as a list of terms.
 #[derive(Clone, Debug)]
@@ -242,6 +247,13 @@ enum Shape {
         /// The exact test (`Prs::contains_at`'s), built once.
         exact: Box<ParallelotopeTest>,
     },
+    /// `Z_k (+) B_P(remainder + r_t)`: per report step, the test of the zonotope
+    /// (`Prs::contains_at`'s, built once; `None` for a box among them, at `t = 0`) and the
+    /// radius added to it.
+    Zonotope {
+        tests: Vec<Option<ZonotopeTest>>,
+        radius: Vec<f64>,
+    },
     /// Anything else: always ask `contains`.
     Other,
 }
@@ -265,6 +277,31 @@ impl Shape {
             );
         if ball_after_start {
             return Shape::PBall;
+        }
+        // Zonotopes, and boxes among them (the initial box at t = 0).
+        let zonotope = |d: &DetSet| match d {
+            DetSet::Zonotope { center, .. } => center.len() == n,
+            _ => false,
+        };
+        if result.steps.iter().any(|s| zonotope(&s.det))
+            && all(|d| matches!(d, DetSet::Zonotope { .. } | DetSet::Box { .. }))
+        {
+            let p = &result.constants.metric;
+            return Shape::Zonotope {
+                tests: result
+                    .steps
+                    .iter()
+                    .map(|s| match &s.det {
+                        DetSet::Zonotope {
+                            center, generators, ..
+                        } if center.len() == n => Some(ZonotopeTest::new(p, center, generators)),
+                        _ => None,
+                    })
+                    .collect(),
+                radius: (0..result.steps.len())
+                    .map(|k| result.zonotope_radius(k))
+                    .collect(),
+            };
         }
         // Every step's box, flat (`n` per step).
         let (mut lo, mut hi) = (Vec::new(), Vec::new());
@@ -436,9 +473,10 @@ struct OneSet<'a> {
     /// Per step, whether the set is the whole P-ball of the PRS radius (for [`Shape::PBall`]:
     /// else, the initial box at `t = 0`, only "clearly outside" is decided by the ball).
     ball: Vec<bool>,
-    /// Per step, whether a box or a parallelotope certainly holds its centre (then the PRS
-    /// holds the P-ball of radius `r_t` around it); the squared `r_t` and, with a non-negative
-    /// diagonal metric, the "clearly inside" bound of that ball.
+    /// Per step, whether the PRS of a box, a parallelotope or a zonotope certainly holds a
+    /// P-ball around the set's centre ([`Prs::centre_radius`]: `r_t` when a box or a
+    /// parallelotope holds its centre, `remainder + r_t` for a zonotope); that ball's squared
+    /// radius and, with a non-negative diagonal metric, its "clearly inside" bound.
     holds: Vec<bool>,
     rt2: Vec<f64>,
     rt_in: Vec<f64>,
@@ -470,13 +508,16 @@ impl<'a> OneSet<'a> {
             .iter()
             .map(|s| matches!(s.det, DetSet::Ball { .. }))
             .collect();
-        let holds = (0..result.steps.len())
-            .map(|k| {
-                matches!(shape, Shape::Box { .. } | Shape::Parallelotope { .. })
-                    && result.holds_center(k)
+        let centre: Vec<Option<f64>> = (0..result.steps.len())
+            .map(|k| match shape {
+                Shape::Box { .. } | Shape::Parallelotope { .. } | Shape::Zonotope { .. } => {
+                    result.centre_radius(k)
+                }
+                Shape::PBall | Shape::Other => None,
             })
             .collect();
-        let rt2: Vec<f64> = result.steps.iter().map(|s| s.r_t * s.r_t).collect();
+        let holds = centre.iter().map(Option::is_some).collect();
+        let rt2: Vec<f64> = centre.iter().map(|r| r.map_or(0.0, |r| r * r)).collect();
         let rt_in = rt2
             .iter()
             .map(|r| r * (1.0 - eps16) / (1.0 + metric.gamma))
@@ -565,6 +606,10 @@ impl<'a> OneSet<'a> {
             Shape::Parallelotope { t, lo, hi, .. } => {
                 self.in_parallelotope(t, lo, hi, k, x) || self.near_centre_by(metric, k, quad)
             }
+            Shape::Zonotope { tests, radius } => {
+                tests[k].as_ref().is_some_and(|t| t.excess(x) <= radius[k])
+                    || self.near_centre_by(metric, k, quad)
+            }
             Shape::Other => false,
         }
     }
@@ -616,13 +661,21 @@ impl<'a> OneSet<'a> {
                 }
                 mask | self.near_centre_x8(metric, k, mask, quad)
             }
+            Shape::Zonotope { tests, radius } => {
+                // `excess`'s operations, lane by lane.
+                let mask = tests[k].as_ref().map_or(0, |t| {
+                    let (e, r) = (t.excess(&x[..self.n]), radius[k]);
+                    lanes(|l| e.0[l] <= r)
+                });
+                mask | self.near_centre_x8(metric, k, mask, quad)
+            }
             Shape::Other => 0,
         }
     }
 
     /// Whether `(q, a)` (from [`Metric::quad`] around the centre of step `k`) clearly puts
-    /// the state in `B_P(c, r_t)`, which a box's or a parallelotope's PRS holds when its
-    /// deterministic set holds its centre `c` (`Prs::contains_at` asks the same first).
+    /// the state in the P-ball around the centre `c` that the PRS holds (see
+    /// [`OneSet::holds`]; `Prs::contains_at` asks the same ball).
     #[inline(always)]
     fn near_centre(&self, metric: &Metric, k: usize, q: f64, a: f64) -> bool {
         self.holds[k]
@@ -737,7 +790,22 @@ impl<'a> OneSet<'a> {
                 if self.near_centre(metric, k, q, a) {
                     return true;
                 }
-                return self.result.own_contains_at_with(k, x, Some(exact));
+                return self.result.own_contains_at_with(
+                    k,
+                    x,
+                    Some(Prepared::Parallelotope(exact)),
+                );
+            }
+            Shape::Zonotope { tests, .. } => {
+                if clearly_out {
+                    return false;
+                }
+                // The zonotope's own test starts with the shortcut's bound.
+                if self.near_centre(metric, k, q, a) {
+                    return true;
+                }
+                let test = tests[k].as_ref().map(Prepared::Zonotope);
+                return self.result.own_contains_at_with(k, x, test);
             }
             Shape::Other => {}
         }
@@ -1028,9 +1096,10 @@ impl<'a> OneSpan<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::engine;
+    use crate::engine::zonotope;
     use crate::interval::Interval;
     use crate::model::*;
     use crate::prs::TransformUsed;
@@ -1177,6 +1246,68 @@ mod tests {
             };
         }
         r
+    }
+
+    /// Generators of [`zonotope`] in units of the box's half-widths: two (a basis), three (a
+    /// basis among them) and one (a flat zonotope: no basis).
+    pub(in crate::simulate) const SQUARE: &[[f64; 2]] = &[[0.6, 0.3], [-0.3, 0.6]];
+    const THREE: &[[f64; 2]] = &[[0.5, 0.2], [-0.2, 0.5], [0.2, -0.25]];
+    const FLAT: &[[f64; 2]] = &[[0.7, 0.5]];
+
+    /// The interval method's box result with each box replaced by a zonotope around its centre
+    /// (generators `gens` in units of the box's half-widths, so inside the box) plus a
+    /// remainder of `remainder r_t`, with the radii that hold it.
+    fn zonotope(metric: Vec<f64>, gens: &[[f64; 2]], remainder: f64) -> Prs {
+        boxes_to_zonotopes(result(Method::Interval, metric, false), gens, remainder)
+    }
+
+    /// [`zonotope`] of any box result `r` in two states.
+    pub(in crate::simulate) fn boxes_to_zonotopes(
+        mut r: Prs,
+        gens: &[[f64; 2]],
+        remainder: f64,
+    ) -> Prs {
+        let p = r.constants.metric.clone();
+        for st in &mut r.steps {
+            let (lo, hi) = st.det.box_hull().expect("a box");
+            let center: Vec<f64> = (0..2).map(|i| 0.5 * (lo[i] + hi[i])).collect();
+            let half: Vec<f64> = (0..2).map(|i| 0.5 * (hi[i] - lo[i])).collect();
+            let generators: Vec<f64> = gens
+                .iter()
+                .flat_map(|g| [g[0] * half[0], g[1] * half[1]])
+                .collect();
+            let (hull_lo, hull_hi) = zonotope::hull(&center, &generators);
+            let remainder = remainder * st.r_t;
+            let up = |a: f64, b: f64| (Interval::point(a) + Interval::point(b)).hi();
+            let radius = up(zonotope::p_radius(&p, 2, &generators), remainder);
+            st.prs_radius = up(radius, st.r_t);
+            st.det = DetSet::Zonotope {
+                center,
+                generators,
+                remainder,
+                hull_lo,
+                hull_hi,
+                radius,
+            };
+        }
+        r
+    }
+
+    /// Zonotope results for `metric`: [`zonotope`] with each set of generators (the three
+    /// generators' also with the initial box at `t = 0`), and the contraction method's ball cut
+    /// by a zonotope member (an intersection).
+    fn zonotopes(metric: &[f64]) -> Vec<(&'static str, Prs)> {
+        let mut cut = result(Method::Contraction, metric.to_vec(), false);
+        cut.also.push(zonotope(metric.to_vec(), SQUARE, 0.3));
+        let mut boxed = zonotope(metric.to_vec(), THREE, 0.5);
+        boxed.steps[0] = result(Method::Interval, metric.to_vec(), false).steps[0].clone();
+        vec![
+            ("square", zonotope(metric.to_vec(), SQUARE, 0.5)),
+            ("box at t = 0", boxed),
+            ("three", zonotope(metric.to_vec(), THREE, 0.2)),
+            ("flat", zonotope(metric.to_vec(), FLAT, 1.0)),
+            ("member", cut),
+        ]
     }
 
     /// The lanes' shortcut (`inside_by_shortcut_x8`) against the scalar one, state by state:
@@ -1366,12 +1497,23 @@ mod tests {
     }
 
     /// Points at relative P-distances from far inside to far outside, many within rounding of
-    /// the boundary: the shortcuts never disagree with `Prs::contains_at`.
+    /// the boundary: the shortcuts never disagree with `Prs::contains_at`, for every shape
+    /// (the zonotopes of [`zonotopes`] too).
     #[test]
     fn shortcuts_agree_with_contains() {
         let mut rng = PathRng::new(5, 0);
-        for (method, metric, members) in methods_and_metrics() {
-            let r = result(method, metric, members);
+        let zonotopes = [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]]
+            .iter()
+            .flat_map(|metric| zonotopes(metric))
+            .map(|(name, r)| (format!("zonotope {name}"), r))
+            .collect::<Vec<_>>();
+        let cases = methods_and_metrics()
+            .into_iter()
+            .map(|(method, metric, members)| {
+                (format!("{method:?}"), result(method, metric, members))
+            })
+            .chain(zonotopes);
+        for (case, r) in cases {
             let m = Metric::new(&r.constants.metric, 2);
             let mem = Membership::new(&r, &m);
             for (k, st) in r.steps.iter().enumerate() {
@@ -1394,15 +1536,209 @@ mod tests {
                     assert_eq!((q, a), quad_small(&m.upper(), &x, c));
                     let fast = mem.inside(&m, k, &x, c, q, a);
                     let exact = r.contains_at(k, &x);
-                    assert_eq!(fast, exact, "{method:?} k = {k} s = {s}");
+                    assert_eq!(fast, exact, "{case} k = {k} s = {s}");
                     if mem.inside_by_shortcut(&m, k, &x, q, a)
                         || mem.inside_below(k).is_some_and(|b| q < b)
                     {
-                        assert!(exact, "{method:?} k = {k} s = {s}: shortcut");
+                        assert!(exact, "{case} k = {k} s = {s}: shortcut");
                     }
                 }
                 lanes_agree(&mem, &m, k, c, &xs);
             }
+        }
+    }
+
+    /// Points `c + G xi + w` around every zonotope of [`zonotopes`]: `xi` in the cube with one
+    /// coordinate at a face, off by a few ulps to a relative 1e-6 either way or well beyond,
+    /// and `w` of P-norm from 0 to 1.5 times `remainder + r_t`. Every decision (alone, in
+    /// lanes, by the shortcut) agrees with `Prs::contains_at`; the shortcut decides most of the
+    /// states inside, and `contains_at` finds the states built inside (by a relative 1e-9 of
+    /// the radius) inside (at `t = 0`, where the radius is 0, those of the basis'
+    /// parallelotope; the flat zonotope has no basis, and its shortcut is the ball around the
+    /// centre alone).
+    #[test]
+    fn the_zonotope_shortcut_agrees_with_contains() {
+        let mut rng = PathRng::new(9, 0);
+        for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
+            for (name, r) in zonotopes(&metric) {
+                let m = Metric::new(&r.constants.metric, 2);
+                let mem = Membership::new(&r, &m);
+                assert!(mem.has_shortcuts(), "{name}");
+                let z = r.also.first().unwrap_or(&r);
+                let zm = Metric::new(&z.constants.metric, 2);
+                let (mut built_in, mut found_in, mut by_shortcut, mut inside) = (0, 0, 0, 0);
+                for (k, st) in z.steps.iter().enumerate() {
+                    let DetSet::Zonotope {
+                        center,
+                        generators,
+                        remainder,
+                        ..
+                    } = &st.det
+                    else {
+                        // The initial box (shortcuts_agree_with_contains checks it).
+                        continue;
+                    };
+                    let radius = remainder + st.r_t;
+                    let gens: Vec<&[f64]> = generators.chunks(2).collect();
+                    let c = r.steps[k].nominal();
+                    let mut xs = Vec::new();
+                    for i in 0..400 {
+                        let mut xi: Vec<f64> =
+                            gens.iter().map(|_| 2.0 * rng.uniform() - 1.0).collect();
+                        let j = i % gens.len();
+                        let face = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                        let off = [1e-15, 1e-12, 1e-6, 0.3, 0.0][i / 2 % 5];
+                        xi[j] = face * (1.0 + (rng.uniform() - 0.5) * off);
+                        if i % 7 == 0 {
+                            // Inside: away from the faces.
+                            xi[j] = (rng.uniform() - 0.5) * 1.8;
+                        }
+                        let dir = [rng.uniform() - 0.5, rng.uniform() - 0.5];
+                        let (q1, _) = zm.quad(&dir, &[0.0, 0.0]);
+                        let s = 1.5 * rng.uniform();
+                        let w = s * radius / q1.sqrt();
+                        let x: Vec<f64> = (0..2)
+                            .map(|d| {
+                                center[d]
+                                    + gens.iter().zip(&xi).map(|(g, v)| g[d] * v).sum::<f64>()
+                                    + w * dir[d]
+                            })
+                            .collect();
+                        let x = [x[0], x[1]];
+                        xs.push(x);
+                        let (q, a) = m.quad(&x, c);
+                        let exact = r.contains_at(k, &x);
+                        assert_eq!(mem.inside(&m, k, &x, c, q, a), exact, "{name} k = {k}");
+                        if mem.inside_by_shortcut(&m, k, &x, q, a) {
+                            assert!(exact, "{name} k = {k}: shortcut");
+                            by_shortcut += 1;
+                        }
+                        inside += u64::from(exact);
+                        let cube = xi.iter().all(|v| v.abs() <= 1.0 - 1e-9);
+                        // With radius 0 (t = 0) only the basis' parallelotope is certain: a
+                        // point of the zonotope outside it has no certified neighbour.
+                        let certain = radius > 0.0 || gens.len() == 2;
+                        if cube && s < 1.0 - 1e-9 && r.also.is_empty() && certain {
+                            built_in += 1;
+                            found_in += u64::from(exact);
+                        }
+                    }
+                    lanes_agree(&mem, &m, k, c, &xs);
+                }
+                eprintln!(
+                    "{name}: {by_shortcut} by the shortcut, {inside} inside; {found_in} of \
+                     {built_in} built inside found"
+                );
+                assert!(
+                    by_shortcut > inside / 2,
+                    "{name}: {by_shortcut} of {inside}"
+                );
+                if name != "member" {
+                    assert_eq!(found_in, built_in, "{name}");
+                    assert!(built_in > 500, "{name}: {built_in}");
+                }
+            }
+        }
+    }
+    /// A hand-made result in `n` states with a zonotope of `n` random generators (entries up
+    /// to 0.15) at each of `steps` report times, a random metric `A' A + I / 2`, `r_t = 0.05`
+    /// and a remainder of 0.01; and `count` states `c + G xi + w` at random report steps, `xi`
+    /// uniform in the cube and `w` Gaussian scaled to a P-norm of about 0.8 of
+    /// `remainder + r_t` (inside the PRS, most in the shell around the zonotope that its
+    /// shortcut does not decide).
+    fn high_dimensional(n: usize, steps: usize, count: usize) -> (Prs, Vec<(usize, Vec<f64>)>) {
+        let mut rng = PathRng::new(n as u64, 0);
+        let normal = |rng: &mut PathRng| {
+            let (u, v) = (rng.uniform_open0(), rng.uniform());
+            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        let mut r = result(Method::Interval, vec![1.0, 0.0, 0.0, 1.0], false);
+        let a: Vec<f64> = (0..n * n).map(|_| rng.uniform() - 0.5).collect();
+        let p: Vec<f64> = (0..n * n)
+            .map(|v| {
+                let (i, j) = (v / n, v % n);
+                let aa: f64 = (0..n).map(|l| a[l * n + i] * a[l * n + j]).sum();
+                aa + if i == j { 0.5 } else { 0.0 }
+            })
+            .collect();
+        r.states = (0..n).map(|i| format!("x{i}")).collect();
+        r.constants.metric = p.clone();
+        let template = r.steps[1].clone();
+        r.steps = (0..steps)
+            .map(|k| {
+                let center: Vec<f64> = (0..n).map(|_| rng.uniform()).collect();
+                let generators: Vec<f64> =
+                    (0..n * n).map(|_| 0.3 * (rng.uniform() - 0.5)).collect();
+                let (hull_lo, hull_hi) = zonotope::hull(&center, &generators);
+                let (r_t, remainder) = (0.05, 0.01);
+                let up = |a: f64, b: f64| (Interval::point(a) + Interval::point(b)).hi();
+                let radius = up(zonotope::p_radius(&p, n, &generators), remainder);
+                let mut st = template.clone();
+                st.t = k as f64;
+                st.r_t = r_t;
+                st.prs_radius = up(radius, r_t);
+                st.span.lo.clone_from(&hull_lo);
+                st.span.hi.clone_from(&hull_hi);
+                st.det = DetSet::Zonotope {
+                    center,
+                    generators,
+                    remainder,
+                    hull_lo,
+                    hull_hi,
+                    radius,
+                };
+                st
+            })
+            .collect();
+        let m = Metric::new(&p, n);
+        let states = (0..count)
+            .map(|i| {
+                let k = i % steps;
+                let st = &r.steps[k];
+                let gens: Vec<&[f64]> = st.det.generators();
+                let xi: Vec<f64> = (0..n).map(|_| 2.0 * rng.uniform() - 1.0).collect();
+                let w: Vec<f64> = (0..n).map(|_| normal(&mut rng)).collect();
+                let (qw, _) = m.quad(&w, &vec![0.0; n]);
+                let s = 0.8 * (st.det.ball_added() + st.r_t) / qw.sqrt();
+                let x = (0..n)
+                    .map(|d| {
+                        let gx: f64 = gens.iter().zip(&xi).map(|(g, v)| g[d] * v).sum();
+                        st.det.center()[d] + gx + s * w[d]
+                    })
+                    .collect();
+                (k, x)
+            })
+            .collect();
+        (r, states)
+    }
+
+    /// States `x` of [`high_dimensional`] against their step's PRS: `(inside, by the
+    /// shortcut)` counts, each decision asserted equal to `Prs::contains_at`'s.
+    fn decide(r: &Prs, states: &[(usize, Vec<f64>)]) -> (usize, usize) {
+        let m = Metric::new(&r.constants.metric, r.n());
+        let mem = Membership::new(r, &m);
+        let (mut inside, mut by_shortcut) = (0, 0);
+        for (k, x) in states {
+            let c = r.steps[*k].nominal();
+            let (q, a) = m.quad(x, c);
+            let shortcut = mem.inside_by_shortcut(&m, *k, x, q, a);
+            let decided = shortcut || mem.inside(&m, *k, x, c, q, a);
+            assert_eq!(decided, r.contains_at(*k, x), "k = {k}, x = {x:?}");
+            inside += usize::from(decided);
+            by_shortcut += usize::from(shortcut);
+        }
+        (inside, by_shortcut)
+    }
+
+    /// Zonotopes of 2, 6 and 12 states: every state built inside the PRS (by a fifth of the
+    /// ball's radius) is found inside, by the same decisions as `Prs::contains_at`'s.
+    #[test]
+    fn high_dimensional_zonotopes_hold_their_states() {
+        for n in [2, 6, 12] {
+            let (r, states) = high_dimensional(n, 20, 1000);
+            let (inside, by_shortcut) = decide(&r, &states);
+            assert_eq!(inside, states.len(), "n = {n}");
+            assert!(by_shortcut > states.len() / 4, "n = {n}: {by_shortcut}");
         }
     }
 }

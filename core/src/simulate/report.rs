@@ -1,6 +1,7 @@
 //! The result of a Monte Carlo validation, as typed data (renderings: `reachc-runtime`'s
 //! `report`).
 
+use super::dt::DtUsed;
 use super::inputs::InputMode;
 use crate::model::{Guarantee, Method};
 use crate::prs::UnsafeKind;
@@ -24,8 +25,9 @@ pub struct SimReport {
     pub paths: u64,
     /// Random seed.
     pub seed: u64,
-    /// Largest Euler-Maruyama step used (each report interval is split into equal steps).
-    pub dt: f64,
+    /// The Euler-Maruyama steps (each report interval is split into equal steps): the
+    /// smallest and largest, and how they compare with the rule `h L_k <= 0.05`.
+    pub dt: DtUsed,
     /// Euler-Maruyama steps per path.
     pub steps_per_path: u64,
     /// How initial states were drawn.

@@ -1,24 +1,25 @@
 //! A few recorded sample paths, for plots: the Euler-Maruyama paths of [`simulate`](super::simulate)
 //! (same random streams, same initial states, inputs and noise, same steps), with the state
-//! kept at every report time ([`sample_paths`]) or after every Euler-Maruyama step
-//! ([`sample_substeps`]) instead of being reduced to statistics.
+//! kept at every report time ([`result_paths`]; [`sample_paths`] without a result) or after
+//! every Euler-Maruyama step ([`result_substeps`]) instead of being reduced to statistics.
 
 use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
 use super::noise::Noise;
 use super::normal::Ziggurat;
 use super::rng::{PathRng, DRAWS_PER_PATH, MAX_PATHS};
-use super::{Options, SimError};
+use super::{dt, Options, SimError};
 use crate::model::ModelInfo;
+use crate::prs::Prs;
 use crate::system::System;
 
-/// Most paths [`sample_paths`] and [`sample_substeps`] record: they are all kept in memory.
+/// Most paths the functions of this module record: they are all kept in memory.
 pub const MAX_SAMPLE_PATHS: u64 = 100_000;
 
-/// Most state coordinates [`sample_substeps`] records in all (1 GiB).
+/// Most state coordinates [`result_substeps`] records in all (1 GiB).
 const MAX_SUBSTEP_VALUES: u64 = 1 << 27;
 
-/// Sample paths recorded after every Euler-Maruyama step (see [`sample_substeps`]).
+/// Sample paths recorded after every Euler-Maruyama step (see [`result_substeps`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Substeps {
     /// Per report interval `(t_{k-1}, t_k]` (index `k - 1`), its number of Euler-Maruyama
@@ -35,11 +36,11 @@ pub struct Substeps {
 /// `times[k]` is `path[k * n..(k + 1) * n]`. A path whose state became non-finite keeps the
 /// non-finite values.
 ///
-/// Path `p` is path `p` of [`simulate`](super::simulate) with the same options (`opts.seed`,
-/// `opts.inputs`, `opts.dt`, `opts.hold`; `dt` and `hold` default to the largest interval
-/// between report times, which is the analysis' step) when `center` is the result's
-/// `initial_center`: the point where a constant diffusion is evaluated. `None` evaluates it at
-/// path 0's initial state (the same matrix up to rounding). `opts.confidence` and
+/// The paths of [`simulate`](super::simulate)'s random streams (`opts.seed`, `opts.inputs`,
+/// `opts.hold`), with equal Euler-Maruyama steps of at most `opts.dt` (default: the largest
+/// interval between report times; `hold` defaults to it too) and the constant diffusion
+/// evaluated at `center` (`None`: path 0's initial state). Without a result there is no rule
+/// for the step: [`result_paths`] gives the paths `simulate` checks. `opts.confidence` and
 /// `opts.threads` are not used: the paths run on the calling thread.
 pub fn sample_paths<S: System + ?Sized>(
     sys: &S,
@@ -48,31 +49,86 @@ pub fn sample_paths<S: System + ?Sized>(
     center: Option<&[f64]>,
     opts: &Options,
 ) -> Result<Vec<Vec<f64>>, SimError> {
-    record(sys, info, times, center, opts, false).map(|s| s.paths)
+    check_times(times)?;
+    let step = times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    let dt = opts.dt.unwrap_or(step);
+    if times.len() > 1 && !(dt > 0.0 && dt.is_finite()) {
+        return Err(SimError::Usage(format!(
+            "dt = {dt} must be positive and finite"
+        )));
+    }
+    let substeps = times
+        .windows(2)
+        .map(|w| ((w[1] - w[0]) / dt * (1.0 - 1e-12)).ceil().max(1.0))
+        .map(|s| if s <= 1e9 { s as u32 } else { u32::MAX })
+        .collect();
+    record(sys, info, times, center, opts, substeps, false).map(|s| s.paths)
 }
 
-/// [`sample_paths`] with the state kept after every Euler-Maruyama step: what
+/// Path `p` of [`simulate`](super::simulate) of `result` with the same options, recorded at
+/// the result's report times (flat, as [`sample_paths`]): the same random streams, the same
+/// Euler-Maruyama steps (the rule [`DT_RULE`](super::DT_RULE), or `opts.dt`), the constant diffusion
+/// at the result's `initial_center`.
+pub fn result_paths<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+) -> Result<Vec<Vec<f64>>, SimError> {
+    of_result(sys, info, result, opts, false).map(|s| s.paths)
+}
+
+/// [`result_paths`] with the state kept after every Euler-Maruyama step: what
 /// [`simulate`](super::simulate) checks against the tube of a time-uniform result, to be
 /// checked again independently (or plotted between report times). At most
 /// [`MAX_SAMPLE_PATHS`] paths and `2^27` recorded values in all.
-pub fn sample_substeps<S: System + ?Sized>(
+pub fn result_substeps<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
-    times: &[f64],
-    center: Option<&[f64]>,
+    result: &Prs,
     opts: &Options,
 ) -> Result<Substeps, SimError> {
-    record(sys, info, times, center, opts, true)
+    of_result(sys, info, result, opts, true)
 }
 
-/// The paths of [`sample_paths`], with the states of every Euler step (`every_step`) or of the
-/// report times.
+/// The paths of `simulate(result)`, at its report times or after every step (`every_step`).
+fn of_result<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+    every_step: bool,
+) -> Result<Substeps, SimError> {
+    let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
+    check_times(&times)?;
+    let (substeps, _) = dt::choose(sys, info, result, &times, opts.dt).map_err(SimError::Usage)?;
+    let center = Some(&result.initial_center[..]);
+    record(sys, info, &times, center, opts, substeps, every_step)
+}
+
+/// Report times start at 0 and increase.
+fn check_times(times: &[f64]) -> Result<(), SimError> {
+    if times.first() != Some(&0.0)
+        || times
+            .windows(2)
+            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err(SimError::Invalid(
+            "the report times must start at 0 and increase".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The paths over `times`, report interval `k` split into `substeps[k]` equal Euler-Maruyama
+/// steps, with the states of every step (`every_step`) or of the report times.
 fn record<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
     times: &[f64],
     center: Option<&[f64]>,
     opts: &Options,
+    substeps: Vec<u32>,
     every_step: bool,
 ) -> Result<Substeps, SimError> {
     let usage = |m: String| Err(SimError::Usage(m));
@@ -83,22 +139,10 @@ fn record<S: System + ?Sized>(
             opts.paths
         ));
     }
-    if times.first() != Some(&0.0)
-        || times
-            .windows(2)
-            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
-    {
-        return Err(SimError::Invalid(
-            "the report times must start at 0 and increase".into(),
-        ));
-    }
     let step = times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
-    let dt = opts.dt.unwrap_or(step);
     let hold = opts.hold.unwrap_or(step);
-    if times.len() > 1 && !(dt > 0.0 && dt.is_finite() && hold > 0.0 && hold.is_finite()) {
-        return usage(format!(
-            "dt = {dt} and the hold time {hold} must be positive and finite"
-        ));
+    if times.len() > 1 && !(hold > 0.0 && hold.is_finite()) {
+        return usage(format!("the hold time {hold} must be positive and finite"));
     }
     if info.input_box.len() != p
         || info
@@ -110,16 +154,9 @@ fn record<S: System + ?Sized>(
             "the input box must be bounded, one range per input".into(),
         ));
     }
-    // The same split of each report interval as `simulate` (equal steps of at most dt; the
-    // slack keeps a step of exactly dt from being split in two).
-    let substeps: Vec<u32> = times
-        .windows(2)
-        .map(|w| ((w[1] - w[0]) / dt * (1.0 - 1e-12)).ceil().max(1.0))
-        .map(|s| if s <= 1e9 { s as u32 } else { u32::MAX })
-        .collect();
     let per_path: u64 = substeps.iter().map(|&s| u64::from(s)).sum();
     if per_path.saturating_mul(2 * (m + p + 1) as u64) >= DRAWS_PER_PATH {
-        return usage(format!("dt = {dt} gives too many Euler steps"));
+        return usage(format!("{per_path} Euler steps per path are too many"));
     }
     let kept = if every_step {
         per_path + 1

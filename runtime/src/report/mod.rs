@@ -3,11 +3,9 @@
 //! ([`result`]) and of a Monte Carlo [`SimReport`](reachc_core::simulate::SimReport)
 //! ([`simulation`]).
 
-mod finite;
 pub mod result;
 pub mod simulation;
 
-pub use finite::not_finite;
 pub use reachc_core::decimal::time;
 pub use result::{summary, to_json, write_csv};
 

@@ -3,8 +3,8 @@
 use super::{count, csv_field, num, summary_indices, time};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
 use reachc_core::prs::{
-    BallBound, DetSet, Hint, Proved, Prs, R1Method, Step, TransformUsed, UniformBound, Unproved,
-    UnsafeKind, UnsafeVerdict, Verdict,
+    BallBound, DetSet, Hint, Proved, Prs, R1Method, Role, Step, TransformUsed, UniformBound,
+    Unproved, UnsafeKind, UnsafeVerdict, Verdict,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -48,10 +48,13 @@ struct Json<'a> {
     verdict: VerdictJson<'a>,
     validated: ValidationJson,
     hints: Vec<HintJson<'a>>,
-    /// The analysis' further metrics' results, each at `delta / K` (the PRS is the
-    /// intersection: `steps[..].prs_hull_lo/hi` and the verdicts are the intersection's).
+    /// The members of the intersection (the PRS is the intersection:
+    /// `steps[..].prs_hull_lo/hi` and the verdicts are the intersection's).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     also: Vec<Json<'a>>,
+    /// A member's kind (`metric`, `box`, `first_order`); absent for the result itself.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    role: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -163,6 +166,12 @@ struct DetSetJson<'a> {
     hull_lo: Option<&'a [f64]>,
     #[serde(skip_serializing_if = "Option::is_none")]
     hull_hi: Option<&'a [f64]>,
+    /// A zonotope's generators, one array each.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    generators: Option<Vec<&'a [f64]>>,
+    /// A zonotope's remainder (the P-radius of the ball added to it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    remainder: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -276,6 +285,7 @@ impl<'a> Json<'a> {
             },
             hints: prs.hints.iter().map(|h| HintJson::of(prs, h)).collect(),
             also: prs.also.iter().map(Json::of).collect(),
+            role: (prs.role != Role::Own).then(|| prs.role.name()),
         }
     }
 }
@@ -320,28 +330,19 @@ impl<'a> StepJson<'a> {
             .into_iter()
             .map(|b| (b.lo, b.hi))
             .unzip();
-        let (shape, lo, hi, hull_lo, hull_hi) = match &st.det {
-            DetSet::Ball { .. } => ("p_ball", None, None, None, None),
-            DetSet::Box { lo, hi, .. } => ("box", Some(&lo[..]), Some(&hi[..]), None, None),
-            DetSet::Parallelotope {
-                lo,
-                hi,
-                hull_lo,
-                hull_hi,
-                ..
-            } => (
-                "parallelotope",
-                Some(&lo[..]),
-                Some(&hi[..]),
-                Some(&hull_lo[..]),
-                Some(&hull_hi[..]),
-            ),
-        };
+        let (lo, hi) = st.det.corners().unzip();
+        // A box is its own hull.
+        let (hull_lo, hull_hi) = match st.det {
+            DetSet::Box { .. } => None,
+            _ => st.det.box_hull(),
+        }
+        .unzip();
+        let zonotope = matches!(st.det, DetSet::Zonotope { .. });
         StepJson {
             t: st.t,
             nominal: st.nominal(),
             det_set: DetSetJson {
-                shape,
+                shape: st.det.shape(),
                 center: st.det.center(),
                 radius: st.det.radius(),
                 metric: "constants.metric",
@@ -349,6 +350,8 @@ impl<'a> StepJson<'a> {
                 hi,
                 hull_lo,
                 hull_hi,
+                generators: zonotope.then(|| st.det.generators()),
+                remainder: zonotope.then(|| st.det.ball_added()),
             },
             r_t: st.r_t,
             r_pointwise: st.r_pointwise,
@@ -591,14 +594,23 @@ fn shown_states(prs: &Prs) -> Vec<usize> {
     }
 }
 
+/// Whether a result's own sets are first-order zonotopes (a member of role
+/// [`Role::FirstOrder`]; its set at `t = 0` is the initial box).
+fn zonotopes(prs: &Prs) -> bool {
+    prs.role == Role::FirstOrder
+}
+
 /// CSV with header `t,<output state names...>,det_radius,r_t,psi,c,sigma,prs_radius` and one
 /// row per report time (the nominal state in the state columns). For the interval method (box
 /// sets) the header is `t,<state>_lo,<state>_hi,...,r_t,psi` instead; with a coordinate
 /// transform, `t,y1_lo,y1_hi,...,yn_lo,yn_hi,<state>_lo,<state>_hi,...,r_t,psi` (the box in
-/// `y = T x`, then the parallelotope's interval hull in the output states).
+/// `y = T x`, then the parallelotope's interval hull in the output states). For first-order
+/// zonotopes, `t,<state>_lo,<state>_hi,...,remainder,r_t,psi`: the zonotope's interval hull and
+/// the P-radius of the ball added to it (the PRS is `Z (+) B_P(remainder + r_t)`).
 pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
     let shown = shown_states(prs);
-    if prs.method == Method::Interval {
+    let zonotopes = zonotopes(prs);
+    if prs.method == Method::Interval || zonotopes {
         let mut header = String::from("t");
         if let Some(first) = prs.steps.first() {
             for (label, _, _) in box_columns(prs, first) {
@@ -610,12 +622,18 @@ pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
                 );
             }
         }
+        if zonotopes {
+            header.push_str(",remainder");
+        }
         header.push_str(",r_t,psi");
         writeln!(w, "{header}")?;
         for s in &prs.steps {
             let mut row = format!("{}", s.t);
             for (_, a, b) in box_columns(prs, s) {
                 let _ = write!(row, ",{a},{b}");
+            }
+            if zonotopes {
+                let _ = write!(row, ",{}", s.det.ball_added());
             }
             let _ = write!(row, ",{},{}", s.r_t, s.psi);
             writeln!(w, "{row}")?;
@@ -686,7 +704,12 @@ fn box_columns(prs: &Prs, st: &Step) -> Vec<(String, f64, f64)> {
             ys.chain(shown.map(|i| (prs.states[i].clone(), at(hull_lo, i), at(hull_hi, i))))
                 .collect()
         }
-        DetSet::Box { lo, hi, .. } => shown
+        DetSet::Box { lo, hi, .. }
+        | DetSet::Zonotope {
+            hull_lo: lo,
+            hull_hi: hi,
+            ..
+        } => shown
             .map(|i| (prs.states[i].clone(), at(lo, i), at(hi, i)))
             .collect(),
         DetSet::Ball { .. } => Vec::new(),
@@ -791,7 +814,15 @@ pub fn summary(prs: &Prs) -> String {
         prs.kappa
     );
     summary_metrics(prs, &mut s);
-    if prs.method == Method::Interval {
+    if zonotopes(prs) {
+        let _ = writeln!(
+            s,
+            "  deterministic sets: first-order zonotopes (the initial box under the flow's \
+             linearisation along the nominal) plus a P-ball bounding the linearisation's \
+             remainder; PRS = zonotope (+) B_P(remainder + r_t); columns: the zonotope's hull"
+        );
+        box_table(prs, &mut s);
+    } else if prs.method == Method::Interval {
         summary_boxes(prs, &mut s);
     } else {
         let _ = writeln!(s, "  r1 = {:.6} ({}), r2 = {}", prs.r1, r1_how(prs), prs.r2);
@@ -973,12 +1004,10 @@ fn guarantee_sentence(prs: &Prs) -> String {
     }
 }
 
-/// The table of the summary for box sets: per column of [`box_columns`] the range `[lo, hi]`,
-/// and `r_t`.
-/// The number of metrics of a result: its own and those of its members of the same method
-/// (the others are the interval boxes a contraction run is cut by, at the same delta).
+/// The number of metrics of a result: its own and its members that are further metrics (the
+/// others are the interval boxes and first-order zonotopes it is cut by).
 fn metrics(prs: &Prs) -> usize {
-    1 + prs.also.iter().filter(|m| m.method == prs.method).count()
+    1 + prs.also.iter().filter(|m| m.role == Role::Metric).count()
 }
 
 /// The further metrics of an intersection result, and its bounding boxes.
@@ -996,7 +1025,7 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             prs.delta / k as f64
         );
     }
-    let boxes = prs.also.len() + 1 - k;
+    let boxes = prs.also.iter().filter(|m| m.role == Role::Box).count();
     if boxes > 0 {
         let _ = writeln!(
             s,
@@ -1006,10 +1035,26 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             if boxes == 1 { "" } else { "es" }
         );
     }
+    for m in prs.also.iter().filter(|m| m.role == Role::FirstOrder) {
+        let last = m.steps.last();
+        let _ = writeln!(
+            s,
+            "  cut by the first-order zonotope: the PRS also lies in Z_t (+) B_P(remainder_t + \
+             r_t), Z_t the initial box under the flow's linearisation along the nominal \
+             ({}), the remainder bounding the linearisation's error ({} at the horizon; P-radius \
+             of the set {}); the boxes, margins and verdicts below are the intersection's",
+            count(
+                last.map_or(0, |st| st.det.generators().len()) as u64,
+                "generator"
+            ),
+            num(last.map_or(f64::NAN, |st| st.det.ball_added())),
+            num(last.map_or(f64::NAN, |st| st.det.radius()))
+        );
+    }
     for (j, m) in prs
         .also
         .iter()
-        .filter(|m| m.method == prs.method)
+        .filter(|m| m.role == Role::Metric)
         .enumerate()
     {
         let n = m.n().max(1);
@@ -1048,6 +1093,8 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
     }
 }
 
+/// The deterministic sets of an interval result (boxes or parallelotopes) in words, and their
+/// table.
 fn summary_boxes(prs: &Prs, s: &mut String) {
     let inclusion = prs.inclusion.map_or("?", |i| i.name());
     match &prs.transform {
@@ -1071,12 +1118,22 @@ fn summary_boxes(prs: &Prs, s: &mut String) {
             );
         }
     }
+    box_table(prs, s);
+}
+
+/// The table of the summary for sets with a box hull: per column of [`box_columns`] the range
+/// `[lo, hi]`, the remainder of first-order zonotopes, and `r_t`.
+fn box_table(prs: &Prs, s: &mut String) {
     let Some(first) = prs.steps.first() else {
         return;
     };
+    let zonotopes = zonotopes(prs);
     let mut head = format!("  {:>10}", "t");
     for (label, _, _) in box_columns(prs, first) {
         let _ = write!(head, "  {:>27}", format!("{label} [lo, hi]"));
+    }
+    if zonotopes {
+        let _ = write!(head, "  {:>12}", "remainder");
     }
     let _ = write!(head, "  {:>12}", "r_t");
     let _ = writeln!(s, "{head}");
@@ -1085,6 +1142,9 @@ fn summary_boxes(prs: &Prs, s: &mut String) {
         let mut row = format!("  {:>10.4}", st.t);
         for (_, a, b) in box_columns(prs, st) {
             let _ = write!(row, "  [{a:>12.6}, {b:>12.6}]");
+        }
+        if zonotopes {
+            let _ = write!(row, "  {:>12.6}", st.det.ball_added());
         }
         let _ = write!(row, "  {:>12.6}", st.r_t);
         let _ = writeln!(s, "{row}");

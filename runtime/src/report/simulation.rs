@@ -4,7 +4,9 @@
 use super::result::unsafe_kind;
 use super::{count, summary_indices, time};
 use reachc_core::model::Guarantee;
-use reachc_core::simulate::{InitialSampling, InputMode, NoiseKind, SimReport};
+use reachc_core::simulate::{
+    DtSource, DtUsed, InitialSampling, InputMode, NoiseKind, SimReport, DT_RULE, MAX_STEPS,
+};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -25,6 +27,8 @@ struct Json<'a> {
     paths: u64,
     seed: u64,
     dt: f64,
+    dt_min: f64,
+    dt_rule: DtRuleJson,
     steps_per_path: u64,
     initial_states: &'static str,
     inputs: InputsJson,
@@ -39,6 +43,22 @@ struct Json<'a> {
     left_domain: Option<u64>,
     diverged: u64,
     verdict: CoverageJson,
+}
+
+/// How the Euler-Maruyama steps compare with the rule `h L_k <= 0.05`.
+#[derive(Serialize)]
+struct DtRuleJson {
+    /// `rule` (chosen by it) or `option` (`--dt`).
+    source: &'static str,
+    /// `met`, `capped` (the rule's cap of steps per report interval bound) or `coarser` (the
+    /// `--dt` is coarser than the rule asks).
+    status: &'static str,
+    bound: f64,
+    hl_max: f64,
+    rule_min: f64,
+    coarse_intervals: u64,
+    max_steps: u32,
+    warning: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -136,7 +156,18 @@ impl<'a> Json<'a> {
             guarantee: r.guarantee.name(),
             paths: r.paths,
             seed: r.seed,
-            dt: r.dt,
+            dt: r.dt.max,
+            dt_min: r.dt.min,
+            dt_rule: DtRuleJson {
+                source: r.dt.source.name(),
+                status: dt_status(&r.dt),
+                bound: DT_RULE,
+                hl_max: r.dt.hl_max,
+                rule_min: r.dt.rule_min,
+                coarse_intervals: r.dt.coarse,
+                max_steps: MAX_STEPS,
+                warning: dt_warning(&r.dt),
+            },
             steps_per_path: r.steps_per_path,
             initial_states: initial_states(r.initial_states),
             inputs: InputsJson {
@@ -205,6 +236,56 @@ impl<'a> Json<'a> {
     }
 }
 
+/// `met`, `capped` or `coarser`.
+fn dt_status(dt: &DtUsed) -> &'static str {
+    match (dt.meets_rule(), dt.source) {
+        (true, _) => "met",
+        (false, DtSource::Rule) => "capped",
+        (false, DtSource::Option) => "coarser",
+    }
+}
+
+/// The steps used, in words: one `dt`, or the smallest and largest.
+fn dt_range(dt: &DtUsed) -> String {
+    // Equal steps on intervals of equal width differ in their last digits only.
+    let (min, max) = (time(dt.min), time(dt.max));
+    if min == max {
+        format!("dt = {max}")
+    } else {
+        format!("dt = {min} to {max}")
+    }
+}
+
+/// A warning when some Euler-Maruyama steps are coarser than the rule `h L_k <= 0.05` asks
+/// (the check may then test the integrator's error, not the PRS); `None` when they all meet it.
+pub fn dt_warning(dt: &DtUsed) -> Option<String> {
+    let hl = if dt.hl_max.is_finite() {
+        format!("h L up to {:.3}", dt.hl_max)
+    } else {
+        "no finite bound L of the drift's Jacobian over the sets".to_string()
+    };
+    match (dt.meets_rule(), dt.source) {
+        (true, _) => None,
+        (false, DtSource::Rule) => Some(format!(
+            "the Euler-Maruyama step is capped at {MAX_STEPS} steps per report interval on {}, \
+             coarser than the rule h L <= {DT_RULE} asks ({hl}): Euler-Maruyama's own error may \
+             show as paths outside; a smaller --dt checks more finely",
+            count(dt.coarse, "report interval")
+        )),
+        (false, DtSource::Option) => Some(format!(
+            "--dt {} is coarser than the rule h L <= {DT_RULE} asks on {} ({hl}{}): \
+             Euler-Maruyama's own error may show as paths outside",
+            time(dt.max),
+            count(dt.coarse, "report interval"),
+            if dt.rule_min > 0.0 {
+                format!("; the rule's step: {}", time(dt.rule_min))
+            } else {
+                String::new()
+            }
+        )),
+    }
+}
+
 /// How the initial states were drawn, in words.
 fn initial_states(s: InitialSampling) -> &'static str {
     match s {
@@ -261,12 +342,19 @@ pub fn summary(r: &SimReport) -> String {
     // dt is a quotient (step / substeps): show it without its last-digit noise.
     let _ = writeln!(
         s,
-        "  {} (seed {}), Euler-Maruyama with dt = {} ({} per path)",
+        "  {} (seed {}), Euler-Maruyama with {} ({} per path; {})",
         count(r.paths, "path"),
         r.seed,
-        time(r.dt),
-        count(r.steps_per_path, "step")
+        dt_range(&r.dt),
+        count(r.steps_per_path, "step"),
+        match r.dt.source {
+            DtSource::Rule => format!("chosen by the rule h L <= {DT_RULE}"),
+            DtSource::Option => "--dt".to_string(),
+        }
     );
+    if let Some(w) = dt_warning(&r.dt) {
+        let _ = writeln!(s, "  warning: {w}");
+    }
     let _ = writeln!(s, "  initial states: {}", initial_states(r.initial_states));
     let _ = writeln!(s, "  inputs: {}", inputs(r));
     let _ = writeln!(s, "  noise: {}", noise(r.noise));

@@ -48,6 +48,7 @@ const KEYS: &[&str] = &[
     "guarantee",
     "transform",
     "outputs",
+    "first_order",
 ];
 
 impl Checker<'_> {
@@ -96,6 +97,7 @@ impl Checker<'_> {
             ],
             Guarantee::Uniform,
         );
+        let first_order = self.choice(&f, "first_order", &[("on", true), ("off", false)], true);
         let delta = self.number(&f, "delta", 1e-3, |d| {
             (d > 0.0 && d < 1.0)
                 .then_some(())
@@ -177,8 +179,14 @@ impl Checker<'_> {
         else {
             return;
         };
-        let (Some(metric), Some(radius), Some(rate), Some(transform), Some(outputs)) =
-            (metric, radius, rate, transform, outputs)
+        let (
+            Some(metric),
+            Some(radius),
+            Some(rate),
+            Some(transform),
+            Some(outputs),
+            Some(first_order),
+        ) = (metric, radius, rate, transform, outputs, first_order)
         else {
             return;
         };
@@ -282,6 +290,7 @@ impl Checker<'_> {
                 guarantee,
                 transform,
                 outputs,
+                first_order,
             },
             span,
             name_span: name.span.clone(),

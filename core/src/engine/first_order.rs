@@ -1,0 +1,302 @@
+//! First-order deterministic sets (method.md 8.8): the initial box's image under the flow's
+//! linearisation along the validated nominal, a zonotope, plus a P-ball bounding everything
+//! the linearisation leaves out.
+//!
+//! With the validated nominal `p` (a cubic per step, defect `d = p' - f(p, u*)` bounded in the
+//! P-norm) and a matrix curve `M` (`M(0) = I`), every noise-free solution from `x0 + xi` (`xi`
+//! in the initial box minus its centre) under inputs in the box is compared with
+//! `y = p + M xi`. On a step, `M(s) = exp(A (s - t_k)) M_k` with a point matrix `A` (the
+//! Jacobian at the step's middle), so `M' = A M` exactly, and
+//!
+//! ```text
+//! y' - f(y, u) = d + (A - J) M xi - (f(y, u) - f(y, u*)),   J in [D_x f](H)
+//! ```
+//!
+//! (`H` the box holding `p + M xi` over the step), whose P-norm is at most
+//! `|d|_P + |(A - [J](H)) [M] Xi|_P + rho r2`: second order in the box's size, since
+//! `[J](H) - A` shrinks with it. With `c` certified on a region holding `y` and the solution
+//! (H widened by the a-priori remainder), `e = x - y` obeys `D+ |e|_P <= c |e|_P + forcing`,
+//! the remainder ODE of the contraction method. Each node replaces `exp(A h) M_k` by its
+//! floating-point midpoint `M_(k+1)`; the jump `(exp(A h) M_k - M_(k+1)) xi` is added to the
+//! remainder there.
+
+use super::assemble::{Deterministic, Piece};
+use super::defect::NominalStep;
+use super::linalg::{product, to_intervals};
+use super::local::Certifier;
+use super::radius::{expm1_over, BoxRadius};
+use super::{zonotope, Run};
+use crate::interval::Interval;
+use crate::model::Integrator;
+use crate::prs::{DetSet, Span};
+
+/// Terms of the Taylor series of `exp(A tau)` before the remainder bound.
+const TAYLOR_TERMS: usize = 12;
+
+/// Attempts per step to find an a-priori remainder that holds its own bound.
+const MAX_TRIES: usize = 12;
+
+/// The largest model that gets first-order sets: each step multiplies `n x n` interval
+/// matrices (`2 * TAYLOR_TERMS + 2` products, `n^3` each), which beyond this costs far more
+/// than the rest of the run (the 1000-state chain would take hours).
+pub const MAX_FIRST_ORDER_STATES: usize = 32;
+
+/// Whether `run` gets first-order sets: asked for (`first_order = on`, the default), a
+/// validated run, a box initial set, at most [`MAX_FIRST_ORDER_STATES`] states.
+pub(super) fn wanted(run: &Run) -> bool {
+    run.spec.first_order
+        && run.spec.integrator == Integrator::Validated
+        && run.initial.balls.is_empty()
+        && run.setup.n <= MAX_FIRST_ORDER_STATES
+}
+
+/// The first-order sets of a run on the validated nominal's `steps` (each with its report
+/// interval), from the initial box `[x0 - half, x0 + half]`, inputs `inputs[k]` held by the
+/// nominal on report interval `k` and `r2` the input uncertainty; `None` when the run is not
+/// [`wanted`] or a step cannot be bounded (the result then goes without these sets).
+pub(super) fn deterministic(
+    run: &Run,
+    steps: &[(NominalStep, usize)],
+    x0: &[f64],
+    grid: &[f64],
+    inputs: &[Vec<f64>],
+    r2: f64,
+) -> Option<Deterministic> {
+    if !wanted(run) {
+        return None;
+    }
+    let n = run.setup.n;
+    let sys = run.sys;
+    let metric = &run.setup.consts.metric;
+    let cert = Certifier::new(run).ok()?;
+    let norm = BoxRadius::new(metric, n);
+    let w: Vec<f64> = run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect();
+    // Generator j of the initial box: h_j e_j, h_j >= |x - x0_j| over the box.
+    let bounds = run.initial.bounding_box().ok()?;
+    let h: Vec<f64> = bounds
+        .iter()
+        .zip(x0)
+        .map(|(b, &c)| {
+            let c = Interval::point(c);
+            (Interval::point(b.hi) - c)
+                .hi()
+                .max((c - Interval::point(b.lo)).hi())
+        })
+        .collect();
+    let xi: Vec<Interval> = h.iter().map(|&v| Interval::new(-v, v)).collect();
+    let zonotope_at = |center: &[f64], m: &[f64], remainder: f64| {
+        // g_j = M_(., j) h_j.
+        let h = &h;
+        let gens: Vec<f64> = (0..n)
+            .flat_map(|j| (0..n).map(move |i| m[i * n + j] * h[j]))
+            .collect();
+        let (hull_lo, hull_hi) = zonotope::hull(center, &gens);
+        let radius = (Interval::point(zonotope::p_radius(metric, n, &gens))
+            + Interval::point(remainder))
+        .hi();
+        DetSet::Zonotope {
+            center: center.to_vec(),
+            generators: gens,
+            remainder,
+            hull_lo,
+            hull_hi,
+            radius,
+        }
+    };
+    let mut m: Vec<f64> = (0..n * n)
+        .map(|k| if k / n == k % n { 1.0 } else { 0.0 })
+        .collect();
+    // At t = 0 the initial box itself (the zonotope with M = I, as a box: exact membership).
+    let start = DetSet::Box {
+        lo: bounds.iter().map(|b| b.lo).collect(),
+        hi: bounds.iter().map(|b| b.hi).collect(),
+        center: x0.to_vec(),
+        radius: zonotope_at(x0, &m, 0.0).radius(),
+    };
+    let mut rho = Interval::ZERO;
+    let mut x = x0.to_vec();
+    let mut t0 = 0.0;
+    // The remainder's growth over the previous step: the next step's first guess.
+    let mut grew = 0.0f64;
+    let mut pieces = Vec::with_capacity(steps.len());
+    let mut jac = vec![Interval::ZERO; n * n];
+    for (step, k) in steps {
+        let (t1, u) = (step.t1, &inputs[*k]);
+        let span = Interval::point(t1) - Interval::point(t0);
+        let times = Interval::new(t0, t1);
+        // A: the Jacobian at the middle of the step's nodes.
+        let mid: Vec<f64> = x.iter().zip(&step.x1).map(|(a, b)| 0.5 * (a + b)).collect();
+        let mut a = vec![0.0; n * n];
+        sys.jac_x(&mid, u, 0.5 * (t0 + t1), &mut a);
+        let exp_h = exp_enclosure(&a, n, span)?;
+        let exp_over = exp_enclosure(&a, n, Interval::new(0.0, span.hi()))?;
+        let mi = to_intervals(&m);
+        let next = product(&exp_h, &mi, n, n, n);
+        let m_over = product(&exp_over, &mi, n, n, n);
+        // V = [M] Xi over the step, and H = p([t0, t1]) + V.
+        let v: Vec<Interval> = (0..n)
+            .map(|i| (0..n).fold(Interval::ZERO, |acc, j| acc + m_over[i * n + j] * xi[j]))
+            .collect();
+        let hbox: Vec<Interval> = (0..n)
+            .map(|i| Interval::new(step.lo[i], step.hi[i]) + v[i])
+            .collect();
+        let ui: Vec<Interval> = u.iter().map(|&x| Interval::point(x)).collect();
+        sys.jac_x_interval(&hbox, &ui, times, &mut jac);
+        // |(A - [J](H)) V|_P.
+        let lin: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .fold(Interval::ZERO, |acc, j| {
+                        acc + (Interval::point(a[i * n + j]) - jac[i * n + j]) * v[j]
+                    })
+                    .mag()
+            })
+            .collect();
+        let forcing = Interval::point(step.defect) + Interval::point(norm.bound(&lin));
+        // The remainder over the step, on a region that must hold it (a-priori guess `cap`).
+        let mut cap = 1.25 * (rho.hi() + grew) + f64::MIN_POSITIVE;
+        let mut accepted = None;
+        for _ in 0..MAX_TRIES {
+            let region: Vec<Interval> = hbox
+                .iter()
+                .zip(&w)
+                .map(|(b, &wi)| {
+                    let d = Interval::point(cap) * Interval::point(wi);
+                    Interval::new(
+                        (Interval::point(b.lo()) - d).lo(),
+                        (Interval::point(b.hi()) + d).hi(),
+                    )
+                })
+                .collect();
+            let (lo, hi): (Vec<f64>, Vec<f64>) = region.iter().map(|r| (r.lo(), r.hi())).unzip();
+            let lean = cert.may_lean(&lo, &hi, &w);
+            let Ok((rates, _)) = cert.rates(&region, times, lean) else {
+                return None;
+            };
+            if !(rates.c.is_finite() && rates.rho.is_finite()) {
+                return None;
+            }
+            let f = forcing + Interval::point(rates.rho) * Interval::point(r2);
+            let end = rho * (Interval::point(rates.c) * span).exp() + f * expm1_over(rates.c, span);
+            let top = rho.hi().max(end.hi());
+            if top < cap {
+                accepted = Some((end, rates));
+                break;
+            }
+            cap = (2.0 * cap).max(1.25 * top);
+        }
+        let (end, rates) = accepted?;
+        // The node: M_(k+1) the midpoint of exp(A h) M_k, the jump into the remainder.
+        let m_next: Vec<f64> = next.iter().map(|e| e.mid()).collect();
+        let jump: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .fold(Interval::ZERO, |acc, j| {
+                        acc + (next[i * n + j] - Interval::point(m_next[i * n + j])) * xi[j]
+                    })
+                    .mag()
+            })
+            .collect();
+        let after = Interval::point(end.hi()) + Interval::point(norm.bound(&jump));
+        if !after.hi().is_finite() || m_next.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        grew = (after.hi() - rho.hi()).max(0.0);
+        pieces.push(Piece {
+            t1,
+            rates: (rates.c, rates.sigma),
+            over: Span {
+                lo: hbox.iter().map(|b| b.lo()).collect(),
+                hi: hbox.iter().map(|b| b.hi()).collect(),
+                radius: rho.hi().max(end.hi()),
+            },
+            end: (t1 == grid[k + 1]).then(|| zonotope_at(&step.x1, &m_next, after.hi())),
+        });
+        rho = Interval::point(after.hi());
+        m = m_next;
+        x.clone_from(&step.x1);
+        t0 = t1;
+    }
+    Some(Deterministic {
+        start,
+        pieces,
+        frame: None,
+        tube: None,
+    })
+}
+
+/// An enclosure of `exp(A tau)` for every `tau` in `tau` (`tau >= 0`): the Taylor polynomial
+/// of degree [`TAYLOR_TERMS`] in interval arithmetic plus the remainder
+/// `a^(q+1) / (q+1)! / (1 - a / (q+2))` on every entry, `a = |A|_inf tau_max` (the remainder
+/// matrix's infinity norm bounds each of its entries). `None` if `a >= q + 2` or the entries
+/// are not finite.
+fn exp_enclosure(a: &[f64], n: usize, tau: Interval) -> Option<Vec<Interval>> {
+    let q = TAYLOR_TERMS;
+    let norm = (0..n)
+        .map(|i| {
+            (0..n).fold(Interval::ZERO, |acc, j| {
+                acc + Interval::point(a[i * n + j].abs())
+            })
+        })
+        .fold(Interval::ZERO, |m, r| Interval::point(m.hi().max(r.hi())));
+    let big = norm * Interval::point(tau.hi());
+    let qi = Interval::point((q + 2) as f64);
+    if big.hi().partial_cmp(&qi.lo()) != Some(std::cmp::Ordering::Less) {
+        return None;
+    }
+    let mut fact = Interval::ONE;
+    for j in 1..=q + 1 {
+        fact *= Interval::point(j as f64);
+    }
+    let rem = (big.powi(q as i32 + 1) / fact / (Interval::ONE - big / qi)).hi();
+    // Horner: I + A tau (I + A tau / 2 (I + ... (I + A tau / q))).
+    let at: Vec<Interval> = a.iter().map(|&v| Interval::point(v) * tau).collect();
+    let eye = |m: &mut Vec<Interval>| {
+        for i in 0..n {
+            m[i * n + i] += Interval::ONE;
+        }
+    };
+    let mut s = vec![Interval::ZERO; n * n];
+    eye(&mut s);
+    for j in (1..=q).rev() {
+        let scaled: Vec<Interval> = at.iter().map(|&v| v / Interval::point(j as f64)).collect();
+        s = product(&scaled, &s, n, n, n);
+        eye(&mut s);
+    }
+    let r = Interval::new(-rem, rem);
+    let out: Vec<Interval> = s.into_iter().map(|v| v + r).collect();
+    out.iter()
+        .all(|v| v.lo().is_finite() && v.hi().is_finite())
+        .then_some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exp_enclosure_holds_the_closed_form() {
+        // A = [[0, 1], [-1, 0]]: exp(A t) is the rotation by -t... [[cos, sin], [-sin, cos]].
+        let a = [0.0, 1.0, -1.0, 0.0];
+        for t in [0.0, 0.01, 0.3, 1.0] {
+            let e = exp_enclosure(&a, 2, Interval::point(t)).unwrap();
+            let want = [t.cos(), t.sin(), -t.sin(), t.cos()];
+            for (iv, w) in e.iter().zip(want) {
+                assert!(iv.lo() <= w && w <= iv.hi(), "t = {t}: {iv:?} vs {w}");
+                // The remainder bound 1 / 13! / (1 - 1 / 14) at t = 1, rounding below.
+                assert!(iv.width() < 1e-12f64.max(4e-10 * t), "t = {t}: {iv:?}");
+            }
+        }
+        // Over tau in [0, 0.5]: every sampled time's value inside.
+        let e = exp_enclosure(&a, 2, Interval::new(0.0, 0.5)).unwrap();
+        for k in 0..=50 {
+            let t = 0.01 * k as f64;
+            let want = [t.cos(), t.sin(), -t.sin(), t.cos()];
+            for (iv, w) in e.iter().zip(want) {
+                assert!(iv.lo() <= w && w <= iv.hi());
+            }
+        }
+        // A stiff matrix with a too long step: no enclosure rather than a wrong one.
+        assert!(exp_enclosure(&[-100.0], 1, Interval::point(1.0)).is_none());
+    }
+}
