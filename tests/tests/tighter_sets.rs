@@ -347,3 +347,64 @@ fn first_order_sets_are_on_by_default_and_can_be_turned_off() {
     }
     assert!(h_on[1].hi - h_on[1].lo <= 0.8 * (h_off[1].hi - h_off[1].lo));
 }
+
+/// A point start (method.md 8.7): the box of the contraction run has no width at `t = 0`, so
+/// its accuracy target is out of reach and only the floor of `1/64` of the report step stops
+/// the shortening (the analysis' own boxes go down to `2^-12`: 4096 steps per report interval,
+/// which the box's budget of 256 used to refuse, dropping it). The box is kept within that
+/// floor, cuts the ball, and holds the noise-free solutions from the corners of the input box
+/// (RK4 at `h = 1e-4`), at and between the report times.
+#[test]
+fn a_point_start_keeps_its_interval_box_within_the_floor() {
+    let (sys, info) = inline(
+        "model point_start\nstate x = 0\nstate y = 1\ninput u in [-0.01, 0.01]\nnoise w\n\
+         drift {\n  x' = -x + sin(3 * t) + u\n  y' = -2 * y + x\n}\n\
+         diffusion {\n  x: 0.05 * w\n  y: 0.05 * w\n}\n\
+         analysis a { method = contraction  metric = auto  horizon = 2  step = 0.05 }\n",
+    );
+    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let boxes = prs
+        .also
+        .iter()
+        .find(|m| m.role == Role::Box)
+        .expect("the box is kept");
+    let reports = prs.steps.len() - 1;
+    assert!(
+        boxes.internal_steps > reports && boxes.internal_steps <= 64 * reports,
+        "{} internal steps over {reports} report intervals",
+        boxes.internal_steps
+    );
+    // Noise-free solutions for u = -0.01, 0, 0.01: inside the box at every report time and in
+    // its span over each report interval.
+    let f = |t: f64, s: [f64; 2], u: f64| [-s[0] + (3.0 * t).sin() + u, -2.0 * s[1] + s[0]];
+    for u in [-0.01, 0.0, 0.01] {
+        let (mut s, mut t, h) = ([0.0f64, 1.0], 0.0f64, 1e-4f64);
+        for k in 1..=reports {
+            let end = prs.steps[k].t;
+            while t < end - 1e-12 {
+                let h = h.min(end - t);
+                let k1 = f(t, s, u);
+                let k2 = f(
+                    t + h / 2.0,
+                    [s[0] + h / 2.0 * k1[0], s[1] + h / 2.0 * k1[1]],
+                    u,
+                );
+                let k3 = f(
+                    t + h / 2.0,
+                    [s[0] + h / 2.0 * k2[0], s[1] + h / 2.0 * k2[1]],
+                    u,
+                );
+                let k4 = f(t + h, [s[0] + h * k3[0], s[1] + h * k3[1]], u);
+                for i in 0..2 {
+                    s[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+                }
+                t += h;
+                assert!(boxes.span_contains(k, &s), "u = {u}, t = {t}: {s:?}");
+            }
+            let (lo, hi) = boxes.steps[k].det.box_hull().expect("a box");
+            for i in 0..2 {
+                assert!(lo[i] <= s[i] && s[i] <= hi[i], "u = {u}, t = {end}: {s:?}");
+            }
+        }
+    }
+}

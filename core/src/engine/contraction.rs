@@ -7,6 +7,7 @@ use super::assemble::{
     assemble_with, constants_used, rate_used, Deterministic, Header, Piece, Radii,
 };
 use super::defect::{Nominal, NominalStep};
+use super::embedding::Budget;
 use super::intersect::cut_by;
 use super::radius::expm1_over;
 use super::{
@@ -23,9 +24,14 @@ pub const MAX_BOX_STATES: usize = 100;
 
 /// The most internal steps the interval box of a contraction run may take per report interval,
 /// on average (method.md 8.7): it is an extra cut of the ball, not worth many times the ball's
-/// own cost. (The shipped specs' boxes take at most 59; boxes of no width driven by `t` take
-/// the embedding's floor of 4096.)
+/// own cost. (The shipped specs' boxes take at most 59.)
 const BOX_STEPS_PER_REPORT: usize = 256;
+
+/// The shortest step of that box that accuracy alone may ask for, as a fraction of the report
+/// step: a box of no width (a point start) keeps the accuracy target out of reach, and the
+/// analysis' own boxes then go down to `2^-12` of it (4096 steps per report interval, 110 s
+/// spent on `specs/unicycle_lookahead.sde` before the box was dropped for its budget).
+const BOX_ACCURACY_STEPS: usize = 64;
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -149,7 +155,11 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     // result.)
     let boxes = (validated && n <= MAX_BOX_STATES)
         .then(|| {
-            let budget = BOX_STEPS_PER_REPORT * grid.len().saturating_sub(1).max(1);
+            let budget = Budget::helper(
+                grid.len().saturating_sub(1),
+                BOX_STEPS_PER_REPORT,
+                BOX_ACCURACY_STEPS,
+            );
             interval::deterministic(run, spec.inclusion, budget).ok()
         })
         .flatten();

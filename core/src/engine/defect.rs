@@ -35,6 +35,9 @@ pub(crate) struct StepBudget {
     in_interval: usize,
     /// The most steps in all ([`MAX_STEPS`] unless [`StepBudget::at_most`] lowers it).
     limit: usize,
+    /// The most steps in one report interval ([`MAX_STEPS_PER_REPORT`] unless
+    /// [`StepBudget::at_most`] lowers it).
+    interval_limit: usize,
 }
 
 impl StepBudget {
@@ -45,13 +48,16 @@ impl StepBudget {
             total: 0,
             in_interval: 0,
             limit: MAX_STEPS,
+            interval_limit: MAX_STEPS_PER_REPORT,
         }
     }
 
-    /// The same budget with at most `limit` steps in all (never more than [`MAX_STEPS`]).
-    pub(crate) fn at_most(self, limit: usize) -> Self {
+    /// The same budget with at most `limit` steps in all and `per_interval` in one report
+    /// interval (never more than [`MAX_STEPS`] and [`MAX_STEPS_PER_REPORT`]).
+    pub(crate) fn at_most(self, limit: usize, per_interval: usize) -> Self {
         StepBudget {
             limit: limit.min(MAX_STEPS),
+            interval_limit: per_interval.min(MAX_STEPS_PER_REPORT),
             ..self
         }
     }
@@ -74,12 +80,13 @@ impl StepBudget {
                 .at_setting(Setting::Horizon),
             ));
         }
-        if self.in_interval >= MAX_STEPS_PER_REPORT {
+        if self.in_interval >= self.interval_limit {
             return Err(RunError::NonFinite(
                 Detail::from(format!(
-                    "{what} needs more than {MAX_STEPS_PER_REPORT} validated steps in the \
+                    "{what} needs more than {} validated steps in the \
                      report interval [{}, {}] (at t = {}): it grows without bound there, or is \
                      too stiff for this report step ({hint})",
+                    self.interval_limit,
                     time(window[0]),
                     time(window[1]),
                     time(t)

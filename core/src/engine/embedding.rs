@@ -10,7 +10,7 @@
 //! evaluations of the drift and of the non-zero Jacobian entries: time proportional to the
 //! size of the expressions, not to `n^2`.
 
-use super::defect::{StepBudget, MIN_STEP};
+use super::defect::{StepBudget, MAX_STEPS, MAX_STEPS_PER_REPORT, MIN_STEP};
 use super::hermite::Cubic;
 use super::nominal::rk4_step;
 use super::{Detail, RunError, Setting};
@@ -18,6 +18,39 @@ use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{Inclusion, Integrator};
 use crate::system::System;
+
+/// How much work the embedding's validated steps may take.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Budget {
+    /// The most steps in all.
+    pub(crate) steps: usize,
+    /// The most steps in one report interval.
+    pub(crate) per_interval: usize,
+    /// The shortest step accuracy alone may ask for, as a fraction of the report step (shorter
+    /// steps are taken only where a longer one does not validate).
+    pub(crate) floor: f64,
+}
+
+impl Budget {
+    /// An analysis' own boxes: up to [`MAX_STEPS`] and [`MAX_STEPS_PER_REPORT`], accuracy down
+    /// to `2^-12` of the report step.
+    pub(crate) const FULL: Budget = Budget {
+        steps: MAX_STEPS,
+        per_interval: MAX_STEPS_PER_REPORT,
+        floor: 1.0 / 4096.0,
+    };
+
+    /// A helper's boxes over `reports` report intervals: `per_report` steps per interval on
+    /// average and 4 times that in any one, accuracy down to `1 / floor_steps` of the report
+    /// step.
+    pub(crate) fn helper(reports: usize, per_report: usize, floor_steps: usize) -> Budget {
+        Budget {
+            steps: per_report * reports.max(1),
+            per_interval: 4 * per_report,
+            floor: 1.0 / floor_steps.max(1) as f64,
+        }
+    }
+}
 
 /// The embedding system on boxes `(lo, hi)`, with scratch space for its evaluations.
 pub(crate) struct Embedding<'a> {
@@ -191,8 +224,8 @@ impl<'a> Embedding<'a> {
     /// `[lo, hi]` at `t = 0` over the report grid, inputs in `inputs[k]` on report interval
     /// `k`: each step's end box and its hull over the step hold every trajectory from the box,
     /// at the end and over the whole step. Steps are chosen so that what validation adds to a
-    /// box stays near `accuracy` times its width per unit time. The last step of each report
-    /// interval ends exactly on the report time.
+    /// box stays near `accuracy` times its width per unit time, within `budget`. The last step
+    /// of each report interval ends exactly on the report time.
     pub(crate) fn validated(
         &mut self,
         lo: &[f64],
@@ -200,29 +233,36 @@ impl<'a> Embedding<'a> {
         grid: &[f64],
         inputs: &[Vec<Interval>],
         accuracy: f64,
-        max_steps: usize,
+        budget: Budget,
     ) -> Result<Vec<BoxStep>, RunError> {
         let mut out = Vec::new();
         let (mut lo, mut hi) = (lo.to_vec(), hi.to_vec());
         let mut t = 0.0;
         let mut h = grid.get(1).copied().unwrap_or(0.0);
-        let mut budget = StepBudget::new(
+        let mut steps = StepBudget::new(
             "the embedding system",
             "the other inclusion, a coordinate transform, the contraction method, a smaller \
              report step or a shorter horizon may help",
         )
-        .at_most(max_steps);
+        .at_most(budget.steps, budget.per_interval);
         for (k, w) in grid.windows(2).enumerate() {
             if self.field.ubox != inputs[k] {
                 self.field.set_inputs(&inputs[k]);
             }
             let end = w[1];
-            budget.next_interval();
+            steps.next_interval();
             while t < end {
-                budget.take(t, w)?;
+                steps.take(t, w)?;
                 let report = w[1] - w[0];
-                let (step, next) =
-                    self.validated_step(&lo, &hi, t, h.min(report), w, k, accuracy)?;
+                let (step, next) = self.validated_step(
+                    &lo,
+                    &hi,
+                    t,
+                    h.min(report),
+                    w,
+                    k,
+                    (accuracy, budget.floor),
+                )?;
                 h = next.min(report);
                 (lo, hi) = (step.lo.clone(), step.hi.clone());
                 t = step.t1;
@@ -234,7 +274,7 @@ impl<'a> Embedding<'a> {
 
     /// One validated step from the box `[lo, hi]` at `t` in report interval `interval`
     /// (`window`), of length at most `h`: shortened until it validates and what it adds to the
-    /// box is within `accuracy` (the latter only down to `2^-12` of the report step: a step
+    /// box is within `accuracy` (the latter only down to `floor` times the report step: a step
     /// that validates is sound, only looser; the former down to [`MIN_STEP`] of it). Returns
     /// the step and the length to try next.
     #[allow(clippy::too_many_arguments)]
@@ -246,11 +286,11 @@ impl<'a> Embedding<'a> {
         mut h: f64,
         window: &[f64],
         interval: usize,
-        accuracy: f64,
+        (accuracy, floor): (f64, f64),
     ) -> Result<(BoxStep, f64), RunError> {
         let end = window[1];
         let min_h = MIN_STEP * (end - window[0]);
-        let floor = (end - window[0]) * 2f64.powi(-12);
+        let floor = (end - window[0]) * floor;
         h = h.max(min_h);
         let wmax = lo.iter().zip(hi).fold(0.0f64, |m, (a, b)| m.max(b - a));
         // Per coordinate, what a step may add per unit time (a floor for boxes of no width).

@@ -29,8 +29,7 @@
 use super::assemble::{
     assemble_with, constants_used, rate_used, Deterministic, Header, Piece, Radii,
 };
-use super::defect::MAX_STEPS;
-use super::embedding::{BoxStep, Embedding};
+use super::embedding::{BoxStep, Budget, Embedding};
 use super::intersect::cut_by;
 use super::transform::{self, with_buffer, Frame};
 use super::{
@@ -45,7 +44,7 @@ use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
 pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
-    let (mut det, mut header) = deterministic(run, inclusion, MAX_STEPS)?;
+    let (mut det, mut header) = deterministic(run, inclusion, Budget::FULL)?;
     // Local rates: certified per step on the box widened by the tube.
     let local = if run.spec.rate == Rate::Local {
         let pieces = &mut det.pieces;
@@ -103,7 +102,7 @@ fn first_order_of(run: &Run, r1: f64, x0: &[f64]) -> Option<Deterministic> {
 pub(super) fn deterministic(
     run: &Run,
     inclusion: Inclusion,
-    max_steps: usize,
+    budget: Budget,
 ) -> Result<(Deterministic, Header), RunError> {
     let (spec, consts, n) = (run.spec, run.setup.consts, run.setup.n);
     let metric = &consts.metric;
@@ -122,7 +121,7 @@ pub(super) fn deterministic(
         run.initial,
         &grid,
         &run_inputs(run, &inputs),
-        (inclusion, max_steps),
+        (inclusion, budget),
     )?;
     let (r1, r1_bound) = r1::bound(metric, run.initial, &half0);
     let (kappa, radius_rule) = radius::stochastic_factor(n, spec);
@@ -282,7 +281,7 @@ fn boxes(
     initial: &InitialSet,
     grid: &[f64],
     inputs: &[Vec<Interval>],
-    (inclusion, max_steps): (Inclusion, usize),
+    (inclusion, budget): (Inclusion, Budget),
 ) -> Result<Boxes, RunError> {
     let (n, p) = (sys.n(), sys.p());
     validate(info, spec, n, p)?;
@@ -339,7 +338,7 @@ fn boxes(
             grid,
             inputs,
             1e-2 / spec.horizon.max(f64::MIN_POSITIVE),
-            max_steps,
+            budget,
         )?
     } else {
         embedding
@@ -393,7 +392,7 @@ pub fn interval_boxes(
         &info.initial,
         &grid,
         &inputs,
-        (spec.inclusion, MAX_STEPS),
+        (spec.inclusion, Budget::FULL),
     )?;
     let mut out = vec![(0.0, d.start.0, d.start.1)];
     out.extend(
