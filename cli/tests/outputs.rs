@@ -187,6 +187,43 @@ fn deny_unsafe_fails_on_not_shown_safe_and_writes_the_results() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `--probability`: the bound and what limits it, printed and in the JSON. The decay from 1
+/// crosses `x <= 0.5` at t = ln(2) / 3 without noise: no delta helps, one run.
+#[test]
+fn probability_prints_its_bound_and_limit() {
+    let dir = scratch("probability", THROUGH);
+    let out = dir.join("out");
+    let o = run_interp(&dir, &["-o", s(&out), "--probability"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    assert!(
+        text(&o).contains(
+            "P(safe on [0, 1]): no bound (1 run; the deterministic set alone is not shown to \
+             avoid `low` at t = 0.3, so no delta helps"
+        ),
+        "{}",
+        text(&o)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("contraction.json")).unwrap())
+            .unwrap();
+    let p = &json["safety_probability"];
+    assert_eq!(p["lower_bound"], serde_json::Value::Null);
+    assert_eq!(
+        (p["runs"].as_u64(), p["proved"].as_bool()),
+        (Some(1), Some(true))
+    );
+    assert_eq!(
+        (p["limit"]["kind"].as_str(), p["limit"]["set"].as_str()),
+        (Some("deterministic"), Some("low"))
+    );
+    // Without the flag, no such field.
+    let o = run_interp(&dir, &["-o", s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let plain = std::fs::read_to_string(out.join("contraction.json")).unwrap();
+    assert!(!plain.contains("safety_probability") && !text(&o).contains("P(safe"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn messages_count_in_the_singular_and_plural() {
     let dir = scratch("counts", THROUGH);

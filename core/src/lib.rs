@@ -11,6 +11,7 @@ pub mod interval;
 pub mod kappa;
 pub mod lanes;
 pub mod model;
+pub mod probability;
 pub mod prs;
 mod reach;
 pub mod simulate;

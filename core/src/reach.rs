@@ -192,20 +192,40 @@ impl<'a> Reach<'a> {
     }
 
     fn run_from(&self, initial: &InitialSet, inputs: Inputs) -> Result<Prs, RunError> {
+        self.run_spec(&self.spec, initial, inputs)
+    }
+
+    /// The PRS of the spec's initial set and input box at another `delta` in `(0, 1)` (see
+    /// [`Reach::with_delta`]).
+    pub(crate) fn run_at(&self, delta: f64) -> Result<Prs, RunError> {
+        let spec = AnalysisSpec {
+            delta,
+            ..self.spec.clone()
+        };
+        engine::validate(self.info, &spec, self.setup.n, self.setup.p)?;
+        self.run_spec(&spec, &self.info.initial, Inputs::Box)
+    }
+
+    fn run_spec(
+        &self,
+        own: &AnalysisSpec,
+        initial: &InitialSet,
+        inputs: Inputs,
+    ) -> Result<Prs, RunError> {
         // Local rates hold wherever the tube goes: the domain does not constrain them.
-        check_initial(self.info, initial, self.spec.rate != Rate::Local)?;
+        check_initial(self.info, initial, own.rate != Rate::Local)?;
         // K metrics: each set at delta / K, the PRS their intersection (union bound).
         let k = 1 + self.also.len();
         let spec = AnalysisSpec {
             // Rounded down, so that the K shares sum to at most delta.
-            delta: (self.spec.delta / k as f64).next_down(),
-            ..self.spec.clone()
+            delta: (own.delta / k as f64).next_down(),
+            ..own.clone()
         };
         let run_with = |setup: &Setup| {
             engine::run_engine(&Run {
                 sys: self.sys,
                 info: self.info,
-                spec: if k == 1 { &self.spec } else { &spec },
+                spec: if k == 1 { own } else { &spec },
                 setup,
                 initial,
                 inputs,
@@ -233,7 +253,7 @@ impl<'a> Reach<'a> {
         Ok(engine::intersect(
             self.info,
             &self.setup.checks,
-            self.spec.delta,
+            own.delta,
             first,
             others,
         ))

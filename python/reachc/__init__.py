@@ -26,13 +26,14 @@ from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Tuple, Un
 import numpy as np
 
 from . import _native
-from ._native import AnalysisError, Diagnostic, SpecError
+from ._native import AnalysisError, Diagnostic, SafetyProbability, SpecError
 
 __all__ = [
     "AnalysisError",
     "Diagnostic",
     "Reach",
     "Result",
+    "SafetyProbability",
     "Simulation",
     "Spec",
     "SpecError",
@@ -260,6 +261,16 @@ class Reach:
         if a.ndim != 3 or a.shape[1:] != (self._n, 2):
             raise ValueError(f"boxes have shape (m, {self._n}, 2), not {a.shape}")
         return [Result(r) for r in self._native.sweep(a)]
+
+    def safety_probability(self) -> SafetyProbability:
+        """A certified lower bound of the probability that no unsafe set is entered on
+        ``[0, horizon]``, for every start in the spec's initial set and every input: the
+        ``safety_probability`` of ``reachc run --probability`` (``lower_bound`` is ``None``
+        without a bound; ``limit`` says what stops it: ``resolution``, ``floor``,
+        ``stochastic``, ``deterministic`` or ``failed``; ``text`` is the CLI's line). About a
+        dozen runs, the GIL released. Raises :class:`AnalysisError` for a pointwise guarantee
+        or a model without unsafe sets."""
+        return self._native.safety_probability()
 
     def __repr__(self) -> str:
         return repr(self._native)

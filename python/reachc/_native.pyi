@@ -102,6 +102,21 @@ class Reach:
         inputs: Optional[Tuple[List[float], List[List[float]]]] = None,
     ) -> Result: ...
     def sweep(self, boxes: FloatArray) -> List[Result]: ...
+    def safety_probability(self) -> SafetyProbability: ...
+
+class SafetyProbability:
+    horizon: float
+    lower_bound: Optional[float]
+    delta: Optional[float]
+    not_shown_at: Optional[float]
+    limit: str
+    limit_t: Optional[float]
+    limit_set: Optional[str]
+    limit_why: Optional[str]
+    runs: int
+    proved: bool
+    conditional_on_domain: bool
+    text: str
 
 class Result:
     @property

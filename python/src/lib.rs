@@ -28,6 +28,7 @@ use reachc_compiler::ir::{ExprId, Names};
 use reachc_compiler::model::Model;
 use reachc_runtime::engine::RunError;
 use reachc_runtime::model::{InitialSet, ModelInfo};
+use reachc_runtime::probability::SafetyLimit;
 use reachc_runtime::prs::{DetSet, Verdict};
 use reachc_runtime::simulate::{self, InputMode, SimError, SimReport};
 use reachc_runtime::{report, Bounds, InputPlan, Prs, Reach};
@@ -613,12 +614,71 @@ impl ReachHandle {
         Ok(out)
     }
 
+    /// A certified lower bound of the probability that no unsafe set is entered on `[0, T]`,
+    /// for every start in the spec's initial set and every input (`reachc run
+    /// --probability`; about a dozen runs, the GIL released).
+    fn safety_probability(&self, py: Python<'_>) -> PyResult<SafetyProbabilityPy> {
+        let p = py
+            .detach(|| self.reach.0.safety_probability())
+            .map_err(run_error)?;
+        let sets = &self.inner.info.unsafe_sets;
+        let name = |set: usize| Some(sets[set].name.clone());
+        let (limit, t, set, why) = match &p.limit {
+            SafetyLimit::Resolution => ("resolution", None, None, None),
+            SafetyLimit::Floor => ("floor", None, None, None),
+            SafetyLimit::Stochastic { t, set } => ("stochastic", Some(*t), name(*set), None),
+            SafetyLimit::Deterministic { t, set } => ("deterministic", Some(*t), name(*set), None),
+            SafetyLimit::Failed { delta, why } => ("failed", Some(*delta), None, Some(why.clone())),
+        };
+        Ok(SafetyProbabilityPy {
+            horizon: p.horizon,
+            lower_bound: p.lower_bound(),
+            delta: p.delta,
+            not_shown_at: p.not_shown_at,
+            limit: limit.to_string(),
+            limit_t: t,
+            limit_set: set,
+            limit_why: why,
+            runs: p.runs,
+            proved: p.validation.not_validated.is_empty(),
+            conditional_on_domain: p.validation.conditional_on_domain,
+            text: report::probability::line(sets, &p),
+        })
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Reach({:?} of model {:?})",
             self.reach.0.analysis().name,
             self.inner.info.name
         )
+    }
+}
+
+/// A certified lower bound of the probability of safety (`Reach.safety_probability`): the
+/// fields of the JSON's `safety_probability`, the limit flattened (`limit_t` is the time of a
+/// `stochastic` or `deterministic` limit and the `delta` of a `failed` one), and `text` the
+/// summary's line.
+#[pyclass(module = "reachc._native", frozen, get_all, name = "SafetyProbability")]
+struct SafetyProbabilityPy {
+    horizon: f64,
+    lower_bound: Option<f64>,
+    delta: Option<f64>,
+    not_shown_at: Option<f64>,
+    limit: String,
+    limit_t: Option<f64>,
+    limit_set: Option<String>,
+    limit_why: Option<String>,
+    runs: usize,
+    proved: bool,
+    conditional_on_domain: bool,
+    text: String,
+}
+
+#[pymethods]
+impl SafetyProbabilityPy {
+    fn __repr__(&self) -> String {
+        self.text.clone()
     }
 }
 
@@ -1059,6 +1119,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Spec>()?;
     m.add_class::<ReachHandle>()?;
     m.add_class::<ReachResult>()?;
+    m.add_class::<SafetyProbabilityPy>()?;
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;

@@ -4,6 +4,7 @@ a sweep of 100 initial boxes through one handle, input plans, the interrupt."""
 from __future__ import annotations
 
 import _thread
+import json
 import threading
 import time
 from pathlib import Path
@@ -243,3 +244,46 @@ def test_gil_is_released_during_runs(pendulum: reachc.Spec) -> None:
     for t in threads:
         t.join()
     assert len(out) == 2 and out[0] == out[1]
+
+
+def test_safety_probability_equals_the_cli(cli: Path, tmp_path: Path) -> None:
+    spec = reachc.load(SPECS / "vanderpol_feedback.sde")
+    p = spec.reach("contraction").safety_probability()
+    done = run_cli(
+        cli,
+        [
+            "run",
+            str(SPECS / "vanderpol_feedback.sde"),
+            "--backend",
+            "interp",
+            "--analysis",
+            "contraction",
+            "--probability",
+            "-o",
+            str(tmp_path),
+        ],
+    )
+    assert done.returncode == 0, done.stderr
+    written = json.loads((tmp_path / "contraction.json").read_text())["safety_probability"]
+    assert p.lower_bound is not None and 0.999 < p.lower_bound < 1.0
+    assert (p.lower_bound, p.delta, p.not_shown_at, p.runs) == (
+        written["lower_bound"],
+        written["delta"],
+        written["not_shown_at"],
+        written["runs"],
+    )
+    assert (p.limit, p.proved) == (written["limit"]["kind"], written["proved"]) == (
+        "resolution",
+        True,
+    )
+    assert p.text in done.stdout
+
+
+def test_safety_probability_needs_a_uniform_guarantee() -> None:
+    text = (
+        "model m\nstate x in [0, 0.1]\nnoise w\ndrift { x' = -x }\ndiffusion { x: 0.1 * w }\n"
+        "unsafe high halfspace { x >= 1 }\n"
+        "analysis a { method = contraction  horizon = 1  step = 0.1  guarantee = pointwise }\n"
+    )
+    with pytest.raises(reachc.AnalysisError, match="guarantee = uniform"):
+        reachc.loads(text).reach("a").safety_probability()

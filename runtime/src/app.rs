@@ -5,7 +5,7 @@
 //! [`run`] and [`simulate()`] take typed options ([`RunOptions`], [`SimulateOptions`]); a
 //! generated binary's command line is their textual form, parsed by [`Command::parse`] and
 //! written by `to_args` (by hand, no clap, so the runtime stays light):
-//! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--error-lines]`, or
+//! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--probability] [--error-lines]`, or
 //! `simulate --paths N [options]` (see [`SIMULATE_USAGE`]).
 //!
 //! Exit codes (the CLI's too): [`EXIT_OK`], [`EXIT_FAILED`] (an analysis could not run, its
@@ -31,12 +31,15 @@ use std::process::ExitCode;
 pub const DEFAULT_OUT_DIR: &str = "reachc-out";
 
 const USAGE: &str =
-    "usage: <model> [--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--error-lines]
+    "usage: <model> [--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--probability]
+               [--error-lines]
        <model> simulate --paths N [options]   (Monte Carlo check; simulate --help)
   --analysis NAME  run only this analysis (default: all)
   -o, --out DIR    output directory for <analysis>.json and <analysis>.csv (default: reachc-out)
   -q, --quiet      do not print the summaries
   --deny-unsafe    exit with status 3 when a verdict is \"not shown safe\"
+  --probability    also bound the probability of safety on [0, T] (analyses with unsafe sets
+                   and a uniform guarantee; about a dozen runs each)
   --error-lines    report failed analyses as `reachc-failure` lines (for reachc)
   -h, --help       print this help
   Exit status: 0 ok, 1 an analysis could not run (the others' results are written), 2 usage
@@ -94,6 +97,9 @@ pub struct RunOptions {
     pub quiet: bool,
     /// Exit with [`EXIT_UNSAFE`] when a verdict is "not shown safe".
     pub deny_unsafe: bool,
+    /// Also compute each analysis' probability of safety ([`Reach::safety_probability`]):
+    /// printed, and in the JSON.
+    pub probability: bool,
     /// `out_dir` is a staging directory that the caller moves into place (`reachc run --plot`):
     /// do not print where the files were written.
     pub stage: bool,
@@ -108,6 +114,7 @@ impl Default for RunOptions {
             out_dir: PathBuf::from(DEFAULT_OUT_DIR),
             quiet: false,
             deny_unsafe: false,
+            probability: false,
             stage: false,
             error_lines: false,
         }
@@ -224,6 +231,7 @@ fn parse_run(args: &[String]) -> Result<Command, String> {
             "-o" | "--out" => opts.out_dir = PathBuf::from(args.value(flag, inline)?),
             "-q" | "--quiet" => opts.quiet = true,
             "--deny-unsafe" => opts.deny_unsafe = true,
+            "--probability" => opts.probability = true,
             "--stage" => opts.stage = true,
             "--error-lines" => opts.error_lines = true,
             "-h" | "--help" => return Ok(Command::Help(USAGE)),
@@ -296,6 +304,7 @@ impl RunOptions {
         for (on, flag) in [
             (self.quiet, "--quiet"),
             (self.deny_unsafe, "--deny-unsafe"),
+            (self.probability, "--probability"),
             (self.stage, "--stage"),
             (self.error_lines, "--error-lines"),
         ] {
@@ -466,7 +475,8 @@ fn run_analyses<S: System + Sync>(
     let mut failures = Failures::new(collect, opts.error_lines);
     let (mut files, mut not_safe) = (Files::new(), false);
     for &name in &selected {
-        let res = match Reach::new(sys, info, name).and_then(|r| r.run()) {
+        let reach = Reach::new(sys, info, name);
+        let res = match reach.as_ref().map_err(Clone::clone).and_then(|r| r.run()) {
             Ok(res) => res,
             Err(RunError::Unsupported(why)) => {
                 let _ = writeln!(err, "skipped analysis `{name}`: {why}");
@@ -477,9 +487,25 @@ fn run_analyses<S: System + Sync>(
                 continue;
             }
         };
+        // The probability of safety, where it is asked for and defined.
+        let probability = match (&reach, opts.probability) {
+            (Ok(reach), true) if !info.unsafe_sets.is_empty() => Some(reach.safety_probability()),
+            _ => None,
+        };
         if !opts.quiet {
-            let _ = writeln!(out, "{}", report::summary(&res));
+            let _ = write!(out, "{}", report::summary(&res));
+            match &probability {
+                Some(Ok(p)) => {
+                    let _ = writeln!(out, "  {}", report::probability::line(&info.unsafe_sets, p));
+                }
+                Some(Err(why)) => {
+                    let _ = writeln!(out, "  probability of safety: not computed: {why}");
+                }
+                None => {}
+            }
+            let _ = writeln!(out);
         }
+        let probability = probability.and_then(Result::ok);
         not_safe |= matches!(res.verdict, reachc_core::prs::Verdict::NotShownSafe { .. });
         let mut csv = Vec::new();
         // Writing into memory cannot fail.
@@ -487,7 +513,7 @@ fn run_analyses<S: System + Sync>(
         let dir = &opts.out_dir;
         files.add(
             dir.join(format!("{name}.json")),
-            (report::to_json(&res) + "\n").into(),
+            (report::to_json_with(&res, probability.as_ref()) + "\n").into(),
         );
         files.add(dir.join(format!("{name}.csv")), csv);
     }
@@ -745,6 +771,7 @@ mod tests {
             out_dir: PathBuf::from("some dir/out"),
             quiet: true,
             deny_unsafe: true,
+            probability: true,
             stage: true,
             error_lines: true,
         };

@@ -68,7 +68,9 @@
 //! outside the spec's domain or an input plan outside its input box is an error, and a
 //! [`ModelInfo`] edited after generation (another domain or input box) is refused.
 
-pub use reachc_core::{engine, func, interval, kappa, lanes, model, prs, simulate, system, table};
+pub use reachc_core::{
+    engine, func, interval, kappa, lanes, model, probability, prs, simulate, system, table,
+};
 pub use reachc_core::{Bounds, InputPlan, Interval, ModelInfo, Prs, Reach, System, X8};
 
 #[cfg(feature = "app")]

@@ -81,6 +81,11 @@ pub enum Command {
         /// Exit with code 3 when a verdict is "not shown safe" (the results are written).
         #[arg(long)]
         deny_unsafe: bool,
+        /// Also bound each analysis' probability of safety on [0, T], for every start and input
+        /// (analyses with unsafe sets and a uniform guarantee; about a dozen runs each):
+        /// printed, and `safety_probability` in the JSON.
+        #[arg(long)]
+        probability: bool,
         /// Do not show cargo's progress (compiled backend).
         #[arg(short, long)]
         quiet: bool,
@@ -131,8 +136,20 @@ fn run(command: Command) -> Result<(), u8> {
             out,
             plot,
             deny_unsafe,
+            probability,
             quiet,
-        } => run::run_spec(&spec, analysis, backend, out, &plot, (deny_unsafe, quiet)),
+        } => run::run_spec(
+            &spec,
+            analysis,
+            backend,
+            out,
+            &plot,
+            run::Flags {
+                deny_unsafe,
+                probability,
+                quiet,
+            },
+        ),
         Command::Simulate(cmd) => simulate::run_command(cmd),
         Command::Plot(args) => plot::run_plot(&args),
         Command::Check { spec } => {

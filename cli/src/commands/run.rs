@@ -27,6 +27,17 @@ pub enum Backend {
     Interp,
 }
 
+/// The switches of `reachc run`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Flags {
+    /// `--deny-unsafe`: exit with 3 when a verdict is "not shown safe".
+    pub deny_unsafe: bool,
+    /// `--probability`: also bound each analysis' probability of safety.
+    pub probability: bool,
+    /// `--quiet`: no cargo progress.
+    pub quiet: bool,
+}
+
 /// Runs `reachc run` (and, with `--plot`, plots the results). Exit codes as the runtime's
 /// [`reachc_runtime::app::run`]: 0 ok, 1 spec errors or an analysis that cannot run (each
 /// failure located in the spec; the other analyses' results are written), 2 usage, I/O or
@@ -38,7 +49,11 @@ pub fn run_spec(
     backend: Backend,
     out: Option<PathBuf>,
     plot: &RunPlotArgs,
-    (deny_unsafe, quiet): (bool, bool),
+    Flags {
+        deny_unsafe,
+        probability,
+        quiet,
+    }: Flags,
 ) -> Result<(), u8> {
     let color = std::io::stderr().is_terminal();
     let mut loaded = load_reporting(spec)?;
@@ -52,6 +67,7 @@ pub fn run_spec(
         out_dir: staging.clone().unwrap_or_else(|| out_dir.clone()),
         quiet: false,
         deny_unsafe,
+        probability,
         stage: staging.is_some(),
         error_lines: backend == Backend::Compiled,
     };

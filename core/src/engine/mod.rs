@@ -280,6 +280,7 @@ pub fn run(sys: &dyn System, info: &ModelInfo, analysis: &Analysis) -> Result<Pr
 }
 
 pub(crate) use intersect::intersect;
+pub(crate) use safety::deterministic_limit;
 
 /// Runs the engine of the analysis' method; a result with a number that is not finite is a
 /// [`RunError::NonFinite`].

@@ -295,3 +295,36 @@ fn box_margin(
         }
     }
 }
+
+/// The first report step and unsafe set at which the deterministic sets of `prs` alone (its
+/// own and its members', each without its stochastic radius) are not shown to avoid the set:
+/// where no `delta` can make the PRS safe. `None` when they avoid every set at every report
+/// time (or a metric cannot be factorised, which leaves nothing to say).
+///
+/// Each member's margin is computed in its own metric; the intersection's margin is the largest
+/// (as for the PRS). Parallelotopes are checked through their hulls (no frame): one-sided like
+/// every margin here, so "not shown" rather than "touches".
+pub(crate) fn deterministic_limit(
+    sets: &[UnsafeSet],
+    prs: &crate::prs::Prs,
+) -> Option<(usize, usize)> {
+    let n = prs.n();
+    let members: Vec<&crate::prs::Prs> = std::iter::once(prs).chain(&prs.also).collect();
+    let mut checks = Vec::with_capacity(members.len());
+    for m in &members {
+        let l = linalg::cholesky(&linalg::to_intervals(&m.constants.metric), n)?;
+        let diag = linalg::inverse_diagonal(&l, n);
+        let w: Vec<f64> = diag.iter().map(|d| d.sqrt().hi()).collect();
+        checks.push((Check::all(sets, n, &l, &diag).ok()?, w));
+    }
+    (0..prs.steps.len()).find_map(|k| {
+        (0..sets.len()).find_map(|j| {
+            let margin = members
+                .iter()
+                .zip(&checks)
+                .map(|(m, (c, w))| c[j].margin(&m.steps[k].det, 0.0, &Context { w, frame: None }))
+                .fold(f64::NEG_INFINITY, f64::max);
+            (margin.is_nan() || margin <= 0.0).then_some((k, j))
+        })
+    })
+}

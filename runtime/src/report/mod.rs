@@ -3,11 +3,12 @@
 //! ([`result`]) and of a Monte Carlo [`SimReport`](reachc_core::simulate::SimReport)
 //! ([`simulation`]).
 
+pub mod probability;
 pub mod result;
 pub mod simulation;
 
 pub use reachc_core::decimal::time;
-pub use result::{summary, to_json, write_csv};
+pub use result::{summary, to_json, to_json_with, write_csv};
 
 /// `n` and the noun, singular or plural: `1 thread`, `4 threads`.
 pub fn count(n: u64, noun: &str) -> String {

@@ -1,7 +1,9 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
+use super::probability::ProbabilityJson;
 use super::{count, csv_field, num, summary_indices, time};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
+use reachc_core::probability::SafetyProbability;
 use reachc_core::prs::{
     BallBound, DetSet, Hint, Proved, Prs, R1Method, Role, Step, TransformUsed, UniformBound,
     Unproved, UnsafeKind, UnsafeVerdict, Verdict,
@@ -12,8 +14,15 @@ use std::io::{self, Write};
 
 /// Pretty-printed JSON of a result. Non-finite numbers (e.g. an infinite margin) are `null`.
 pub fn to_json(prs: &Prs) -> String {
+    to_json_with(prs, None)
+}
+
+/// [`to_json`] with the analysis' probability of safety (`reachc run --probability`).
+pub fn to_json_with(prs: &Prs, probability: Option<&SafetyProbability>) -> String {
+    let mut json = Json::of(prs);
+    json.safety_probability = probability.map(|p| ProbabilityJson::of(prs, p));
     // Plain data with string keys: serialising cannot fail.
-    serde_json::to_string_pretty(&Json::of(prs)).expect("a result serialises")
+    serde_json::to_string_pretty(&json).expect("a result serialises")
 }
 
 /// The JSON document, field for field (the order is the documented one).
@@ -46,6 +55,9 @@ struct Json<'a> {
     steps: Vec<StepJson<'a>>,
     unsafe_sets: Vec<UnsafeJson<'a>>,
     verdict: VerdictJson<'a>,
+    /// The probability of safety (`reachc run --probability` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    safety_probability: Option<ProbabilityJson<'a>>,
     validated: ValidationJson,
     hints: Vec<HintJson<'a>>,
     /// The members of the intersection (the PRS is the intersection:
@@ -278,6 +290,7 @@ impl<'a> Json<'a> {
                     set: &prs.unsafe_sets[set].name,
                 },
             },
+            safety_probability: None,
             validated: ValidationJson {
                 rigorous: prs.validation.rigorous.iter().map(proved).collect(),
                 not_validated: prs.validation.not_validated.iter().map(unproved).collect(),
