@@ -11,6 +11,9 @@ use reachc_core::model::{
 use reachc_core::prs::{BallBound, DetSet, Prs, Span, Unproved, UnsafeKind, Verdict};
 use reachc_core::{InputPlan, Reach, System};
 
+mod common;
+use common::Pend;
+
 // ---------------------------------------------------------------------------------------------
 // Systems
 // ---------------------------------------------------------------------------------------------
@@ -120,55 +123,6 @@ impl System for WithInput {
     }
 }
 
-/// The paper's inverted pendulum with feedback: `theta' = omega`,
-/// `omega' = 10 sin(theta) - 20 theta - 20 omega`, `G = [0, 0.1]'`.
-struct Pendulum;
-
-impl System for Pendulum {
-    fn n(&self) -> usize {
-        2
-    }
-    fn p(&self) -> usize {
-        0
-    }
-    fn m(&self) -> usize {
-        1
-    }
-    fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = x[1];
-        out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-    }
-    fn drift_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = x[1];
-        out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-    }
-    fn jac_x(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[0.0, 1.0, 10.0 * x[0].cos() - 20.0, -20.0]);
-    }
-    fn jac_x_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ZERO;
-        out[1] = Interval::ONE;
-        out[2] = 10.0 * x[0].cos() - 20.0;
-        out[3] = Interval::point(-20.0);
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-    fn jac_u_interval(
-        &self,
-        _x: &[Interval],
-        _u: &[Interval],
-        _t: Interval,
-        _out: &mut [Interval],
-    ) {
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[0.0, 0.1]);
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ZERO;
-        out[1] = Interval::point(0.1);
-    }
-}
-
 // ---------------------------------------------------------------------------------------------
 // Model data
 // ---------------------------------------------------------------------------------------------
@@ -251,7 +205,7 @@ fn input_setup() -> (WithInput, ModelInfo, Analysis) {
 const PENDULUM_P: [f64; 4] = [35.68, 2.21, 2.21, 1.27];
 
 /// System (e): the pendulum with the paper's constants.
-fn pendulum_setup() -> (Pendulum, ModelInfo, Analysis) {
+fn pendulum_setup() -> (Pend, ModelInfo, Analysis) {
     let pi10 = std::f64::consts::PI / 10.0;
     let inf = info(
         "pendulum",
@@ -261,7 +215,7 @@ fn pendulum_setup() -> (Pendulum, ModelInfo, Analysis) {
     );
     // The paper's constants (Sec. VIII-B).
     let constants = Constants::given(&inf, PENDULUM_P.to_vec(), -0.5, 0.1130, 0.0);
-    (Pendulum, inf, analysis(1e-3, 4.0, 0.01, constants))
+    (Pend::PAPER, inf, analysis(1e-3, 4.0, 0.01, constants))
 }
 
 /// A result and the results it is intersected with.

@@ -11,6 +11,9 @@ use reachc_core::model::{
 use reachc_core::prs::{DetSet, Prs, Unproved, Verdict};
 use reachc_core::{Reach, System};
 
+mod common;
+use common::Pend;
+
 // ---------------------------------------------------------------------------------------------
 // Systems
 // ---------------------------------------------------------------------------------------------
@@ -51,55 +54,6 @@ impl System for Lin {
     }
     fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
         out[0] = Interval::point(0.1);
-    }
-}
-
-/// The paper's pendulum: `theta' = omega`, `omega' = 10 sin(theta) - 20 theta - 20 omega`,
-/// `G = [0, 0.1]'`.
-struct Pendulum;
-
-impl System for Pendulum {
-    fn n(&self) -> usize {
-        2
-    }
-    fn p(&self) -> usize {
-        0
-    }
-    fn m(&self) -> usize {
-        1
-    }
-    fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = x[1];
-        out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-    }
-    fn drift_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = x[1];
-        out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-    }
-    fn jac_x(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[0.0, 1.0, 10.0 * x[0].cos() - 20.0, -20.0]);
-    }
-    fn jac_x_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ZERO;
-        out[1] = Interval::ONE;
-        out[2] = 10.0 * x[0].cos() - 20.0;
-        out[3] = Interval::point(-20.0);
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-    fn jac_u_interval(
-        &self,
-        _x: &[Interval],
-        _u: &[Interval],
-        _t: Interval,
-        _out: &mut [Interval],
-    ) {
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[0.0, 0.1]);
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ZERO;
-        out[1] = Interval::point(0.1);
     }
 }
 
@@ -398,9 +352,9 @@ fn linear_safety_and_membership() {
 fn pendulum_boxes_contain_sampled_trajectories() {
     let info = pendulum_info(vec![]);
     let a = analysis(4.0, 0.01, Integrator::Rk4, pendulum_constants());
-    let jac = run_with(&Pendulum, &info, &a, Inclusion::Jacobian).unwrap();
-    let nat = run_with(&Pendulum, &info, &a, Inclusion::Natural);
-    let mixed = run_with(&Pendulum, &info, &a, Inclusion::Mixed).unwrap();
+    let jac = run_with(&Pend::PAPER, &info, &a, Inclusion::Jacobian).unwrap();
+    let nat = run_with(&Pend::PAPER, &info, &a, Inclusion::Natural);
+    let mixed = run_with(&Pend::PAPER, &info, &a, Inclusion::Mixed).unwrap();
     let th = std::f64::consts::PI / 10.0;
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let sub = 20; // fine step 0.0005
@@ -415,7 +369,7 @@ fn pendulum_boxes_contain_sampled_trajectories() {
             if k > 0 {
                 let h = (st.t - jac.steps[k - 1].t) / sub as f64;
                 for _ in 0..sub {
-                    rk4_step(&Pendulum, &mut x, h);
+                    rk4_step(&Pend::PAPER, &mut x, h);
                 }
             }
             let mut results = vec![&jac, &mixed];

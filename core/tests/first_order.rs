@@ -4,63 +4,15 @@
 //! closed-form `exp(A t)` image of the initial box with a remainder at rounding level.
 
 use reachc_core::engine;
-use reachc_core::interval::Interval;
 use reachc_core::model::{
     Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo,
 };
 use reachc_core::prs::{DetSet, Prs};
 use reachc_core::System;
 
-/// `theta' = omega`, `omega' = k sin(theta) - 20 theta - 20 omega` (the paper's pendulum for
-/// `k = 10`, linear for `k = 0`), noise `0.1` on omega.
-struct Pend {
-    k: f64,
-}
+mod common;
 
-impl System for Pend {
-    fn n(&self) -> usize {
-        2
-    }
-    fn p(&self) -> usize {
-        0
-    }
-    fn m(&self) -> usize {
-        1
-    }
-    fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = x[1];
-        out[1] = self.k * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-    }
-    fn drift_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = x[1];
-        out[1] = Interval::point(self.k) * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-    }
-    fn jac_x(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[0.0, 1.0, self.k * x[0].cos() - 20.0, -20.0]);
-    }
-    fn jac_x_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ZERO;
-        out[1] = Interval::ONE;
-        out[2] = Interval::point(self.k) * x[0].cos() - 20.0;
-        out[3] = Interval::point(-20.0);
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-    fn jac_u_interval(
-        &self,
-        _x: &[Interval],
-        _u: &[Interval],
-        _t: Interval,
-        _out: &mut [Interval],
-    ) {
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[0.0, 0.1]);
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ZERO;
-        out[1] = Interval::point(0.1);
-    }
-}
+use common::Pend;
 
 const P: [f64; 4] = [35.68, 2.21, 2.21, 1.27];
 const HALF: [f64; 2] = [std::f64::consts::PI / 10.0, 0.2];
@@ -192,7 +144,7 @@ fn check(sys: &Pend, prs: &Prs, times: &[f64]) -> Vec<(f64, f64, [f64; 2], [f64;
 
 #[test]
 fn pendulum_first_order_sets_hold_the_sampled_flows_both_methods() {
-    let sys = Pend { k: 10.0 };
+    let sys = Pend::PAPER;
     for method in [Method::Contraction, Method::Interval] {
         let (info, analysis) = setup(method);
         let prs = engine::run(&sys, &info, &analysis).expect("runs");
