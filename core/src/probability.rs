@@ -77,13 +77,13 @@ pub enum SafetyLimit {
         /// Unsafe set index.
         set: usize,
     },
-    /// A run failed (the diagnostic says why) at `delta`, the smallest `delta` tried after the
-    /// last one shown safe: treated as not shown safe.
+    /// A run failed at `delta`, the smallest `delta` tried after the last one shown safe:
+    /// treated as not shown safe.
     Failed {
         /// The `delta` whose run failed.
         delta: f64,
-        /// The run's error, as text.
-        why: String,
+        /// Why it failed.
+        why: RunError,
     },
 }
 
@@ -152,16 +152,12 @@ impl Reach<'_> {
             }
         }
         let limit = match (&best, &worst) {
+            (_, Some((delta, Err(e)))) => SafetyLimit::Failed {
+                delta: *delta,
+                why: e.clone(),
+            },
             (Some(_), None) => SafetyLimit::Floor,
-            (Some(_), Some((delta, Err(e)))) => SafetyLimit::Failed {
-                delta: *delta,
-                why: e.to_string(),
-            },
             (Some(_), Some(_)) => SafetyLimit::Resolution,
-            (None, Some((delta, Err(e)))) => SafetyLimit::Failed {
-                delta: *delta,
-                why: e.to_string(),
-            },
             (None, Some((_, Ok(p)))) => match engine::deterministic_limit(sets, p) {
                 Some((k, set)) => SafetyLimit::Deterministic {
                     t: p.steps[k].t,

@@ -628,7 +628,9 @@ impl ReachHandle {
             SafetyLimit::Floor => ("floor", None, None, None),
             SafetyLimit::Stochastic { t, set } => ("stochastic", Some(*t), name(*set), None),
             SafetyLimit::Deterministic { t, set } => ("deterministic", Some(*t), name(*set), None),
-            SafetyLimit::Failed { delta, why } => ("failed", Some(*delta), None, Some(why.clone())),
+            SafetyLimit::Failed { delta, why } => {
+                ("failed", Some(*delta), None, Some(why.to_string()))
+            }
         };
         Ok(SafetyProbabilityPy {
             horizon: p.horizon,

@@ -475,9 +475,9 @@ fn run_analyses<S: System + Sync>(
     let mut failures = Failures::new(collect, opts.error_lines);
     let (mut files, mut not_safe) = (Files::new(), false);
     for &name in &selected {
-        let reach = Reach::new(sys, info, name);
-        let res = match reach.as_ref().map_err(Clone::clone).and_then(|r| r.run()) {
-            Ok(res) => res,
+        let ran = Reach::new(sys, info, name).and_then(|r| r.run().map(|res| (r, res)));
+        let (reach, res) = match ran {
+            Ok(ran) => ran,
             Err(RunError::Unsupported(why)) => {
                 let _ = writeln!(err, "skipped analysis `{name}`: {why}");
                 continue;
@@ -488,10 +488,8 @@ fn run_analyses<S: System + Sync>(
             }
         };
         // The probability of safety, where it is asked for and defined.
-        let probability = match (&reach, opts.probability) {
-            (Ok(reach), true) if !info.unsafe_sets.is_empty() => Some(reach.safety_probability()),
-            _ => None,
-        };
+        let probability =
+            (opts.probability && !info.unsafe_sets.is_empty()).then(|| reach.safety_probability());
         if !opts.quiet {
             let _ = write!(out, "{}", report::summary(&res));
             match &probability {

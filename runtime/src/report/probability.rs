@@ -29,7 +29,7 @@ enum LimitJson<'a> {
     Floor,
     Stochastic { t: f64, set: &'a str },
     Deterministic { t: f64, set: &'a str },
-    Failed { delta: f64, why: &'a str },
+    Failed { delta: f64, why: String },
 }
 
 impl<'a> ProbabilityJson<'a> {
@@ -51,7 +51,10 @@ impl<'a> ProbabilityJson<'a> {
                     t: *t,
                     set: name(*set),
                 },
-                SafetyLimit::Failed { delta, why } => LimitJson::Failed { delta: *delta, why },
+                SafetyLimit::Failed { delta, why } => LimitJson::Failed {
+                    delta: *delta,
+                    why: why.to_string(),
+                },
             },
             runs: p.runs,
             proved: p.validation.not_validated.is_empty(),
