@@ -53,6 +53,10 @@ pub struct ModelInfo {
     /// `X_t - x_t` is exactly Gaussian (method.md section 8.1) and engines size the stochastic
     /// part from its covariance.
     pub affine: bool,
+    /// Whether `G` is constant (no state, input, time or table in it: additive noise). Then
+    /// the noise of the linearisation along the nominal cancels the model's exactly and the
+    /// first-order sets get a Gaussian part (method.md 8.10).
+    pub constant_diffusion: bool,
     /// Unsafe sets.
     pub unsafe_sets: Vec<UnsafeSet>,
     /// The analyses, with their certified constants.

@@ -108,16 +108,20 @@ pub enum Role {
     Box,
     /// The first-order sets of the same run, at the same delta (method.md 8.8).
     FirstOrder,
+    /// The linearised Gaussian sets of the same run (method.md 8.10): first-order zonotopes
+    /// holding the stochastic part too, at their own share of delta.
+    Linearised,
 }
 
 impl Role {
-    /// The role's name in outputs: `own`, `metric`, `box`, `first_order`.
+    /// The role's name in outputs: `own`, `metric`, `box`, `first_order`, `linearised`.
     pub fn name(self) -> &'static str {
         match self {
             Role::Own => "own",
             Role::Metric => "metric",
             Role::Box => "box",
             Role::FirstOrder => "first_order",
+            Role::Linearised => "linearised",
         }
     }
 }
@@ -651,6 +655,13 @@ pub enum Proved {
     ExactGaussian,
     /// The time-uniform Gaussian mixture bound on `epochs` epochs at `delta / epochs` each.
     GaussianMixture {
+        /// The number of epochs.
+        epochs: usize,
+    },
+    /// The linearised Gaussian sets (method.md 8.10): the linearisation's covariance along the
+    /// nominal (enclosed), the mixture bound on `epochs` epochs (one per internal step), and the
+    /// linearisation's error bounded path by path on that event.
+    LinearisedGaussian {
         /// The number of epochs.
         epochs: usize,
     },

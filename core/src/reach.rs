@@ -7,7 +7,7 @@ use crate::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, Inclusion, InitialSet, Method, ModelInfo,
     Rate,
 };
-use crate::prs::{Prs, Role};
+use crate::prs::{Prs, Role, Verdict};
 use crate::system::System;
 
 /// An analysis of a model, ready to run: its parameters checked, its certified constants
@@ -216,48 +216,111 @@ impl<'a> Reach<'a> {
         check_initial(self.info, initial, own.rate != Rate::Local)?;
         // K metrics: each set at delta / K, the PRS their intersection (union bound).
         let k = 1 + self.also.len();
-        let spec = AnalysisSpec {
-            // Rounded down, so that the K shares sum to at most delta.
-            delta: (own.delta / k as f64).next_down(),
-            ..own.clone()
-        };
-        let run_with = |setup: &Setup| {
+        let run_with = |setup: &Setup, spec: &AnalysisSpec, gaussian: Option<f64>| {
             engine::run_engine(&Run {
                 sys: self.sys,
                 info: self.info,
-                spec: if k == 1 { own } else { &spec },
+                spec,
                 setup,
                 initial,
                 inputs,
+                gaussian,
             })
         };
-        let first = run_with(&self.setup);
-        if k == 1 {
-            // Alternatives: the result with the smallest box at the horizon (where one fails,
-            // the others still stand).
-            let size = |p: &Prs| p.hull(p.horizon).map_or(f64::INFINITY, |h| log_volume(&h));
-            let mut best = first;
-            for other in self.alternatives.iter().filter_map(|s| run_with(s).ok()) {
-                if best.as_ref().map_or(true, |b| size(&other) < size(b)) {
-                    best = Ok(other);
-                }
-            }
-            return best;
+        // With the linearised Gaussian sets (method.md 8.10) they take one more share of delta;
+        // of that and the plain run, the better (a choice made from the results alone, both
+        // being valid at delta).
+        let gaussian = engine::gaussian_wanted(self.info, own, initial, self.setup.n);
+        if k > 1 {
+            let several = |shares: usize, with_gaussian: bool| -> Result<Prs, RunError> {
+                // Rounded down, so that the shares sum to at most delta.
+                let spec = AnalysisSpec {
+                    delta: (own.delta / shares as f64).next_down(),
+                    ..own.clone()
+                };
+                let first = run_with(&self.setup, &spec, with_gaussian.then_some(spec.delta))?;
+                let others = self
+                    .also
+                    .iter()
+                    .map(|s| run_with(s, &spec, None).map(|p| p.with_role(Role::Metric)))
+                    .collect::<Result<_, _>>()?;
+                Ok(engine::intersect(
+                    self.info,
+                    &self.setup.checks,
+                    own.delta,
+                    first,
+                    others,
+                ))
+            };
+            let plain = several(k, false);
+            return match gaussian {
+                true => pick(plain, several(k + 1, true), own.delta),
+                false => plain,
+            };
         }
-        let first = first?;
-        let others = self
-            .also
-            .iter()
-            .map(|s| run_with(s).map(|p| p.with_role(Role::Metric)))
-            .collect::<Result<_, _>>()?;
-        Ok(engine::intersect(
-            self.info,
-            &self.setup.checks,
-            own.delta,
-            first,
-            others,
-        ))
+        let one = |setup: &Setup| {
+            let plain = run_with(setup, own, None);
+            if !gaussian {
+                return plain;
+            }
+            let half = AnalysisSpec {
+                delta: (own.delta / 2.0).next_down(),
+                ..own.clone()
+            };
+            pick(plain, run_with(setup, &half, Some(half.delta)), own.delta)
+        };
+        // Alternatives: the result with the smallest box at the horizon (where one fails, the
+        // others still stand).
+        let size = |p: &Prs| p.hull(p.horizon).map_or(f64::INFINITY, |h| log_volume(&h));
+        let mut best = one(&self.setup);
+        for other in self.alternatives.iter().filter_map(|s| one(s).ok()) {
+            if best.as_ref().map_or(true, |b| size(&other) < size(b)) {
+                best = Ok(other);
+            }
+        }
+        best
     }
+}
+
+/// Of the plain result of an analysis and the one `split` with the linearised Gaussian sets
+/// (method.md 8.10; both valid at `delta`), the [`better`]; the plain one when the split run
+/// fails or has no such set (it fails or cuts nowhere).
+fn pick(
+    plain: Result<Prs, RunError>,
+    split: Result<Prs, RunError>,
+    delta: f64,
+) -> Result<Prs, RunError> {
+    match split {
+        Ok(mut split) if split.also.iter().any(|m| m.role == Role::Linearised) => {
+            split.delta = delta;
+            match plain {
+                Ok(plain) if !better(&split, &plain) => Ok(plain),
+                _ => Ok(split),
+            }
+        }
+        _ => plain,
+    }
+}
+
+/// Whether `a` is the better of two results of one analysis: shown safe where `b` is not, or
+/// else bounding boxes of less volume summed (in logarithms) over the report times.
+fn better(a: &Prs, b: &Prs) -> bool {
+    let safe = |p: &Prs| matches!(p.verdict, Verdict::Safe);
+    if safe(a) != safe(b) {
+        return safe(a);
+    }
+    let size = |p: &Prs| -> f64 {
+        (1..p.steps.len())
+            .map(|k| {
+                p.hull_at(k).map_or(f64::INFINITY, |h| {
+                    h.iter()
+                        .map(|x| (0.5 * (x.hi - x.lo)).max(1e-300).ln())
+                        .sum()
+                })
+            })
+            .sum()
+    };
+    size(a) < size(b)
 }
 
 /// A known input signal: piecewise constant on the analysis' report steps, `u(t) = f(t_k)` on

@@ -178,6 +178,7 @@ fn info(
         domain: vec![Bounds::ENTIRE; n],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets: vec![],
         analyses: vec![],
     }

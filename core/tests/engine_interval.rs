@@ -102,6 +102,7 @@ fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
         domain: vec![Bounds::ENTIRE],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets,
         analyses: vec![],
     }
@@ -126,6 +127,7 @@ fn pendulum_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
         domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets,
         analyses: vec![],
     }

@@ -33,6 +33,7 @@ fn setup(method: Method) -> (ModelInfo, Analysis) {
         domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets: vec![],
         analyses: vec![],
     };

@@ -121,6 +121,7 @@ fn model(name: &str, x0: &[(f64, f64)], c: f64) -> ModelInfo {
         domain: vec![Bounds::ENTIRE; n],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets: vec![],
         analyses: vec![],
     };

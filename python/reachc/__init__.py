@@ -413,7 +413,8 @@ class Result:
     def role(self) -> str:
         """What this result is within an intersection: ``"own"`` for an analysis' result,
         ``"metric"`` (a further metric's, at ``delta / K``), ``"box"`` (the interval box of a
-        contraction run) or ``"first_order"`` (first-order zonotopes) for a member."""
+        contraction run), ``"first_order"`` (first-order zonotopes) or ``"linearised"`` (first-order
+        zonotopes holding the Gaussian part too) for a member."""
         return str(self._native.role)
 
     def to_json(self) -> str:

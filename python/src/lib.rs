@@ -942,7 +942,7 @@ impl ReachResult {
     }
 
     /// What this result is within an intersection: `"own"` for an analysis' result,
-    /// `"metric"`, `"box"` or `"first_order"` for a member.
+    /// `"metric"`, `"box"`, `"first_order"` or `"linearised"` for a member.
     #[getter]
     fn role(&self) -> &'static str {
         self.prs.role.name()

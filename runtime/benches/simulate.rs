@@ -89,6 +89,7 @@ fn info() -> ModelInfo {
         domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets: vec![],
         analyses: vec![],
     };

@@ -82,6 +82,7 @@ fn model(analyses: Vec<Analysis>) -> ModelInfo {
         domain: vec![Bounds::ENTIRE],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets: vec![],
         analyses,
     }

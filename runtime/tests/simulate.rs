@@ -118,6 +118,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
         domain: vec![Bounds::ENTIRE; n],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets: vec![UnsafeSet {
             name: "far".into(),
             shape: UnsafeShape::HalfSpace {

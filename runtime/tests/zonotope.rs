@@ -84,6 +84,7 @@ fn model() -> ModelInfo {
         domain: vec![Bounds::ENTIRE; 2],
         has_domain: false,
         affine: false,
+        constant_diffusion: false,
         unsafe_sets: vec![],
         analyses: vec![],
     };

@@ -14,7 +14,7 @@ use reachc_runtime::model::{
     Analysis, AutoFit, Bounds, Constants, Inclusion, Integrator, Method, ModelInfo, Rate,
     TransformSource,
 };
-use reachc_runtime::prs::{DetSet, Hint};
+use reachc_runtime::prs::{DetSet, Hint, Role};
 use reachc_runtime::{Prs, Reach, System};
 
 /// The shipped spec's model with the interpreter and its info.
@@ -381,9 +381,11 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
         "c = {}",
         contraction.constants.c
     );
-    // The default's own box still wraps; the first-order member cuts it.
+    // The default's own box still wraps; the first-order members (8.8, and 8.10: msd's noise
+    // is constant) cut it.
     let (box_lo, box_hi) = first.steps.last().unwrap().det.box_hull().unwrap();
-    assert_eq!(first.also.len(), 1);
+    let roles: Vec<Role> = first.also.iter().map(|m| m.role).collect();
+    assert_eq!(roles, [Role::FirstOrder, Role::Linearised]);
     for i in 0..2 {
         assert!(
             ha[i] <= 2.0 * hc[i],
@@ -417,11 +419,18 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
             // The hint's float sum against the PRS hull's outward-rounded one.
             assert!((half_width - hp[0]).abs() <= 1e-12 * hp[0], "{half_width}");
             assert!(*half_width > WRAPPING_FACTOR * ball_half_width);
-            // Near the contraction PRS (each analysis' metric is chosen for its own method's
-            // PRS, so the two differ a little).
+            // Near the contraction analysis' own ball (each analysis' metric is chosen for its
+            // own method's PRS, so the two differ a little; that ball is at delta / 2 beside the
+            // linearised Gaussian set of method.md 8.10, which makes the PRS itself smaller).
+            let ball = Prs {
+                also: Vec::new(),
+                ..contraction.clone()
+            };
+            let hb = final_half_widths(&ball);
             assert!(
-                (ball_half_width - hc[0]).abs() <= 0.05 * hc[0],
-                "{ball_half_width}"
+                (ball_half_width - hb[0]).abs() <= 0.1 * hb[0],
+                "{ball_half_width} vs {}",
+                hb[0]
             );
             assert_eq!(*c, plain.constants.c);
         }

@@ -155,8 +155,17 @@ fn metric_auto_is_never_worse_than_the_identity() {
             ) else {
                 continue;
             };
+            // Where the linearised Gaussian set (method.md 8.10) decides the result, the metric
+            // enters only through the nominal's defect, bounded in the P-norm, and through the
+            // shares of delta (per-state metrics: the set at delta / 3 against delta / 2 with
+            // one metric): within 0.05.
+            let slack = if a.also.iter().any(|m| m.role == Role::Linearised) {
+                0.05
+            } else {
+                1e-9
+            };
             assert!(
-                log_volume(&a) <= log_volume(&b) + 1e-9,
+                log_volume(&a) <= log_volume(&b) + slack,
                 "{} / {name}: auto {} > identity {}",
                 path.display(),
                 log_volume(&a),
@@ -261,11 +270,16 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
     let (sys, info) = shipped("pendulum.sde");
     let reach = Reach::new(&sys, &info, "contraction").unwrap();
     let prs = reach.run().unwrap();
-    // The box, and the first-order set (method.md 8.8, tests/tests/tighter_sets.rs below).
+    // The box, the first-order set (method.md 8.8, tests/tests/tighter_sets.rs below) and the
+    // linearised Gaussian set (8.10, tests/tests/linearised.rs), which takes half of delta:
+    // the run's own sets hold at the other half.
     let roles = |p: &Prs| p.also.iter().map(|m| m.role).collect::<Vec<_>>();
-    assert_eq!(roles(&prs), [Role::Box, Role::FirstOrder]);
+    assert_eq!(roles(&prs), [Role::Box, Role::FirstOrder, Role::Linearised]);
     let boxes = &prs.also[0];
-    assert_eq!((boxes.method, boxes.delta), (Method::Interval, prs.delta));
+    assert_eq!(
+        (boxes.method, boxes.delta),
+        (Method::Interval, (prs.delta / 2.0).next_down())
+    );
     // The same stochastic radii widen both sets.
     for (a, b) in prs.steps.iter().zip(&boxes.steps) {
         assert_eq!((a.t, a.r_t), (b.t, b.r_t));
@@ -292,7 +306,7 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
     assert!(prs.contains_at(k, &c));
 
     let prs = reach.with_delta(0.1).unwrap().run().unwrap();
-    assert_eq!(roles(&prs), [Role::Box, Role::FirstOrder]);
+    assert_eq!(roles(&prs), [Role::Box, Role::FirstOrder, Role::Linearised]);
     let paths = 4000;
     let opts = Options {
         paths,
@@ -334,8 +348,9 @@ fn first_order_sets_are_on_by_default_and_can_be_turned_off() {
     };
     let (on, written, off) = (run(""), run("first_order = on"), run("first_order = off"));
     let roles = |p: &Prs| p.also.iter().map(|m| m.role).collect::<Vec<_>>();
-    // The interval box of the run (method.md 8.7) cuts the ball too.
-    assert_eq!(roles(&on), [Role::Box, Role::FirstOrder]);
+    // The interval box of the run (method.md 8.7) cuts the ball too, and the noise is
+    // constant: the linearised Gaussian set (8.10) comes with the first-order one.
+    assert_eq!(roles(&on), [Role::Box, Role::FirstOrder, Role::Linearised]);
     assert_eq!(roles(&written), roles(&on));
     assert_eq!(roles(&off), [Role::Box]);
     assert_eq!(on.role, Role::Own);

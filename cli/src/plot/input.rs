@@ -46,7 +46,8 @@ pub struct ResultFile {
     pub role: Role,
 }
 
-/// What a result is within an intersection (`"metric"`, `"box"`, `"first_order"`; none for
+/// What a result is within an intersection (`"metric"`, `"box"`, `"first_order"`,
+/// `"linearised"`; none for
 /// the result itself).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -60,6 +61,8 @@ pub enum Role {
     Box,
     /// The first-order sets (zonotopes plus a remainder ball).
     FirstOrder,
+    /// The linearised Gaussian sets (zonotopes holding the stochastic part too).
+    Linearised,
 }
 
 /// The guarantee of a result (`"uniform"` or `"pointwise"`).

@@ -158,9 +158,9 @@ fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
 }
 
 /// Whether a result's own sets are first-order zonotopes (a member of role
-/// [`Role::FirstOrder`]; its set at `t = 0` is the initial box).
+/// [`Role::FirstOrder`] or [`Role::Linearised`]; its set at `t = 0` is the initial box).
 fn zonotopes(result: &ResultFile) -> bool {
-    result.role == Role::FirstOrder
+    matches!(result.role, Role::FirstOrder | Role::Linearised)
 }
 
 /// The projected PRS `poly` of report step `k` clipped by the projected PRS of each further
@@ -287,6 +287,9 @@ pub fn sets_scene(
         }
         if of(Role::FirstOrder) > 0 {
             parts.push("the first-order zonotope + B_P(remainder + r_t)".to_string());
+        }
+        if of(Role::Linearised) > 0 {
+            parts.push("the linearised Gaussian zonotope".to_string());
         }
         notes[1] = format!(
             "PRS: the intersection of {} (dashed: the first deterministic set); drawn: the \

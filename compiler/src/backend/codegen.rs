@@ -1768,6 +1768,7 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
     let domain = list(info.domain.iter().map(|&r| range(r)));
     let has_domain = info.has_domain;
     let affine = info.affine;
+    let constant_diffusion = info.constant_diffusion;
     let unsafe_sets: Vec<TokenStream> = info.unsafe_sets.iter().map(|u| w.unsafe_set(u)).collect();
     let unsafe_sets = list(unsafe_sets);
     let analyses: Vec<TokenStream> = info.analyses.iter().map(|a| w.analysis(a, info)).collect();
@@ -1803,6 +1804,7 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
                 domain: domain.clone(),
                 has_domain: #has_domain,
                 affine: #affine,
+                constant_diffusion: #constant_diffusion,
                 unsafe_sets: #unsafe_sets,
                 analyses: #analyses,
             }

@@ -80,6 +80,11 @@ pub fn prepare(model: &mut Model) -> Prepared {
         domain: model.domain.clone(),
         has_domain: model.has_domain,
         affine: is_affine(model, &derivatives),
+        constant_diffusion: model
+            .diffusion
+            .iter()
+            .flatten()
+            .all(|e| model.pool.vars_of(*e).is_empty()),
         unsafe_sets: model.unsafe_sets.clone(),
         analyses,
     };

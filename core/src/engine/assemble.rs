@@ -148,6 +148,19 @@ impl Radii {
     }
 }
 
+impl Radii {
+    /// No stochastic radius: for sets that hold the stochastic part themselves (method.md
+    /// 8.10), at `reports` report times after 0.
+    pub(super) fn inside(reports: usize) -> Radii {
+        Radii {
+            pointwise: vec![(0.0, 0.0); reports],
+            guaranteed: vec![(0.0, 0.0); reports],
+            uniform: None,
+            gaussian: None,
+        }
+    }
+}
+
 /// The AMGF tube's radii per report time `(at it, largest over its report interval)`, and its
 /// number of epochs.
 fn amgf_tube(run: &Run, det: &Deterministic) -> (Vec<(f64, f64)>, usize) {

@@ -166,7 +166,15 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     // The first-order sets (method.md 8.8), on the same nominal, with the same radii.
     let first = validated
         .then(|| {
-            first_order::deterministic(run, &steps, &header.initial_center, &grid, &inputs, r2)
+            first_order::deterministic(
+                run,
+                &steps,
+                &header.initial_center,
+                &grid,
+                &inputs,
+                r2,
+                run.gaussian,
+            )
         })
         .flatten();
     let radii = Radii::new(run, &det, header.kappa);
@@ -180,9 +188,8 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         header.rigorous[0] = rates_proved;
         members.push(assemble_with(run, det, header, None, radii.clone()).with_role(Role::Box));
     }
-    if let Some(det) = first {
-        members
-            .push(assemble_with(run, det, first_header, None, radii).with_role(Role::FirstOrder));
+    if let Some(first) = first {
+        members.extend(first_order::members(run, first, first_header, radii));
     }
     Ok(cut_by(run, ball, members))
 }

@@ -20,15 +20,16 @@
 //! floating-point midpoint `M_(k+1)`; the jump `(exp(A h) M_k - M_(k+1)) xi` is added to the
 //! remainder there.
 
-use super::assemble::{Deterministic, Piece};
+use super::assemble::{assemble_with, Deterministic, Header, Piece, Radii};
 use super::defect::NominalStep;
 use super::linalg::{product, to_intervals};
+use super::linearised::{StepData, Tracker};
 use super::local::Certifier;
 use super::radius::{expm1_over, BoxRadius};
 use super::{zonotope, Run};
 use crate::interval::Interval;
-use crate::model::Integrator;
-use crate::prs::{DetSet, Span};
+use crate::model::{AnalysisSpec, Guarantee, InitialSet, Integrator, ModelInfo};
+use crate::prs::{DetSet, Proved, Prs, Role, Span};
 
 /// Terms of the Taylor series of `exp(A tau)` before the remainder bound.
 const TAYLOR_TERMS: usize = 12;
@@ -44,16 +45,43 @@ pub const MAX_FIRST_ORDER_STATES: usize = 32;
 /// Whether `run` gets first-order sets: asked for (`first_order = on`, the default), a
 /// validated run, a box initial set, at most [`MAX_FIRST_ORDER_STATES`] states.
 pub(super) fn wanted(run: &Run) -> bool {
-    run.spec.first_order
-        && run.spec.integrator == Integrator::Validated
-        && run.initial.balls.is_empty()
-        && run.setup.n <= MAX_FIRST_ORDER_STATES
+    wanted_for(run.spec, run.initial, run.setup.n)
+}
+
+fn wanted_for(spec: &AnalysisSpec, initial: &InitialSet, n: usize) -> bool {
+    spec.first_order
+        && spec.integrator == Integrator::Validated
+        && initial.balls.is_empty()
+        && n <= MAX_FIRST_ORDER_STATES
+}
+
+/// Whether a run of `spec` from `initial` may get the linearised Gaussian sets (method.md
+/// 8.10): first-order sets [`wanted`], constant noise and a time-uniform guarantee.
+pub(crate) fn gaussian_wanted(
+    info: &ModelInfo,
+    spec: &AnalysisSpec,
+    initial: &InitialSet,
+    n: usize,
+) -> bool {
+    wanted_for(spec, initial, n) && info.constant_diffusion && spec.guarantee == Guarantee::Uniform
+}
+
+/// The first-order sets of a run, and with `gaussian = Some(delta')` (additive noise, a
+/// time-uniform guarantee) the linearised Gaussian sets at `delta'` (method.md 8.10) with their
+/// number of epochs.
+pub(super) struct FirstOrder {
+    /// The first-order deterministic sets (8.8).
+    pub(super) det: Deterministic,
+    /// The linearised Gaussian sets (8.10), the stochastic part inside their zonotopes, and the
+    /// mixture bound's number of epochs; `None` when not asked for or a step cannot be bounded.
+    pub(super) gaussian: Option<(Deterministic, usize)>,
 }
 
 /// The first-order sets of a run on the validated nominal's `steps` (each with its report
 /// interval), from the initial box `[x0 - half, x0 + half]`, inputs `inputs[k]` held by the
 /// nominal on report interval `k` and `r2` the input uncertainty; `None` when the run is not
-/// [`wanted`] or a step cannot be bounded (the result then goes without these sets).
+/// [`wanted`] or a step cannot be bounded (the result then goes without these sets). With
+/// `gaussian = Some(delta')`, also the linearised Gaussian sets at `delta'` where they apply.
 pub(super) fn deterministic(
     run: &Run,
     steps: &[(NominalStep, usize)],
@@ -61,10 +89,12 @@ pub(super) fn deterministic(
     grid: &[f64],
     inputs: &[Vec<f64>],
     r2: f64,
-) -> Option<Deterministic> {
+    gaussian: Option<f64>,
+) -> Option<FirstOrder> {
     if !wanted(run) {
         return None;
     }
+
     let n = run.setup.n;
     let sys = run.sys;
     let metric = &run.setup.consts.metric;
@@ -84,6 +114,8 @@ pub(super) fn deterministic(
         })
         .collect();
     let xi: Vec<Interval> = h.iter().map(|&v| Interval::new(-v, v)).collect();
+    let mut tracker = gaussian.and_then(|delta| Tracker::new(run, steps.len(), delta, &h));
+    let mut gauss_pieces = Vec::new();
     let zonotope_at = |center: &[f64], m: &[f64], remainder: f64| {
         // g_j = M_(., j) h_j.
         let h = &h;
@@ -202,6 +234,32 @@ pub(super) fn deterministic(
             return None;
         }
         grew = (after.hi() - rho.hi()).max(0.0);
+        let report = t1 == grid[k + 1];
+        if let Some(tr) = tracker.as_mut() {
+            let hull: Vec<Interval> = (0..n)
+                .map(|i| Interval::new(step.lo[i], step.hi[i]))
+                .collect();
+            let data = StepData {
+                a: &a,
+                exp_h: &exp_h,
+                exp_over: &exp_over,
+                span,
+                times,
+                hull: &hull,
+                v: &v,
+                u,
+                defect: step.defect,
+                jump: &jump,
+                x1: &step.x1,
+                m_next: &m_next,
+                half: &h,
+                report,
+            };
+            match tr.step(&data, (rates.c, rates.sigma)) {
+                Some(piece) => gauss_pieces.push(piece),
+                None => tracker = None,
+            }
+        }
         pieces.push(Piece {
             t1,
             rates: (rates.c, rates.sigma),
@@ -210,19 +268,52 @@ pub(super) fn deterministic(
                 hi: hbox.iter().map(|b| b.hi()).collect(),
                 radius: rho.hi().max(end.hi()),
             },
-            end: (t1 == grid[k + 1]).then(|| zonotope_at(&step.x1, &m_next, after.hi())),
+            end: report.then(|| zonotope_at(&step.x1, &m_next, after.hi())),
         });
         rho = Interval::point(after.hi());
         m = m_next;
         x.clone_from(&step.x1);
         t0 = t1;
     }
-    Some(Deterministic {
-        start,
-        pieces,
-        frame: None,
-        tube: None,
+    let gaussian = tracker.map(|tr| {
+        let det = Deterministic {
+            start: start.clone(),
+            pieces: gauss_pieces,
+            frame: None,
+            tube: None,
+        };
+        (det, tr.epochs())
+    });
+    Some(FirstOrder {
+        det: Deterministic {
+            start,
+            pieces,
+            frame: None,
+            tube: None,
+        },
+        gaussian,
     })
+}
+
+/// The members a run's first-order sets give (method.md 8.8, 8.10): the zonotopes widened by
+/// the run's stochastic radii, and the linearised Gaussian sets, which hold their stochastic
+/// part themselves.
+pub(super) fn members(run: &Run, first: FirstOrder, header: Header, radii: Radii) -> Vec<Prs> {
+    let mut out = vec![
+        assemble_with(run, first.det, header.clone(), None, radii).with_role(Role::FirstOrder)
+    ];
+    if let Some((det, epochs)) = first.gaussian {
+        let reports = det.pieces.iter().filter(|p| p.end.is_some()).count();
+        let mut prs = assemble_with(run, det, header, None, Radii::inside(reports));
+        prs.validation
+            .rigorous
+            .push(Proved::LinearisedGaussian { epochs });
+        if let Some(delta) = run.gaussian {
+            prs.delta = delta;
+        }
+        out.push(prs.with_role(Role::Linearised));
+    }
+    out
 }
 
 /// An enclosure of `exp(A tau)` for every `tau` in `tau` (`tau >= 0`): the Taylor polynomial
@@ -230,7 +321,7 @@ pub(super) fn deterministic(
 /// `a^(q+1) / (q+1)! / (1 - a / (q+2))` on every entry, `a = |A|_inf tau_max` (the remainder
 /// matrix's infinity norm bounds each of its entries). `None` if `a >= q + 2` or the entries
 /// are not finite.
-fn exp_enclosure(a: &[f64], n: usize, tau: Interval) -> Option<Vec<Interval>> {
+pub(super) fn exp_enclosure(a: &[f64], n: usize, tau: Interval) -> Option<Vec<Interval>> {
     let q = TAYLOR_TERMS;
     let norm = (0..n)
         .map(|i| {

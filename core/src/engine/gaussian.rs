@@ -333,9 +333,27 @@ impl Linear {
     }
 }
 
+/// Enclosures of `e^(A h)` and `int_0^h e^(A s) W e^(A' s) ds` for a point matrix `A` (row-major)
+/// and the interval matrix `w` (the linearisation's step of method.md 8.10; the metric is not
+/// used).
+pub(super) fn step_flow(
+    a: &[f64],
+    w: &[Interval],
+    n: usize,
+    h: Interval,
+) -> (Vec<Interval>, Vec<Interval>) {
+    let lin = Linear {
+        n,
+        a: a.iter().map(|&v| Interval::point(v)).collect(),
+        w: w.to_vec(),
+        r: Vec::new(),
+    };
+    lin.flow(1.0, h)
+}
+
 /// `eta` minimising `(1 + eta)(2 L + n ln(1 + 1/eta))`, the squared radius factor at an epoch's
 /// end (golden section on `ln eta`; any `eta > 0` is valid).
-fn best_eta(n: usize, log_inv: f64) -> f64 {
+pub(super) fn best_eta(n: usize, log_inv: f64) -> f64 {
     let f = |u: f64| {
         let eta = u.exp();
         (1.0 + eta) * (2.0 * log_inv + n as f64 * (1.0 / eta).ln_1p())
@@ -354,11 +372,11 @@ fn best_eta(n: usize, log_inv: f64) -> f64 {
 }
 
 /// `M X M'`.
-fn congruence(m: &Mat, x: &Mat, n: usize) -> Mat {
+pub(super) fn congruence(m: &Mat, x: &Mat, n: usize) -> Mat {
     product(&product(m, x, n, n, n), &transpose(m, n), n, n, n)
 }
 
-fn add(a: &Mat, b: &Mat) -> Mat {
+pub(super) fn add(a: &Mat, b: &Mat) -> Mat {
     a.iter().zip(b).map(|(x, y)| *x + *y).collect()
 }
 

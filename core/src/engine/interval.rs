@@ -39,7 +39,7 @@ use super::{
 use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
-use crate::prs::{DetSet, Proved, Prs, R1Bound, Role, Span, TransformUsed, Unproved};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, Span, TransformUsed, Unproved};
 use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
@@ -77,9 +77,8 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
     let first_header = header.clone();
     let prs = assemble_with(run, det, header, local, radii.clone());
     let members = first
-        .map(|det| assemble_with(run, det, first_header, None, radii).with_role(Role::FirstOrder))
-        .into_iter()
-        .collect();
+        .map(|first| first_order::members(run, first, first_header, radii))
+        .unwrap_or_default();
     // Hints on what the user gets: the intersection (a box that wraps is no news where the
     // first-order set keeps the result tight).
     let mut prs = cut_by(run, prs, members);
@@ -90,11 +89,11 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
 /// The first-order sets of an interval run: the validated nominal from the initial set's
 /// centre `x0` (the contraction method's, `r1` setting its accuracy), then
 /// [`first_order::deterministic`]; `None` where either cannot be computed.
-fn first_order_of(run: &Run, r1: f64, x0: &[f64]) -> Option<Deterministic> {
+fn first_order_of(run: &Run, r1: f64, x0: &[f64]) -> Option<first_order::FirstOrder> {
     let grid = nominal::time_grid(run.spec.horizon, run.spec.step);
     let (inputs, r2) = run.nominal_inputs(&grid);
     let steps = contraction::nominal_steps(run, x0, r1, &grid, &inputs).ok()?;
-    first_order::deterministic(run, &steps, x0, &grid, &inputs, r2)
+    first_order::deterministic(run, &steps, x0, &grid, &inputs, r2, run.gaussian)
 }
 
 /// The deterministic part of an interval run (the embedding's boxes on its steps, with the

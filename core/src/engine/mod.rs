@@ -30,6 +30,7 @@ mod hints;
 mod intersect;
 pub(crate) mod interval;
 pub(crate) mod linalg;
+mod linearised;
 mod local;
 mod nominal;
 mod r1;
@@ -42,6 +43,7 @@ pub(crate) mod zonotope;
 
 pub use contraction::MAX_BOX_STATES;
 pub use culprit::{Culprit, Detail, Setting};
+pub(crate) use first_order::gaussian_wanted;
 pub use first_order::MAX_FIRST_ORDER_STATES;
 pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
@@ -239,6 +241,10 @@ pub(crate) struct Run<'a> {
     pub(crate) setup: &'a Setup<'a>,
     pub(crate) initial: &'a InitialSet,
     pub(crate) inputs: Inputs<'a>,
+    /// The share of delta of the linearised Gaussian sets (method.md 8.10), when the run is
+    /// to compute them (the rest of the run then holds at `spec.delta`, the two shares summing
+    /// to the analysis' delta).
+    pub(crate) gaussian: Option<f64>,
 }
 
 impl Run<'_> {

@@ -504,6 +504,7 @@ mod tests {
             domain: vec![Bounds::ENTIRE; 2],
             has_domain: false,
             affine: false,
+            constant_diffusion: false,
             unsafe_sets: if inputs {
                 vec![UnsafeSet {
                     name: "far".into(),

@@ -1140,6 +1140,7 @@ mod tests {
             domain: vec![Bounds::ENTIRE; 2],
             has_domain: false,
             affine: false,
+            constant_diffusion: false,
             unsafe_sets: vec![],
             analyses: vec![],
         };

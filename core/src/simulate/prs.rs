@@ -1185,6 +1185,7 @@ pub(super) mod tests {
             domain: vec![Bounds::ENTIRE; 2],
             has_domain: false,
             affine: false,
+            constant_diffusion: false,
             unsafe_sets: vec![],
             analyses: vec![],
         };

@@ -288,6 +288,7 @@ mod tests {
             domain: vec![Bounds::ENTIRE],
             has_domain: false,
             affine: false,
+            constant_diffusion: false,
             unsafe_sets: vec![],
             analyses: vec![],
         }

@@ -570,6 +570,13 @@ fn proved(p: &Proved) -> String {
              averaged-MGF tube): one event, of probability at least 1 - delta, for all t in \
              [0, horizon]"
         ),
+        Proved::LinearisedGaussian { epochs } => format!(
+            "linearised Gaussian sets: the covariance of the linearisation along the nominal \
+             (enclosed), Ville's inequality on the method-of-mixtures martingale over {epochs} \
+             epochs (one per internal step) at their share of delta, and the linearisation's \
+             error bounded path by path on that event (interval Jacobians and input \
+             Jacobians on a box holding the state, propagated by the linear flow)"
+        ),
     }
 }
 
@@ -608,9 +615,9 @@ fn shown_states(prs: &Prs) -> Vec<usize> {
 }
 
 /// Whether a result's own sets are first-order zonotopes (a member of role
-/// [`Role::FirstOrder`]; its set at `t = 0` is the initial box).
+/// [`Role::FirstOrder`] or [`Role::Linearised`]; its set at `t = 0` is the initial box).
 fn zonotopes(prs: &Prs) -> bool {
-    prs.role == Role::FirstOrder
+    matches!(prs.role, Role::FirstOrder | Role::Linearised)
 }
 
 /// CSV with header `t,<output state names...>,det_radius,r_t,psi,c,sigma,prs_radius` and one
@@ -1062,6 +1069,18 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             ),
             num(last.map_or(f64::NAN, |st| st.det.ball_added())),
             num(last.map_or(f64::NAN, |st| st.det.radius()))
+        );
+    }
+    for m in prs.also.iter().filter(|m| m.role == Role::Linearised) {
+        let _ = writeln!(
+            s,
+            "  cut by the linearised Gaussian set (delta = {} of it; the other sets at the \
+             rest): the PRS also lies in a zonotope holding the initial box under the flow's \
+             linearisation, the linearisation's error and its Gaussian part, for all t at once \
+             (P-radius {} at the horizon); the boxes, margins and verdicts below are the \
+             intersection's",
+            num(m.delta),
+            num(m.steps.last().map_or(f64::NAN, |st| st.det.radius()))
         );
     }
     for (j, m) in prs

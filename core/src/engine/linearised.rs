@@ -1,0 +1,505 @@
+//! The linearised Gaussian part of the first-order sets (method.md 8.10): with additive noise
+//! (`G` constant), the state is compared with `p + M xi + Z`, `Z` the Gaussian solution of the
+//! linearisation along the nominal, and the difference `W` is bounded path by path.
+//!
+//! On an internal step `[t_k, t_(k+1)]` of the first-order sets (8.8) the nominal `p`, the
+//! matrix curve `M' = A_k M` and the box `V = [M] Xi` are given. `Z` solves
+//! `dZ = A_k Z dt + G dW`, `Z_0 = 0`, so `Z_t ~ N(0, Sigma_t)` with
+//! `Sigma_(k+1) = E Sigma_k E' + int_0^h e^(A s) G G' e^(A' s) ds` (enclosed). Since `G` is
+//! constant the noise cancels in `W = X - p - M xi - Z`:
+//!
+//! ```text
+//! W' = A_k W + (Jbar - A_k)(M xi + Z + W) + (f(X, u) - f(X, u*)) - d,
+//! ```
+//!
+//! `Jbar` the mean of `D_x f` on the segment from `p` to `X`. On the event that `Z` stays in the
+//! per-step boxes of the mixture bound (probability `1 - delta`, one epoch per internal step),
+//! the forcing is bounded per coordinate on a box holding `X`, and `W` is propagated by the
+//! linear flow itself (a zonotope), not by a contraction rate: a remainder in a fast direction is
+//! damped as fast as the flow damps it.
+
+use super::assemble::Piece;
+use super::first_order::exp_enclosure;
+use super::gaussian::{add, best_eta, congruence, step_flow};
+use super::linalg::product;
+use super::{zonotope, Inputs, Run};
+use crate::interval::Interval;
+use crate::kappa::log_inv_delta_upper;
+use crate::model::Guarantee;
+use crate::prs::{DetSet, Span};
+
+/// Attempts per step to find an a-priori box for `W` that holds its own bound.
+const MAX_TRIES: usize = 12;
+
+/// `W`'s zonotope keeps at most this many generators per state; beyond, the smallest are
+/// replaced by their bounding box.
+const ORDER: usize = 4;
+
+/// The P-ball added to each set, relative to its radius (see [`Tracker::set_at`]).
+const SLACK: f64 = 1e-6;
+
+/// What one internal step of the first-order sets hands over (method.md 8.8's quantities).
+pub(super) struct StepData<'s> {
+    /// The point matrix `A_k`, row-major.
+    pub(super) a: &'s [f64],
+    /// `exp(A_k h)`, enclosed.
+    pub(super) exp_h: &'s [Interval],
+    /// `exp(A_k tau)` for every `tau` in `[0, h]`, enclosed.
+    pub(super) exp_over: &'s [Interval],
+    /// The step's length and its time range.
+    pub(super) span: Interval,
+    pub(super) times: Interval,
+    /// The nominal's hull over the step.
+    pub(super) hull: &'s [Interval],
+    /// `V = [M] Xi` over the step.
+    pub(super) v: &'s [Interval],
+    /// The nominal input on the step.
+    pub(super) u: &'s [f64],
+    /// `|d|_P` over the step (the nominal's defect).
+    pub(super) defect: f64,
+    /// Per coordinate, a bound of the node's jump `(E M_k - M_(k+1)) xi`.
+    pub(super) jump: &'s [f64],
+    /// The nominal at the step's end.
+    pub(super) x1: &'s [f64],
+    /// `M_(k+1)` (floating point, row-major).
+    pub(super) m_next: &'s [f64],
+    /// The initial box's half-widths.
+    pub(super) half: &'s [f64],
+    /// Whether the step ends at a report time.
+    pub(super) report: bool,
+}
+
+/// The linearised Gaussian sets along the steps of one run.
+pub(super) struct Tracker<'r> {
+    run: &'r Run<'r>,
+    n: usize,
+    /// `G G'`, enclosed.
+    noise: Vec<Interval>,
+    /// `Sigma` at the current node.
+    sigma: Vec<Interval>,
+    /// `(1 + eta) beta` of the mixture bound at `delta / K`.
+    factor: Interval,
+    /// `W`'s zonotope (centre 0): its generators.
+    gens: Vec<Vec<f64>>,
+    /// Per coordinate, `sqrt((P^-1)_ii)` rounded up (P-norm bounds to coordinates).
+    w: Vec<f64>,
+    /// Per coordinate, the growth of `W`'s hull over the previous step (the next guess).
+    grew: Vec<f64>,
+    /// The internal steps (epochs) the bound was laid out for.
+    epochs: usize,
+    /// Per state, whether it is pinned: a point start that neither noise, nor an input, nor
+    /// another state's spread reaches (see [`pinned`]).
+    pinned: Vec<bool>,
+}
+
+impl<'r> Tracker<'r> {
+    /// A tracker for `run` over `epochs` internal steps at probability level `delta`, or `None`
+    /// when the model's noise is not constant or the run's guarantee is not time-uniform.
+    pub(super) fn new(
+        run: &'r Run<'r>,
+        epochs: usize,
+        delta: f64,
+        half: &[f64],
+    ) -> Option<Tracker<'r>> {
+        let n = run.setup.n;
+        if !run.info.constant_diffusion || run.spec.guarantee != Guarantee::Uniform || epochs == 0 {
+            return None;
+        }
+        let m = run.sys.m();
+        let mut g = vec![Interval::ZERO; n * m];
+        run.sys.diffusion_interval(
+            &vec![Interval::ENTIRE; n],
+            Interval::new(0.0, run.spec.horizon),
+            &mut g,
+        );
+        if g.iter().any(|v| !v.is_bounded()) {
+            return None;
+        }
+        let pinned = pinned(run, &g, half);
+        let noise: Vec<Interval> = (0..n * n)
+            .map(|k| {
+                let (i, j) = (k / n, k % n);
+                (0..m).fold(Interval::ZERO, |s, l| s + g[i * m + l] * g[j * m + l])
+            })
+            .collect();
+        // One epoch per internal step, each at delta / K (union bound).
+        let log_inv = log_inv_delta_upper((delta / epochs as f64).next_down());
+        let eta = best_eta(n, log_inv);
+        let eta_i = Interval::point(eta);
+        let beta = Interval::point(2.0) * Interval::point(log_inv)
+            + Interval::point(n as f64) * (Interval::ONE + eta_i.recip()).ln();
+        let factor = Interval::point(((Interval::ONE + eta_i) * beta).hi());
+        Some(Tracker {
+            run,
+            n,
+            noise,
+            sigma: vec![Interval::ZERO; n * n],
+            factor,
+            gens: Vec::new(),
+            w: run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect(),
+            grew: vec![0.0; n],
+            epochs,
+            pinned,
+        })
+    }
+
+    /// The number of epochs of the mixture bound (one per internal step).
+    pub(super) fn epochs(&self) -> usize {
+        self.epochs
+    }
+
+    /// Advances over one internal step: the piece of the linearised Gaussian set, or `None`
+    /// when the step cannot be bounded (the run then goes without this set).
+    pub(super) fn step(&mut self, d: &StepData, rates: (f64, f64)) -> Option<Piece> {
+        let n = self.n;
+        let point = Interval::point;
+        // Sigma at the step's end, and S >= Sigma + eps I, S = mid(Sigma) + 2 eps I.
+        let (_, gamma) = step_flow(d.a, &self.noise, n, d.span);
+        self.sigma = add(&congruence(&d.exp_h.to_vec(), &self.sigma, n), &gamma);
+        let eps = (0..n)
+            .map(|i| {
+                (0..n)
+                    .fold(Interval::ZERO, |s, j| {
+                        let v = self.sigma[i * n + j];
+                        s + point((point(v.hi()) - point(v.mid())).hi())
+                            + point((point(v.mid()) - point(v.lo())).hi())
+                    })
+                    .hi()
+            })
+            .fold(0.0, f64::max);
+        let eps = (2.0 * eps).max(f64::MIN_POSITIVE);
+        let s: Vec<Interval> = (0..n * n)
+            .map(|k| {
+                let mid = point(self.sigma[k].mid());
+                if k / n == k % n {
+                    mid + point(eps)
+                } else {
+                    mid
+                }
+            })
+            .collect();
+        // Z over the step: Z_t = e^(-A (t_(k+1) - t)) M_t, M_t in the ellipsoid factor * S.
+        let neg: Vec<f64> = d.a.iter().map(|v| -v).collect();
+        let back = exp_enclosure(&neg, n, Interval::new(0.0, d.span.hi()))?;
+        let fs = product(&back, &s, n, n, n);
+        let z_over: Vec<f64> = (0..n)
+            .map(|i| {
+                let q = (0..n).fold(Interval::ZERO, |acc, j| {
+                    acc + fs[i * n + j] * back[i * n + j]
+                });
+                (self.factor * point(q.hi().max(0.0))).sqrt().hi()
+            })
+            .collect();
+        let z_end: Vec<f64> = (0..n)
+            .map(|i| {
+                (self.factor * point(s[i * n + i].hi().max(0.0)))
+                    .sqrt()
+                    .hi()
+            })
+            .collect();
+        if z_over.iter().chain(&z_end).any(|z| !z.is_finite()) {
+            return None;
+        }
+        // W over the step, on an a-priori box that must hold it.
+        let gi: Vec<Interval> = self.gens_matrix();
+        let m = self.gens.len();
+        let fg = product(d.exp_over, &gi, n, n, m);
+        let base: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..m)
+                    .fold(Interval::ZERO, |s, j| s + point(fg[i * m + j].mag()))
+                    .hi()
+            })
+            .collect();
+        let ui: Vec<Interval> = d.u.iter().map(|&x| point(x)).collect();
+        let mut cap: Vec<f64> = base
+            .iter()
+            .zip(&self.grew)
+            .map(|(b, g)| 1.25 * (b + g) + f64::MIN_POSITIVE)
+            .collect();
+        let mut jac = vec![Interval::ZERO; n * n];
+        let mut accepted = None;
+        for _ in 0..MAX_TRIES {
+            // X - p lies in dev = V + Z + W; the region holds p + dev.
+            let dev: Vec<Interval> = (0..n)
+                .map(|i| {
+                    d.v[i] + Interval::new(-z_over[i], z_over[i]) + Interval::new(-cap[i], cap[i])
+                })
+                .collect();
+            let region: Vec<Interval> = (0..n).map(|i| d.hull[i] + dev[i]).collect();
+            self.run.sys.jac_x_interval(&region, &ui, d.times, &mut jac);
+            let du = input_change(self.run, d, &region);
+            let beta: Vec<f64> = (0..n)
+                .map(|i| {
+                    let lin = (0..n).fold(du[i], |acc, j| {
+                        acc + (jac[i * n + j] - point(d.a[i * n + j])) * dev[j]
+                    });
+                    (point(lin.mag()) + point(d.defect) * point(self.w[i])).hi()
+                })
+                .collect();
+            if beta.iter().any(|b| !b.is_finite()) {
+                return None;
+            }
+            // int_0^h e^(A (h - s)) b(s) ds, and over the step: h [e^(A [0, h])] [-beta, beta].
+            let forced: Vec<f64> = (0..n)
+                .map(|i| {
+                    (0..n)
+                        .fold(Interval::ZERO, |acc, j| {
+                            acc + point(d.exp_over[i * n + j].mag()) * point(beta[j])
+                        })
+                        .hi()
+                })
+                .map(|v| (point(v) * point(d.span.hi())).hi())
+                .collect();
+            let over: Vec<f64> = (0..n)
+                .map(|i| (point(base[i]) + point(forced[i])).hi())
+                .collect();
+            if over.iter().zip(&cap).all(|(o, c)| o < c) {
+                accepted = Some((over, forced));
+                break;
+            }
+            for (c, o) in cap.iter_mut().zip(&over) {
+                *c = (2.0 * *c).max(1.25 * o);
+            }
+        }
+        let (over, forced) = accepted?;
+        // W at the step's end: E W_k (the midpoint's generators, the rest in a box), the
+        // forcing, the node's jump.
+        let eg = product(d.exp_h, &gi, n, n, m);
+        let mut boxed: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..m)
+                    .fold(point(forced[i]) + point(d.jump[i]), |s, j| {
+                        let e = eg[i * m + j];
+                        s + point((point(e.hi()) - point(e.mid())).hi())
+                            .max(point((point(e.mid()) - point(e.lo())).hi()))
+                    })
+                    .hi()
+            })
+            .collect();
+        let mut gens: Vec<Vec<f64>> = (0..m)
+            .map(|j| (0..n).map(|i| eg[i * m + j].mid()).collect())
+            .collect();
+        reduce(&mut gens, &mut boxed, n);
+        push_box(&mut gens, &boxed);
+        let before: Vec<f64> = self.hull_of_w();
+        self.gens = gens;
+        let after = self.hull_of_w();
+        self.grew = after
+            .iter()
+            .zip(&before)
+            .map(|(a, b)| (a - b).max(0.0))
+            .collect();
+        if after.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let mut boxes: Vec<Interval> = (0..n)
+            .map(|i| {
+                let r = point(z_over[i]) + point(over[i]);
+                d.hull[i] + d.v[i] + Interval::new(-r.hi(), r.hi())
+            })
+            .collect();
+        self.widen_pinned(&mut boxes);
+        let over_span = Span {
+            lo: boxes.iter().map(|b| b.lo()).collect(),
+            hi: boxes.iter().map(|b| b.hi()).collect(),
+            radius: 0.0,
+        };
+        let end = d.report.then(|| self.set_at(d, &z_end));
+        Some(Piece {
+            t1: d.times.hi(),
+            rates,
+            over: over_span,
+            end,
+        })
+    }
+
+    /// The set at a report time: `p + M Xi` (the generators in interval arithmetic, their
+    /// rounding in a box), `W`'s zonotope and `Z`'s box, as one zonotope.
+    fn set_at(&self, d: &StepData, z: &[f64]) -> DetSet {
+        let n = self.n;
+        let point = Interval::point;
+        let mut boxed = z.to_vec();
+        let mut flat = Vec::with_capacity(n * (n + self.gens.len() + 1));
+        for j in 0..n {
+            for (i, b) in boxed.iter_mut().enumerate() {
+                let g = point(d.m_next[i * n + j]) * point(d.half[j]);
+                flat.push(g.mid());
+                let r = (point(g.hi()) - point(g.mid()))
+                    .max(point(g.mid()) - point(g.lo()))
+                    .hi();
+                *b = (point(*b) + point(r)).hi();
+            }
+        }
+        for g in &self.gens {
+            flat.extend_from_slice(g);
+        }
+        for (i, &b) in boxed.iter().enumerate() {
+            if b > 0.0 {
+                flat.extend((0..n).map(|k| if k == i { b } else { 0.0 }));
+            }
+        }
+        let metric = &self.run.setup.consts.metric;
+        for (i, wide) in self.pinned_widths(&flat) {
+            flat.extend((0..n).map(|k| if k == i { wide } else { 0.0 }));
+        }
+        let (hull_lo, hull_hi) = zonotope::hull(d.x1, &flat);
+        let radius = zonotope::p_radius(metric, n, &flat);
+        // A ball of a millionth of the set's radius around it: the set only grows, and a
+        // state inside gets certified by the membership test (which needs a positive slack).
+        let remainder = (point(radius) * point(SLACK)).hi();
+        DetSet::Zonotope {
+            center: d.x1.to_vec(),
+            generators: flat,
+            remainder,
+            hull_lo,
+            hull_hi,
+            radius: (point(radius) + point(remainder)).hi(),
+        }
+    }
+
+    /// Per pinned state `i` (see [`pinned`]), the half-width the set claims there: the extent
+    /// `R sqrt((P^-1)_ii)` of the P-ball of radius `R` around the centre holding the zonotope
+    /// with generators `flat` (the set only grows).
+    fn pinned_widths(&self, flat: &[f64]) -> Vec<(usize, f64)> {
+        if !self.pinned.contains(&true) {
+            return Vec::new();
+        }
+        let around = zonotope::p_radius(&self.run.setup.consts.metric, self.n, flat);
+        (0..self.n)
+            .filter(|&i| self.pinned[i])
+            .map(|i| {
+                (
+                    i,
+                    (Interval::point(around) * Interval::point(self.w[i])).hi(),
+                )
+            })
+            .collect()
+    }
+
+    /// Widens the pinned states of the box `boxes` as [`Tracker::pinned_widths`] does a set.
+    fn widen_pinned(&self, boxes: &mut [Interval]) {
+        let n = self.n;
+        let flat: Vec<f64> = (0..n)
+            .flat_map(|j| {
+                let r = boxes[j].rad();
+                (0..n).map(move |i| if i == j { r } else { 0.0 })
+            })
+            .collect();
+        for (i, wide) in self.pinned_widths(&flat) {
+            boxes[i] += Interval::new(-wide, wide);
+        }
+    }
+
+    /// `W`'s generators as an `n x m` interval matrix (row-major).
+    fn gens_matrix(&self) -> Vec<Interval> {
+        let m = self.gens.len();
+        (0..self.n * m)
+            .map(|k| Interval::point(self.gens[k % m][k / m]))
+            .collect()
+    }
+
+    /// Per coordinate, the half-width of `W`'s hull (rounded up).
+    fn hull_of_w(&self) -> Vec<f64> {
+        (0..self.n)
+            .map(|i| {
+                self.gens
+                    .iter()
+                    .fold(Interval::ZERO, |s, g| s + Interval::point(g[i].abs()))
+                    .hi()
+            })
+            .collect()
+    }
+}
+
+/// Per state, whether it is pinned to the validated nominal: it starts at a point and no
+/// noise channel, input or initial spread reaches it through the drift's dependencies (`f_i`
+/// depends on `x_j` where `(i, j)` is in [`System::jac_x_pattern`]). The set is exact there up
+/// to the nominal's defect (1e-6 and below), far finer than an Euler-Maruyama path of any
+/// practical step follows the state (its error is `O(dt)`), so a Monte Carlo check could not
+/// tell a correct set from a wrong one: the member leaves those states to the other sets
+/// (method.md 8.10).
+///
+/// [`System::jac_x_pattern`]: crate::system::System::jac_x_pattern
+fn pinned(run: &Run, g: &[Interval], half: &[f64]) -> Vec<bool> {
+    let n = run.setup.n;
+    let (m, p) = (run.sys.m(), run.sys.p());
+    let zero = |v: &Interval| v.lo() == 0.0 && v.hi() == 0.0;
+    let mut ju = vec![Interval::ZERO; n * p];
+    if p > 0 {
+        run.sys.jac_u_interval(
+            &vec![Interval::ENTIRE; n],
+            &super::input_intervals(run.info),
+            Interval::new(0.0, run.spec.horizon),
+            &mut ju,
+        );
+    }
+    let mut reached: Vec<bool> = (0..n)
+        .map(|i| {
+            half[i] > 0.0
+                || (0..m).any(|l| !zero(&g[i * m + l]))
+                || (0..p).any(|l| !zero(&ju[i * p + l]))
+        })
+        .collect();
+    let pattern = run.sys.jac_x_pattern();
+    loop {
+        let mut grew = false;
+        for &(i, j) in &pattern {
+            if reached[j] && !reached[i] {
+                reached[i] = true;
+                grew = true;
+            }
+        }
+        if !grew {
+            return reached.iter().map(|r| !r).collect();
+        }
+    }
+}
+
+/// `f(X, u) - f(X, u*)` over `region`, per coordinate: `[D_u f](region, U) (U - u*)` under
+/// the input box (the mean value theorem on the convex box), zero under a known input.
+fn input_change(run: &Run, d: &StepData, region: &[Interval]) -> Vec<Interval> {
+    let n = region.len();
+    let p = run.sys.p();
+    if !matches!(run.inputs, Inputs::Box) || p == 0 {
+        return vec![Interval::ZERO; n];
+    }
+    let u = super::input_intervals(run.info);
+    let mut ju = vec![Interval::ZERO; n * p];
+    run.sys.jac_u_interval(region, &u, d.times, &mut ju);
+    (0..n)
+        .map(|i| {
+            (0..p).fold(Interval::ZERO, |s, l| {
+                s + ju[i * p + l] * (u[l] - Interval::point(d.u[l]))
+            })
+        })
+        .collect()
+}
+
+/// Keeps the `(ORDER - 1) n` largest generators (by their 1-norm) and adds the others'
+/// magnitudes to `boxed` (their zonotope lies in that box).
+fn reduce(gens: &mut Vec<Vec<f64>>, boxed: &mut [f64], n: usize) {
+    let keep = (ORDER - 1) * n;
+    if gens.len() <= keep {
+        return;
+    }
+    gens.sort_by(|a, b| {
+        let size = |g: &Vec<f64>| g.iter().map(|v| v.abs()).sum::<f64>();
+        size(b).total_cmp(&size(a))
+    });
+    for g in gens.drain(keep..) {
+        for (b, v) in boxed.iter_mut().zip(&g) {
+            *b = (Interval::point(*b) + Interval::point(v.abs())).hi();
+        }
+    }
+}
+
+/// Appends the box `[-boxed, boxed]` as axis generators (the non-zero ones).
+fn push_box(gens: &mut Vec<Vec<f64>>, boxed: &[f64]) {
+    let n = boxed.len();
+    for (i, &b) in boxed.iter().enumerate() {
+        if b > 0.0 {
+            gens.push((0..n).map(|k| if k == i { b } else { 0.0 }).collect());
+        }
+    }
+}
