@@ -95,3 +95,27 @@ pub fn euler_maruyama(
         *t += dt;
     }
 }
+
+/// Advances `x` from time `*t` to `until` by classical RK4 steps of `h` of the noise-free
+/// drift of `sys` (no inputs): the reference flow for sets of noise-free models.
+pub fn rk4(sys: &dyn reachc_runtime::System, x: &mut [f64], t: &mut f64, until: f64, h: f64) {
+    let n = sys.n();
+    let f = |x: &[f64], t: f64| {
+        let mut out = vec![0.0; n];
+        sys.drift(x, &[], t, &mut out);
+        out
+    };
+    let along = |x: &[f64], k: &[f64], s: f64| -> Vec<f64> {
+        x.iter().zip(k).map(|(a, b)| a + s * b).collect()
+    };
+    while *t < until - 1e-12 {
+        let k1 = f(x, *t);
+        let k2 = f(&along(x, &k1, 0.5 * h), *t + 0.5 * h);
+        let k3 = f(&along(x, &k2, 0.5 * h), *t + 0.5 * h);
+        let k4 = f(&along(x, &k3, h), *t + h);
+        for i in 0..n {
+            x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+        *t += h;
+    }
+}

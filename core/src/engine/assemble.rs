@@ -146,9 +146,7 @@ impl Radii {
             }
         }
     }
-}
 
-impl Radii {
     /// No stochastic radius: for sets that hold the stochastic part themselves (method.md
     /// 8.10), at `reports` report times after 0.
     pub(super) fn inside(reports: usize) -> Radii {
