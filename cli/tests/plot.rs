@@ -98,7 +98,7 @@ fn run_plot_writes_both_figures_for_each_analysis() {
             ["radius.png", "radius.svg"]
                 .iter()
                 .chain(rates)
-                .chain(&["sets.png", "sets.svg"])
+                .chain(&["sets.png", "sets.svg", "widths.png", "widths.svg"])
                 .map(|f| format!("{a}_{f}"))
                 .collect::<Vec<_>>()
         })
@@ -121,6 +121,15 @@ fn run_plot_writes_both_figures_for_each_analysis() {
         let radius = svg(&plots.join(format!("{a}_radius.svg")));
         // No report beside the results: the run simulated the quantile itself.
         assert!(radius.contains("2000 paths"), "{a}");
+        // And its per-state spreads, against the PRS's box.
+        let widths = svg(&plots.join(format!("{a}_widths.svg")));
+        assert!(
+            widths.contains(&format!("pendulum / {a}: half-widths per state"))
+                && widths.contains("theta: PRS")
+                && widths.contains("omega: paths (1-δ)")
+                && widths.contains("2000 paths"),
+            "{a}"
+        );
         assert_eq!(png_size(&plots.join(format!("{a}_sets.png"))), (1100, 780));
         assert_eq!(
             png_size(&plots.join(format!("{a}_radius.png"))),
@@ -160,6 +169,10 @@ fn plot_reads_a_result_with_or_without_the_spec() {
     assert!(!sets.contains("sample paths (Euler"));
     assert!(sets.contains("no sample paths or unsafe sets"));
     assert!(!svg(&dir.join("amgf_rule_radius.svg")).contains("quantile of"));
+    assert!(
+        !dir.join("amgf_rule_widths.svg").exists(),
+        "no report, no widths"
+    );
 
     // With the spec, chosen states (swapped) and a Monte Carlo report beside the result.
     let sim = reachc(&[
@@ -201,6 +214,13 @@ fn plot_reads_a_result_with_or_without_the_spec() {
     assert!(label("x1") && !label("x2"));
     let radius = svg(&pics.join("amgf_rule_radius.svg"));
     assert!(radius.contains("(300 paths)") && radius.contains("amgf_rule.sim.json"));
+    // The plotted states' spreads from the report, in the chosen order.
+    let widths = svg(&pics.join("amgf_rule_widths.svg"));
+    let (x2, x1) = (
+        widths.find("x2: PRS").unwrap(),
+        widths.find("x1: PRS").unwrap(),
+    );
+    assert!(x2 < x1 && widths.contains("300 paths"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

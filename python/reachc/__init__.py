@@ -491,6 +491,24 @@ class Simulation:
         return cast("FloatArray", self._steps["quantile"])
 
     @property
+    def state_quantile(self) -> FloatArray:
+        """Per state, the half-width of the smallest interval about the nominal state holding
+        ``1 - delta`` of the paths, shape ``(k, n)``."""
+        return cast("FloatArray", self._steps["state_quantile"])
+
+    @property
+    def state_max(self) -> FloatArray:
+        """Per state, the largest deviation from the nominal state, shape ``(k, n)``."""
+        return cast("FloatArray", self._steps["state_max"])
+
+    @property
+    def state_prs(self) -> FloatArray:
+        """Per state, the half-width of the PRS's bounding box about the nominal state, shape
+        ``(k, n)``: ``state_prs / state_quantile`` is how many times the sample's spread the
+        PRS is in each coordinate."""
+        return cast("FloatArray", self._steps["state_prs"])
+
+    @property
     def max(self) -> FloatArray:
         """Largest distance to the nominal state, shape ``(k,)``."""
         return cast("FloatArray", self._steps["max"])

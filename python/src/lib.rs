@@ -1025,7 +1025,9 @@ impl Simulation {
     }
 
     /// Per-report-time statistics as arrays of shape `(k,)`: `times`, `r`, `prs_radius`,
-    /// `quantile`, `max`, `outside` (int64), `fraction`, `cp_upper`.
+    /// `quantile`, `max`, `outside` (int64), `fraction`, `cp_upper`; and of shape `(k, n)`,
+    /// per state: `state_quantile` (the half-width about the nominal holding `1 - delta` of
+    /// the paths), `state_max`, `state_prs` (the PRS's bounding-box half-width).
     fn steps<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.report.steps;
         let d = PyDict::new(py);
@@ -1039,6 +1041,14 @@ impl Simulation {
         d.set_item("cp_upper", col(|s| s.cp_upper))?;
         let outside: Vec<i64> = s.iter().map(|s| s.outside as i64).collect();
         d.set_item("outside", Array1::from_vec(outside).into_pyarray(py))?;
+        let n = self.report.states.len();
+        let per_state = |f: fn(&simulate::StateSpread) -> f64| {
+            let v = s.iter().flat_map(|s| s.states.iter().map(f)).collect();
+            array2(py, s.len(), n, v)
+        };
+        d.set_item("state_quantile", per_state(|v| v.quantile))?;
+        d.set_item("state_max", per_state(|v| v.max))?;
+        d.set_item("state_prs", per_state(|v| v.prs))?;
         Ok(d)
     }
 

@@ -80,5 +80,11 @@ def test_simulate_equals_the_cli(
     j = sim.json()
     assert sim.paths == paths and sim.seed == seed
     assert sim.quantile.shape == sim.times.shape == (len(j["steps"]),)
+    n = len(spec.states)
+    assert sim.state_quantile.shape == sim.state_prs.shape == sim.state_max.shape == (len(j["steps"]), n)
+    last = j["steps"][-1]["states"]
+    assert [s["quantile"] for s in last] == list(sim.state_quantile[-1])
+    # The PRS holds 1 - delta of the paths per state too: its half-width is not below theirs.
+    assert all(s["prs"] >= s["quantile"] for s in last)
     assert sim.outside.dtype.kind == "i"
     assert sim.coverage["passed"] == sim.passed

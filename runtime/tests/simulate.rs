@@ -201,7 +201,29 @@ fn linear_quantiles_match_the_exact_gaussian() {
             st.t
         );
         assert!(st.max >= st.quantile);
+        // Per state, X_i ~ N(0, v): the smallest interval about 0 holding 1 - delta of the
+        // paths has half-width z_{1 - delta/2} sqrt(v), z_{0.995} = 2.5758293.
+        let exact_i = 2.575_829_303_548_9 * v.sqrt();
+        for (i, sp) in st.states.iter().enumerate() {
+            let rel = (sp.quantile - exact_i) / exact_i;
+            max_rel = max_rel.max(rel.abs());
+            if k % 25 == 0 {
+                assert!(
+                    rel.abs() < 0.025,
+                    "t = {}, state {i}: {sp:?} vs {exact_i}",
+                    st.t
+                );
+            }
+            // The PRS's box about the nominal: within the ball's, r_t sqrt((P^-1)_ii) = r_t,
+            // and above the sample's spread.
+            assert!(
+                sp.prs <= st.r_t * (1.0 + 1e-12) && sp.prs > sp.quantile,
+                "{sp:?}"
+            );
+            assert!(sp.max >= sp.quantile && sp.ratio() > 1.0, "{sp:?}");
+        }
     }
+    assert_eq!(rep.states, ["x1", "x2"]);
     assert!(max_rel < 0.04, "largest relative error {max_rel}");
     // The time average of the (correlated) errors is much smaller than each.
     let mean: f64 = {
@@ -303,6 +325,11 @@ fn simulated_paths_are_the_recorded_sample_paths() {
                     .reduce(|q, t| q + t)
                     .unwrap();
                 assert_eq!(st.quantile, q.sqrt(), "seed {seed}, t = {}", st.t);
+                // Per state, the one path's deviation.
+                for ((sp, x), c) in st.states.iter().zip(x).zip(res.nominal()) {
+                    assert_eq!(sp.quantile, (x - c).abs(), "seed {seed}, t = {}", st.t);
+                    assert_eq!(sp.max, sp.quantile);
+                }
             }
         }
     }
@@ -467,6 +494,7 @@ fn reports_say_what_was_checked() {
             "prs_radius",
             "quantile",
             "r_t",
+            "states",
             "t"
         ]
     );

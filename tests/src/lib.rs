@@ -2,8 +2,10 @@
 //! corpus live, and a renderer that names files relative to the workspace (stable snapshots).
 
 use reachc_compiler::backend::{interp::Interpreter, prepare};
-use reachc_compiler::driver::load;
+use reachc_compiler::driver::{check_source, load};
 use reachc_runtime::model::ModelInfo;
+use reachc_runtime::prs::{Proved, Role};
+use reachc_runtime::Prs;
 use std::path::{Path, PathBuf};
 
 pub mod fuzz;
@@ -19,6 +21,45 @@ pub fn interpreter_of(mut model: reachc_compiler::model::Model) -> (Interpreter,
 pub fn shipped(name: &str) -> (Interpreter, ModelInfo) {
     let model = load(&workspace().join("specs").join(name)).expect("a shipped spec loads");
     interpreter_of(model.model)
+}
+
+/// The interpreter of a spec given as source (paths in it relative to `specs/`); panics with
+/// the diagnostics if it does not check.
+pub fn inline(source: &str) -> (Interpreter, ModelInfo) {
+    let (model, diags) = check_source(source, &workspace().join("specs"));
+    interpreter_of(model.unwrap_or_else(|| panic!("{diags:?}")))
+}
+
+/// The linearised Gaussian member of a result (method.md 8.10) and its mixture bound's number
+/// of epochs; panics without one.
+pub fn linearised_member(prs: &Prs) -> (&Prs, usize) {
+    let m = prs
+        .also
+        .iter()
+        .find(|m| m.role == Role::Linearised)
+        .expect("a linearised Gaussian member");
+    let epochs = m
+        .validation
+        .rigorous
+        .iter()
+        .find_map(|p| match p {
+            Proved::LinearisedGaussian { epochs } => Some(*epochs),
+            _ => None,
+        })
+        .expect("the member says how it is proved");
+    (m, epochs)
+}
+
+/// The smallest `(1 + eta)(2 ln(K / delta) + n ln(1 + 1/eta))` over `eta` on a fine grid, for
+/// `K` epochs: the mixture bound's squared radius factor can be no smaller.
+pub fn mixture_factor(n: usize, epochs: usize, delta: f64) -> f64 {
+    let l = (epochs as f64 / delta).ln();
+    (1..20000)
+        .map(|k| {
+            let eta = 1e-4 * f64::from(k);
+            (1.0 + eta) * (2.0 * l + n as f64 * (1.0 / eta).ln_1p())
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The workspace root.

@@ -3,48 +3,9 @@
 //! sampled noise-free flows of the nonlinear pendulum (the path-by-path error bound never below
 //! the sampled error), and how the default analyses use them (delta split, the better result).
 
-use reachc_compiler::backend::interp::Interpreter;
-use reachc_compiler::driver::check_source;
-use reachc_e2e::{interpreter_of, rk4, shipped, workspace};
-use reachc_runtime::model::ModelInfo;
-use reachc_runtime::prs::{Proved, Role};
-use reachc_runtime::{Prs, Reach};
-
-fn inline(source: &str) -> (Interpreter, ModelInfo) {
-    let (model, diags) = check_source(source, &workspace().join("specs"));
-    interpreter_of(model.unwrap_or_else(|| panic!("{diags:?}")))
-}
-
-/// The member of role [`Role::Linearised`] and its number of epochs.
-fn member(prs: &Prs) -> (&Prs, usize) {
-    let m = prs
-        .also
-        .iter()
-        .find(|m| m.role == Role::Linearised)
-        .expect("a linearised Gaussian member");
-    let epochs = m
-        .validation
-        .rigorous
-        .iter()
-        .find_map(|p| match p {
-            Proved::LinearisedGaussian { epochs } => Some(*epochs),
-            _ => None,
-        })
-        .expect("the member says how it is proved");
-    (m, epochs)
-}
-
-/// The smallest `(1 + eta)(2 ln(K / delta) + n ln(1 + 1/eta))` over `eta` (a fine grid): the
-/// mixture bound's squared radius factor can be no smaller.
-fn best_factor(n: usize, epochs: usize, delta: f64) -> f64 {
-    let l = (epochs as f64 / delta).ln();
-    (1..20000)
-        .map(|k| {
-            let eta = 1e-4 * k as f64;
-            (1.0 + eta) * (2.0 * l + n as f64 * (1.0 / eta).ln_1p())
-        })
-        .fold(f64::INFINITY, f64::min)
-}
+use reachc_e2e::{inline, linearised_member, mixture_factor, rk4, shipped, workspace};
+use reachc_runtime::prs::Role;
+use reachc_runtime::Reach;
 
 /// `x'' = -2 x - 3 x' + 0.2 w` (eigenvalues -1, -2) from the box `[0.9, 1.1] x [-0.1, 0.1]`:
 /// the member's box at each report time is `|e^(A t)| h + sqrt(factor Sigma_ii(t))`, with
@@ -60,10 +21,10 @@ fn a_linear_system_gets_the_exact_image_and_covariance() {
          step = 0.05\n}\n",
     );
     let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
-    let (m, epochs) = member(&prs);
+    let (m, epochs) = linearised_member(&prs);
     assert_eq!(prs.delta, 1e-3);
     assert!(m.delta <= 5e-4 && m.delta > 4.99e-4, "{}", m.delta);
-    let factor = best_factor(2, epochs, m.delta);
+    let factor = mixture_factor(2, epochs, m.delta);
     let h = [0.1, 0.1];
     let mut worst = 0.0f64;
     for (k, st) in m.steps.iter().enumerate().skip(1) {
@@ -103,7 +64,7 @@ fn noise_free_flows_lie_in_the_member_and_fill_it() {
         .unwrap()
         .run()
         .unwrap();
-    let (m, _) = member(&prs);
+    let (m, _) = linearised_member(&prs);
     let a = std::f64::consts::PI / 10.0;
     let starts: Vec<[f64; 2]> = [-1.0, 0.0, 1.0]
         .iter()
@@ -148,7 +109,7 @@ fn the_default_analyses_split_delta_with_the_member() {
     let (sys, info) = shipped("pendulum.sde");
     for analysis in ["contraction", "interval"] {
         let prs = Reach::new(&sys, &info, analysis).unwrap().run().unwrap();
-        let (m, epochs) = member(&prs);
+        let (m, epochs) = linearised_member(&prs);
         assert_eq!(prs.delta, 1e-3);
         assert_eq!(m.delta, (1e-3f64 / 2.0).next_down());
         assert_eq!(epochs, m.internal_steps);

@@ -3,18 +3,12 @@
 //! nonlinear system, and what limits a bound.
 
 use reachc_compiler::backend::interp::Interpreter;
-use reachc_compiler::driver::check_source;
-use reachc_e2e::{euler_maruyama, interpreter_of, workspace, Rng};
+use reachc_e2e::{euler_maruyama, inline, Rng};
 use reachc_runtime::engine::RunError;
 use reachc_runtime::model::ModelInfo;
 use reachc_runtime::probability::{SafetyLimit, DELTA_FLOOR, RESOLUTION};
 use reachc_runtime::simulate::clopper_pearson_lower;
 use reachc_runtime::{Reach, System};
-
-fn inline(source: &str) -> (Interpreter, ModelInfo) {
-    let (model, diags) = check_source(source, &workspace().join("specs"));
-    interpreter_of(model.unwrap_or_else(|| panic!("{diags:?}")))
-}
 
 /// `x' = mu` with noise `0.5 dW` from 0, unsafe `x >= 2`, horizon 1.
 fn brownian(mu: f64) -> (Interpreter, ModelInfo) {

@@ -2,20 +2,14 @@
 //! Gaussian mixture bound for time-uniform results, and `metric = auto` chosen for the PRS at
 //! the horizon rather than for the rate alone.
 
-use reachc_compiler::backend::interp::Interpreter;
-use reachc_compiler::driver::{check_source, load};
-use reachc_e2e::{interpreter_of, shipped, shipped_specs, workspace};
-use reachc_runtime::model::{Method, ModelInfo};
+use reachc_compiler::driver::load;
+use reachc_e2e::{inline, interpreter_of, shipped, shipped_specs, workspace};
+use reachc_runtime::model::Method;
 use reachc_runtime::prs::{Proved, Role, UniformBound};
 use reachc_runtime::simulate::{
     self, clopper_pearson_lower as lower_bound, clopper_pearson_upper as upper_bound, Options,
 };
 use reachc_runtime::{Prs, Reach};
-
-fn inline(source: &str) -> (Interpreter, ModelInfo) {
-    let (model, diags) = check_source(source, &workspace().join("specs"));
-    interpreter_of(model.unwrap_or_else(|| panic!("{diags:?}")))
-}
 
 /// The sum of the logs of the PRS's bounding-box half-widths at the horizon.
 fn log_volume(prs: &Prs) -> f64 {

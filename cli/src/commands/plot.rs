@@ -17,7 +17,7 @@ use reachc_runtime::simulate::{self, SimReport};
 
 use super::{load_reporting, EXIT_USAGE};
 use crate::plot::input::{ResultFile, SimFile};
-use crate::plot::{self, select, Choice, Model, Quantile};
+use crate::plot::{self, select, Choice, Model, Quantile, StateWidths};
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_compiler::driver::Loaded;
@@ -131,10 +131,23 @@ fn write(files: Files) -> Result<(), u8> {
     )
 }
 
-/// The quantile of a Monte Carlo report.
-fn quantile_of(sim: &SimFile, source: String) -> Quantile {
+/// The quantiles of a Monte Carlo report file (per state when it has them for every state of
+/// the result).
+fn quantile_of(sim: &SimFile, result: &ResultFile, source: String) -> Quantile {
+    let n = result.states.len();
+    let per_state = sim.states == result.states && sim.steps.iter().all(|s| s.states.len() == n);
     Quantile {
         values: sim.steps.iter().map(|s| s.quantile).collect(),
+        states: if per_state {
+            (0..n)
+                .map(|i| StateWidths {
+                    prs: sim.steps.iter().map(|s| s.states[i].prs).collect(),
+                    quantile: sim.steps.iter().map(|s| s.states[i].quantile).collect(),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        },
         paths: sim.paths,
         source,
     }
@@ -148,7 +161,11 @@ fn sibling_report(result_path: &Path, result: &ResultFile) -> Option<Quantile> {
         return None;
     }
     match SimFile::read(&path).map(|s| (s.mismatch(result), s)) {
-        Ok((None, sim)) => Some(quantile_of(&sim, format!("report {}", path.display()))),
+        Ok((None, sim)) => Some(quantile_of(
+            &sim,
+            result,
+            format!("report {}", path.display()),
+        )),
         Ok((Some(why), _)) => {
             eprintln!("note: not using {}: {why}", path.display());
             None
@@ -177,7 +194,11 @@ pub fn run_plot(args: &PlotArgs) -> Result<(), u8> {
                     path.display()
                 )));
             }
-            Some(quantile_of(&sim, format!("report {}", path.display())))
+            Some(quantile_of(
+                &sim,
+                &result,
+                format!("report {}", path.display()),
+            ))
         }
         None => sibling_report(&args.result, &result),
     };
@@ -244,19 +265,14 @@ fn run_quantile(model: &Model<'_>, json: &Path, result: &ResultFile) -> Option<Q
                 return None;
             }
         };
-    Some(Quantile {
-        values: report
-            .steps
-            .iter()
-            .map(|s| Some(s.quantile).filter(|q| q.is_finite()))
-            .collect(),
-        paths: report.paths,
-        source: format!(
+    Some(Quantile::of(
+        &report,
+        format!(
             "{} paths simulated for this plot (seed 0; `reachc simulate -o` writes a report \
              that is used instead)",
             report.paths
         ),
-    })
+    ))
 }
 
 /// After `reachc run` wrote its results into `staging` (see [`staging_dir`]): plots each

@@ -14,7 +14,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::font::FAMILY;
 use super::geometry::Point;
 use super::output::Draw;
-use super::scene::{RadiusScene, RatesScene, SetsScene};
+use super::scene::{RadiusScene, RatesScene, SetsScene, WidthsScene};
 use reachc_runtime::report::count;
 
 /// Size of the sets figure.
@@ -470,126 +470,189 @@ fn panels<DB: DrawingBackend>(
 /// Radii spanning more than this ratio are drawn on a logarithmic axis.
 const LOG_RATIO: f64 = 1e3;
 
+/// A curve of a figure against time: values per report time (`None`: a gap), its colour,
+/// whether it is dashed, its legend label.
+struct Curve<'a> {
+    values: Vec<Option<f64>>,
+    colour: RGBColor,
+    dashed: bool,
+    label: &'a str,
+}
+
+/// Curves against the report `times` with the legend panel: a linear value axis, or a
+/// logarithmic one when the values span more than [`LOG_RATIO`].
+fn curves_figure<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: u32,
+    (title, y_label): (&str, &str),
+    times: &[f64],
+    curves: &[Curve<'_>],
+    notes: &[String],
+) -> Result<(), String> {
+    let (plot_area, legend_area) = panels(area, s);
+    let t_last = times.last().copied().unwrap_or(1.0);
+    let right = if t_last > 0.0 { t_last } else { 1.0 };
+    let values: Vec<f64> = curves
+        .iter()
+        .flat_map(|c| c.values.iter().flatten())
+        .copied()
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    let top = values.iter().copied().fold(0.0, f64::max);
+    let low = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut builder = chart_builder(&plot_area, title, s);
+    let mut notes = notes.to_vec();
+    // Exploding radii (an analysis whose c is positive) would flatten everything else.
+    if top > LOG_RATIO * low {
+        let chart = builder
+            .build_cartesian_2d(0.0..right, (low / 1.5..top * 1.5).log_scale())
+            .map_err(err)?;
+        notes.push(format!(
+            "logarithmic scale: the values span {:.0} orders of magnitude",
+            (top / low).log10()
+        ));
+        draw_curves(chart, s, true, (times, y_label), curves)?;
+    } else {
+        let top = if top > 0.0 { 1.08 * top } else { 1.0 };
+        let chart = builder
+            .build_cartesian_2d(0.0..right, 0.0..top)
+            .map_err(err)?;
+        draw_curves(chart, s, false, (times, y_label), curves)?;
+    }
+    let entries: Vec<(Mark, String)> = curves
+        .iter()
+        .map(|c| {
+            let mark = if c.dashed {
+                Mark::Dashed(c.colour.to_rgba())
+            } else {
+                Mark::Line(c.colour.to_rgba(), 2)
+            };
+            (mark, c.label.to_string())
+        })
+        .collect();
+    legend(&legend_area, s, &entries, &notes)
+}
+
+/// The curves of [`curves_figure`] on a linear or logarithmic value axis (`log`: values that
+/// are not positive are left out).
+fn draw_curves<DB: DrawingBackend, Y>(
+    mut chart: ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
+    s: u32,
+    log: bool,
+    (times, y_label): (&[f64], &str),
+    curves: &[Curve<'_>],
+) -> Result<(), String>
+where
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let i = |v: i32| v * s as i32;
+    let x_span = times.last().copied().unwrap_or(1.0);
+    let y_span = if log { 0.0 } else { chart.y_range().end };
+    let x_fmt = |v: &f64| tick(*v, x_span);
+    let y_fmt = |v: &f64| {
+        if log {
+            tick(*v, v.abs())
+        } else {
+            tick(*v, y_span)
+        }
+    };
+    mesh(&mut chart, s, ["t", y_label], [&x_fmt, &y_fmt])?;
+    for c in curves {
+        // Runs of drawable points: a curve is broken where a value is missing, not finite, or
+        // (log scale) not positive.
+        let mut runs = vec![Vec::new()];
+        for (t, v) in times.iter().zip(&c.values) {
+            match v {
+                Some(v) if v.is_finite() && (!log || *v > 0.0) => {
+                    if let Some(r) = runs.last_mut() {
+                        r.push((*t, *v));
+                    }
+                }
+                _ => runs.push(Vec::new()),
+            }
+        }
+        let style = c.colour.stroke_width(2 * s);
+        for run in runs {
+            if c.dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(run, i(9), i(5), style))
+                    .map_err(err)?;
+            } else {
+                chart
+                    .draw_series(LineSeries::new(run, style))
+                    .map_err(err)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 impl Draw for RadiusScene {
     fn draw<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
         s: u32,
     ) -> Result<(), String> {
-        let (plot_area, legend_area) = panels(area, s);
-        let t_last = self.times.last().copied().unwrap_or(1.0);
-        let right = if t_last > 0.0 { t_last } else { 1.0 };
-        let quantiles = self.quantile.iter().flat_map(|(q, _)| q.iter().flatten());
-        let values: Vec<f64> = self
-            .prs_radius
-            .iter()
-            .chain(&self.r_t)
-            .chain(quantiles)
-            .copied()
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .collect();
-        let top = values.iter().copied().fold(0.0, f64::max);
-        let low = values.iter().copied().fold(f64::INFINITY, f64::min);
-        let mut builder = chart_builder(&plot_area, &self.title, s);
-        // Exploding radii (an analysis whose c is positive) would flatten everything else.
-        if top > LOG_RATIO * low {
-            let chart = builder
-                .build_cartesian_2d(0.0..right, (low / 1.5..top * 1.5).log_scale())
-                .map_err(err)?;
-            let note = format!(
-                "logarithmic scale: the radii span {:.0} orders of magnitude",
-                (top / low).log10()
-            );
-            self.draw_radii(chart, s, true, &legend_area, note)
-        } else {
-            let top = if top > 0.0 { 1.08 * top } else { 1.0 };
-            let chart = builder
-                .build_cartesian_2d(0.0..right, 0.0..top)
-                .map_err(err)?;
-            self.draw_radii(chart, s, false, &legend_area, String::new())
+        let some = |v: &[f64]| v.iter().map(|v| Some(*v)).collect();
+        let mut curves = vec![
+            Curve {
+                values: some(&self.prs_radius),
+                colour: PALETTE[1],
+                dashed: false,
+                label: &self.prs_label,
+            },
+            // Dashed over the PRS radius: the two are equal for a point initial set and no
+            // inputs.
+            Curve {
+                values: some(&self.r_t),
+                colour: PALETTE[0],
+                dashed: true,
+                label: "stochastic radius r_t",
+            },
+        ];
+        if let Some((q, label)) = &self.quantile {
+            curves.push(Curve {
+                values: q.clone(),
+                colour: PALETTE[2],
+                dashed: false,
+                label,
+            });
         }
+        let labels = (self.title.as_str(), "radius (P-norm)");
+        curves_figure(area, s, labels, &self.times, &curves, &self.notes)
     }
 }
 
-impl RadiusScene {
-    /// The curves and the legend, on a linear or logarithmic radius axis (`log`: values that
-    /// are not positive are left out).
-    fn draw_radii<DB: DrawingBackend, Y>(
+impl Draw for WidthsScene {
+    fn draw<DB: DrawingBackend>(
         &self,
-        mut chart: ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
+        area: &DrawingArea<DB, Shift>,
         s: u32,
-        log: bool,
-        legend_area: &DrawingArea<DB, Shift>,
-        note: String,
-    ) -> Result<(), String>
-    where
-        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
-    {
-        let i = |v: i32| v * s as i32;
-        let x_span = self.times.last().copied().unwrap_or(1.0);
-        let y_span = if log { 0.0 } else { chart.y_range().end };
-        let x_fmt = |v: &f64| tick(*v, x_span);
-        let y_fmt = |v: &f64| {
-            if log {
-                tick(*v, v.abs())
-            } else {
-                tick(*v, y_span)
-            }
-        };
-        mesh(&mut chart, s, ["t", "radius (P-norm)"], [&x_fmt, &y_fmt])?;
-        // Runs of drawable points: a curve is broken where a value is missing, not finite, or
-        // (log scale) not positive.
-        let runs = |values: &mut dyn Iterator<Item = Option<f64>>| -> Vec<Vec<(f64, f64)>> {
-            let mut runs = vec![Vec::new()];
-            for (t, v) in self.times.iter().zip(values) {
-                match v {
-                    Some(v) if v.is_finite() && (!log || v > 0.0) => {
-                        if let Some(r) = runs.last_mut() {
-                            r.push((*t, v));
-                        }
-                    }
-                    _ => runs.push(Vec::new()),
-                }
-            }
-            runs
-        };
-        let (c_prs, c_r, c_q) = (PALETTE[1], PALETTE[0], PALETTE[2]);
-        for run in runs(&mut self.prs_radius.iter().map(|v| Some(*v))) {
-            chart
-                .draw_series(LineSeries::new(run, c_prs.stroke_width(2 * s)))
-                .map_err(err)?;
-        }
-        // Dashed over the PRS radius: the two are equal for a point initial set and no inputs.
-        for run in runs(&mut self.r_t.iter().map(|v| Some(*v))) {
-            chart
-                .draw_series(DashedLineSeries::new(
-                    run,
-                    i(9),
-                    i(5),
-                    c_r.stroke_width(2 * s),
-                ))
-                .map_err(err)?;
-        }
-        let mut entries = vec![
-            (Mark::Line(c_prs.to_rgba(), 2), self.prs_label.clone()),
-            (
-                Mark::Dashed(c_r.to_rgba()),
-                "stochastic radius r_t".to_string(),
-            ),
-        ];
-        if let Some((q, label)) = &self.quantile {
-            for run in runs(&mut q.iter().copied()) {
-                chart
-                    .draw_series(LineSeries::new(run, c_q.stroke_width(2 * s)))
-                    .map_err(err)?;
-            }
-            entries.push((Mark::Line(c_q.to_rgba(), 2), label.clone()));
-        }
-        let mut notes = self.notes.clone();
-        if !note.is_empty() {
-            notes.push(note);
-        }
-        legend(legend_area, s, &entries, &notes)
+    ) -> Result<(), String> {
+        let curves: Vec<Curve<'_>> = self
+            .states
+            .iter()
+            .enumerate()
+            .flat_map(|(k, w)| {
+                let colour = PALETTE[k % PALETTE.len()];
+                [
+                    Curve {
+                        values: w.prs.clone(),
+                        colour,
+                        dashed: false,
+                        label: &w.prs_label,
+                    },
+                    Curve {
+                        values: w.paths.clone(),
+                        colour,
+                        dashed: true,
+                        label: &w.paths_label,
+                    },
+                ]
+            })
+            .collect();
+        let labels = (self.title.as_str(), "half-width about x*_t");
+        curves_figure(area, s, labels, &self.times, &curves, &self.notes)
     }
 }
 

@@ -227,6 +227,9 @@ pub struct SimFile {
     pub delta: f64,
     /// Number of paths.
     pub paths: u64,
+    /// The state names (absent from reports of older versions).
+    #[serde(default)]
+    pub states: Vec<String>,
     /// Per report time.
     pub steps: Vec<SimStep>,
 }
@@ -238,6 +241,18 @@ pub struct SimStep {
     pub t: f64,
     /// Empirical `(1 - delta)` quantile of `|X_t - x*_t|_P` (`null` when not finite).
     pub quantile: Option<f64>,
+    /// Per state (absent from reports of older versions).
+    #[serde(default)]
+    pub states: Vec<SimState>,
+}
+
+/// One state at one report time of a Monte Carlo report.
+#[derive(Clone, Debug, Deserialize)]
+pub struct SimState {
+    /// The half-width about `x*_t,i` holding `1 - delta` of the paths (`null`: not finite).
+    pub quantile: Option<f64>,
+    /// The PRS's bounding-box half-width about `x*_t,i` (`null`: not finite).
+    pub prs: Option<f64>,
 }
 
 /// Reads a JSON file into `T`; the message names the file.

@@ -82,15 +82,53 @@ fn reference(model: &Model<'_>, plane: [usize; 2]) -> Option<(String, Vec<Point>
     })
 }
 
-/// A Monte Carlo quantile for the radius figure.
+/// A Monte Carlo quantile for the radius figure, and the per-state spreads for the widths
+/// figure.
 #[derive(Clone, Debug)]
 pub struct Quantile {
     /// Per report time of the result (`None` where not finite).
     pub values: Vec<Option<f64>>,
+    /// Per state of the result, in its order (empty: the report has none).
+    pub states: Vec<StateWidths>,
     /// Number of paths.
     pub paths: u64,
     /// Where it comes from, for the legend.
     pub source: String,
+}
+
+/// One state's half-widths about the nominal over the report times (`None` where not finite).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateWidths {
+    /// The PRS's bounding box.
+    pub prs: Vec<Option<f64>>,
+    /// The interval holding `1 - delta` of the paths.
+    pub quantile: Vec<Option<f64>>,
+}
+
+impl Quantile {
+    /// The quantiles of a Monte Carlo report, described by `source`.
+    pub fn of(report: &simulate::SimReport, source: String) -> Quantile {
+        let finite = |v: f64| Some(v).filter(|v| v.is_finite());
+        Quantile {
+            values: report.steps.iter().map(|s| finite(s.quantile)).collect(),
+            states: (0..report.states.len())
+                .map(|i| StateWidths {
+                    prs: report
+                        .steps
+                        .iter()
+                        .map(|s| finite(s.states[i].prs))
+                        .collect(),
+                    quantile: report
+                        .steps
+                        .iter()
+                        .map(|s| finite(s.states[i].quantile))
+                        .collect(),
+                })
+                .collect(),
+            paths: report.paths,
+            source,
+        }
+    }
 }
 
 /// Output file names: `DIR/<analysis>_sets.svg` and so on.
@@ -162,8 +200,10 @@ fn renderings<F: Draw>(
 }
 
 /// Plots a result: `DIR/<analysis>_sets.svg/.png` (the sets at the chosen times, sample paths
-/// and unsafe sets when the model is given), `DIR/<analysis>_radius.svg/.png` and, when the
-/// rates vary in time (local or empirical), `DIR/<analysis>_rates.svg/.png` (`c_t`). Returns the
+/// and unsafe sets when the model is given), `DIR/<analysis>_radius.svg/.png`, with a Monte
+/// Carlo report's per-state spreads `DIR/<analysis>_widths.svg/.png` (the plotted states'
+/// bounding-box half-widths against the paths') and, when the rates vary in time (local or
+/// empirical), `DIR/<analysis>_rates.svg/.png` (`c_t`). Returns the
 /// files, rendered but not written; the error is a message.
 pub fn plot_result(
     result: &ResultFile,
@@ -217,6 +257,15 @@ pub fn plot_result(
         &result.analysis,
         "radius",
     ));
+    if let Some(widths) = quantile.and_then(|q| scene::widths_scene(result, states, q)) {
+        files.extend(renderings(
+            &widths,
+            figures::RADIUS_SIZE,
+            dir,
+            &result.analysis,
+            "widths",
+        ));
+    }
     if let Some(rates) = scene::rates_scene(result) {
         files.extend(renderings(
             &rates,

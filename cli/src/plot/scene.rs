@@ -6,6 +6,7 @@
 use super::geometry::{clip, Plane, Point, Projected};
 use super::input::{Guarantee, Method, RateSource, ResultFile, Role, Shape, Step};
 use super::regions::Region;
+use super::Quantile;
 use reachc_runtime::model::{Analysis, ModelInfo};
 use reachc_runtime::report::count;
 
@@ -66,6 +67,94 @@ pub struct RadiusScene {
     pub quantile: Option<(Vec<Option<f64>>, String)>,
     /// Lines for the legend panel.
     pub notes: Vec<String>,
+}
+
+/// The widths figure: per plotted state, the PRS's bounding-box half-width about the nominal
+/// and the half-width holding `1 - δ` of the Monte Carlo paths, against time (tightness per
+/// coordinate).
+#[derive(Clone, Debug)]
+pub struct WidthsScene {
+    /// Title.
+    pub title: String,
+    /// Report times.
+    pub times: Vec<f64>,
+    /// The plotted states' curves.
+    pub states: Vec<WidthCurves>,
+    /// Lines for the legend panel.
+    pub notes: Vec<String>,
+}
+
+/// One state's curves in the widths figure.
+#[derive(Clone, Debug)]
+pub struct WidthCurves {
+    /// The PRS's half-widths (`None`: not finite) and their legend label.
+    pub prs: Vec<Option<f64>>,
+    pub prs_label: String,
+    /// The paths' half-widths and their legend label.
+    pub paths: Vec<Option<f64>>,
+    pub paths_label: String,
+}
+
+/// The widths figure of the `plotted` states of a result, from a Monte Carlo report with
+/// per-state spreads (`None` without them).
+pub fn widths_scene(
+    result: &ResultFile,
+    plotted: [usize; 2],
+    quantile: &Quantile,
+) -> Option<WidthsScene> {
+    if quantile.states.len() != result.states.len() {
+        return None;
+    }
+    let mut picked = plotted.to_vec();
+    picked.dedup();
+    let times = result.times();
+    let mut notes = vec![
+        format!(
+            "half-widths about the nominal x*_t: of the PRS's bounding box (solid) and of the \
+             smallest interval holding 1-δ of {} (dashed), δ = {}",
+            count(quantile.paths, "path"),
+            result.delta
+        ),
+        format!("paths: {}", quantile.source),
+    ];
+    let states = picked
+        .iter()
+        .map(|&i| {
+            let w = &quantile.states[i];
+            let name = &result.states[i];
+            // The ratio at the last report time where both are finite and positive.
+            let last =
+                w.prs
+                    .iter()
+                    .zip(&w.quantile)
+                    .zip(&times)
+                    .rev()
+                    .find_map(|((p, q), t)| match (p, q) {
+                        (Some(p), Some(q)) if *q > 0.0 => Some((p / q, *t)),
+                        _ => None,
+                    });
+            if let Some((ratio, t)) = last {
+                notes.push(format!(
+                    "{name}: the PRS is {ratio:.2} times the paths' half-width at t = {t}"
+                ));
+            }
+            WidthCurves {
+                prs: w.prs.clone(),
+                prs_label: format!("{name}: PRS"),
+                paths: w.quantile.clone(),
+                paths_label: format!("{name}: paths (1-δ)"),
+            }
+        })
+        .collect();
+    Some(WidthsScene {
+        title: format!(
+            "{} / {}: half-widths per state",
+            result.model, result.analysis
+        ),
+        times,
+        states,
+        notes,
+    })
 }
 
 /// The rates figure of a result whose rates vary in time (`rate = local` or `empirical`):

@@ -68,6 +68,12 @@ impl Scale {
     }
 }
 
+/// The smallest scale the epochs are laid out for. Noise that is zero has an outward-rounded
+/// bound of a subnormal (`sigma = 5e-324`), whose `S` would make `lambda = z / sqrt(S kappa)`
+/// overflow and the radius infinite; epochs laid out for a larger `S` hold all the same (any
+/// thresholds covering the horizon's `S` do), and give a radius of about `sqrt(S_FLOOR)`.
+const S_FLOOR: f64 = 1e-200;
+
 /// One epoch of the tube.
 #[derive(Clone, Copy, Debug)]
 struct Epoch {
@@ -97,6 +103,7 @@ impl Tube {
                 epochs: Vec::new(),
             };
         }
+        let (s_first, s_last) = (s_first.max(S_FLOOR), s_last.max(S_FLOOR));
         let ratio = (s_last / s_first.max(f64::MIN_POSITIVE)).max(1.0);
         // An infinite scale (a run that diverges) saturates the cast: add without overflow.
         let k = (ratio.log2().ceil() as usize)
@@ -230,6 +237,19 @@ mod tests {
     fn an_infinite_scale_gets_the_most_epochs_without_overflow() {
         let tube = Tube::new(2, 1e-3, 1e-2, f64::INFINITY);
         assert_eq!(tube.epochs.len(), MAX_EPOCHS);
+    }
+
+    /// Zero noise bounded outward (a subnormal sigma, so a subnormal `S`): a finite radius of
+    /// about `sqrt(S_FLOOR)` (it was infinite, and the local rates of noise-free specs could
+    /// not close), still above the pointwise radius of the real `S`.
+    #[test]
+    fn a_subnormal_scale_gets_a_tiny_finite_radius() {
+        let s = 5e-324 * 0.01;
+        let tube = Tube::new(1, 1e-3, s, 1e-323);
+        for s in [0.0f64, 5e-324, 1e-323] {
+            let r = tube.radius(Interval::ZERO, Interval::new(0.0, s.max(5e-324)));
+            assert!(r > 0.0 && r < 1e-98, "S = {s:e}: {r:e}");
+        }
     }
 
     /// At each epoch's threshold the tube's radius is the pointwise one at delta / K; between

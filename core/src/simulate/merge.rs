@@ -7,7 +7,7 @@ use super::binomial;
 use super::part::{Part, PartStats, RunInfo};
 use super::part_file::run_bytes;
 use super::report::{
-    Coverage, HorizonReport, InputsReport, SimReport, SimStep, TubeReport, UnsafeHits,
+    Coverage, HorizonReport, InputsReport, SimReport, SimStep, StateSpread, TubeReport, UnsafeHits,
 };
 use super::shard::Shard;
 use super::topk::TopK;
@@ -38,7 +38,8 @@ pub struct Merger {
     /// The shards seen, with their parts' labels.
     seen: BTreeMap<u64, String>,
     stats: Option<PartStats>,
-    topk: Option<TopK>,
+    /// The metric's distances and the states' deviations.
+    topk: Option<(TopK, TopK)>,
 }
 
 impl Default for Merger {
@@ -68,17 +69,18 @@ impl Merger {
         match &self.first {
             None => {
                 let run = &part.run;
-                let steps = run.steps.len() as u64;
-                if run.quantile_rank.saturating_mul(16 * steps) > QUANTILE_BYTES {
+                let (steps, n) = (run.steps.len(), run.states.len());
+                let buffers = steps as u64 * (1 + n as u64);
+                if run.quantile_rank.saturating_mul(16 * buffers) > QUANTILE_BYTES {
                     return err(format!(
-                        "`{label}`: exact quantiles of rank {} over {steps} report times need more \
-                         than {} GiB",
+                        "`{label}`: exact quantiles of rank {} over {steps} report times and {n} \
+                         states need more than {} GiB",
                         run.quantile_rank,
                         QUANTILE_BYTES >> 30
                     ));
                 }
                 let j = usize::try_from(run.quantile_rank).unwrap_or(usize::MAX);
-                self.topk = Some(TopK::new(run.steps.len(), j));
+                self.topk = Some((TopK::new(steps, j), TopK::new(steps * n, j)));
                 self.first = Some((
                     label.to_string(),
                     run.clone(),
@@ -111,18 +113,20 @@ impl Merger {
             Some(s) => s.add(&part.stats),
             None => self.stats = Some(part.stats),
         }
-        if let Some(topk) = &mut self.topk {
-            for (k, top) in part.top.iter().enumerate() {
-                top.iter().for_each(|&d| topk.push(k, d));
+        if let Some(topks) = &mut self.topk {
+            for (topk, tops) in [(&mut topks.0, &part.top), (&mut topks.1, &part.state_top)] {
+                for (k, top) in tops.iter().enumerate() {
+                    top.iter().for_each(|&d| topk.push(k, d));
+                }
+                topk.tighten();
             }
-            topk.tighten();
         }
         Ok(())
     }
 
     /// The report of the parts added, when they are every shard of one run.
     pub fn finish(self) -> Result<SimReport, MergeError> {
-        let (Some((_, run, _, count)), Some(stats), Some(mut topk)) =
+        let (Some((_, run, _, count)), Some(stats), Some((mut topk, mut state_topk))) =
             (self.first, self.stats, self.topk)
         else {
             return Err(MergeError("no parts to merge".into()));
@@ -146,7 +150,7 @@ impl Merger {
                 self.seen.len()
             )));
         }
-        Ok(report(&run, &stats, &mut topk))
+        Ok(report(&run, &stats, &mut topk, &mut state_topk))
     }
 }
 
@@ -195,8 +199,10 @@ fn difference(a: &RunInfo, b: &RunInfo, a_bytes: &[u8]) -> Option<String> {
 }
 
 /// Quantiles, Clopper-Pearson bounds and the verdict from the merged statistics (`topk`: the
-/// largest `run.quantile_rank` squared distances of all paths at each report time).
-fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK) -> SimReport {
+/// largest `run.quantile_rank` squared distances of all paths at each report time;
+/// `state_topk`: the largest deviations of each state, entry `k n + i`).
+fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut TopK) -> SimReport {
+    let n = run.states.len();
     let n_paths = run.paths;
     let frac = |k: u64| k as f64 / n_paths as f64;
     let alpha = 1.0 - run.confidence;
@@ -217,6 +223,16 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK) -> SimReport {
             let (q2, max2) = topk.result(k).unwrap_or((f64::NAN, f64::NAN));
             let (quantile, max) = (q2.sqrt(), max2.sqrt());
             let outside = total.outside[k];
+            let states = st
+                .hull
+                .iter()
+                .enumerate()
+                .map(|(i, &prs)| {
+                    let (quantile, max) =
+                        state_topk.result(k * n + i).unwrap_or((f64::NAN, f64::NAN));
+                    StateSpread { quantile, max, prs }
+                })
+                .collect();
             SimStep {
                 t: st.t,
                 r_t: st.r_t,
@@ -227,6 +243,7 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK) -> SimReport {
                 fraction: frac(outside),
                 cp_upper: upper(outside),
                 left_tube: run.tube.then_some(total.left_tube[k]),
+                states,
             }
         })
         .collect();
@@ -266,6 +283,7 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK) -> SimReport {
     SimReport {
         model: run.model.clone(),
         analysis: run.analysis.clone(),
+        states: run.states.clone(),
         method: run.method,
         delta: run.delta,
         guarantee: run.guarantee,
@@ -513,7 +531,7 @@ mod tests {
         version[MAGIC_LEN] = 9;
         assert_eq!(
             read(&version),
-            "part file format version 9; this reachc reads version 2"
+            "part file format version 9; this reachc reads version 3"
         );
         let mut longer = bytes.clone();
         longer.extend_from_slice(&[0; 8]);

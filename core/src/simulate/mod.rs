@@ -57,16 +57,17 @@ pub use part::{Part, PartStats, RunInfo, StepInfo};
 pub use part_file::{FORMAT_VERSION, MAGIC};
 pub use report::{
     Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SimReport, SimStep,
-    TubeReport, UnsafeHits,
+    StateSpread, TubeReport, UnsafeHits,
 };
 pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
 pub use shard::Shard;
 pub use workers::thread_count;
 
+use crate::interval::Interval;
 use crate::model::{Guarantee, ModelInfo};
 use crate::prs::{Prs, UnsafeKind};
 use crate::system::System;
-use paths::{ChunkStats, Plan, Span};
+use paths::{ChunkStats, Plan, Span, Thresholds};
 use std::fmt;
 
 /// The version of reachc that simulates (recorded in parts: only parts of one version merge).
@@ -175,24 +176,28 @@ pub fn run_part<S: System + Sync + ?Sized>(
     // j-th largest = ceil((1 - delta) N)-th smallest; the slack keeps delta * N = 1000 (say)
     // from rounding down to 999. N is the whole run's: every part keeps the same j.
     let j = ((result.delta * n_paths as f64 * (1.0 + 1e-12)).floor() as u64 + 1).min(n_paths);
-    let quantile_bytes = 16 * j * steps as u64;
+    // One buffer per report time for the metric's distance and one per state.
+    let n = sys.n();
+    let buffers = steps as u64 * (1 + n as u64);
+    let quantile_bytes = 16u64.saturating_mul(j).saturating_mul(buffers);
     if quantile_bytes > QUANTILE_BYTES {
         return Err(SimError::Usage(format!(
-            "exact quantiles of {n_paths} paths at delta = {} over {steps} report times need \
-             {:.1} GiB (more than {} GiB): use fewer paths",
+            "exact quantiles of {n_paths} paths at delta = {} over {steps} report times and \
+             {n} states need {:.1} GiB (more than {} GiB): use fewer paths",
             result.delta,
             quantile_bytes as f64 / f64::from(1u32 << 30),
             QUANTILE_BYTES >> 30
         )));
     }
     // Batches: many chunks per batch for the threads, few enough candidates in memory.
-    let batch = (BATCH_BYTES / (16 * steps as u64))
-        .clamp(4 * CHUNK, MAX_BATCH)
+    let batch = (BATCH_BYTES / (16 * buffers))
+        .clamp(CHUNK, MAX_BATCH)
         .div_ceil(CHUNK)
         * CHUNK;
     let workers = workers::Workers::new(opts.threads)?;
-    let mut topk = topk::TopK::new(steps, usize::try_from(j).unwrap_or(usize::MAX));
-    let mut total = ChunkStats::new(steps, plan.unsafe_sets.len());
+    let j = usize::try_from(j).unwrap_or(usize::MAX);
+    let (mut topk, mut state_topk) = (topk::TopK::new(steps, j), topk::TopK::new(steps * n, j));
+    let mut total = ChunkStats::new(steps, plan.unsafe_sets.len(), n);
     let range = shard.paths(n_paths);
     let mut done = 0;
     let mine = range.end - range.start;
@@ -200,8 +205,11 @@ pub fn run_part<S: System + Sync + ?Sized>(
         // Small batches first: the thresholds are -inf until a step has `j` values, and every
         // path-step is a candidate until then; doubling keeps the number of batches
         // logarithmic.
-        let end = (done + done.clamp(4 * CHUNK, batch)).min(mine);
-        let thresholds = topk.thresholds().to_vec();
+        let end = (done + done.clamp((4 * CHUNK).min(batch), batch)).min(mine);
+        let thresholds = Thresholds {
+            metric: topk.thresholds().to_vec(),
+            states: state_topk.thresholds().to_vec(),
+        };
         let chunks: Vec<(u64, u64)> = (range.start + done..range.start + end)
             .step_by(CHUNK as usize)
             .map(|s| (s, (s + CHUNK).min(range.start + end)))
@@ -212,16 +220,21 @@ pub fn run_part<S: System + Sync + ?Sized>(
             for &(k, d) in &c.candidates {
                 topk.push(k as usize, d);
             }
+            for &(s, d) in &c.state_candidates {
+                state_topk.push(s as usize, d);
+            }
         }
         topk.tighten();
+        state_topk.tighten();
         done = end;
         progress(done, mine);
     }
     Ok(Part {
-        run: run_info(&plan, info, result, opts, j),
+        run: run_info(&plan, info, result, opts, j as u64),
         shard,
         stats: PartStats::of(total),
         top: topk.into_largest(),
+        state_top: state_topk.into_largest(),
     })
 }
 
@@ -238,6 +251,7 @@ fn run_info<S: System + ?Sized>(
         spec_hash: String::new(),
         model: result.model.clone(),
         analysis: result.analysis.clone(),
+        states: result.states.clone(),
         method: result.method,
         delta: result.delta,
         guarantee: result.guarantee,
@@ -264,10 +278,12 @@ fn run_info<S: System + ?Sized>(
         steps: result
             .steps
             .iter()
-            .map(|s| StepInfo {
+            .enumerate()
+            .map(|(k, s)| StepInfo {
                 t: s.t,
                 r_t: s.r_t,
                 prs_radius: s.prs_radius,
+                hull: hull_half_widths(result, k),
             })
             .collect(),
         digest: part_file::checksum(
@@ -277,6 +293,24 @@ fn run_info<S: System + ?Sized>(
             )
             .as_bytes(),
         ),
+    }
+}
+
+/// Per state, the half-width of the PRS's bounding box at report step `k` about the nominal
+/// state (`max(hi_i - x*_i, x*_i - lo_i)`, rounded up), `NaN` where there is no box.
+fn hull_half_widths(result: &Prs, k: usize) -> Vec<f64> {
+    let c = result.steps[k].nominal();
+    match result.hull_at(k) {
+        Some(hull) => hull
+            .iter()
+            .zip(c)
+            .map(|(b, &c)| {
+                let up = (Interval::point(b.hi) - Interval::point(c)).hi();
+                let down = (Interval::point(c) - Interval::point(b.lo)).hi();
+                up.max(down)
+            })
+            .collect(),
+        None => vec![f64::NAN; c.len()],
     }
 }
 
@@ -543,12 +577,8 @@ mod tests {
     /// blocks of 64 and a last one of 44, whose last 4 paths are not a group of eight.
     #[test]
     fn the_extensions_do_not_change_the_paths() {
-        let sorted = |mut s: ChunkStats| {
-            // The eight-lane loop records a group's steps in turn, the others a step's paths.
-            s.candidates
-                .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-            s
-        };
+        // The eight-lane loop records a group's steps in turn, the others a step's paths.
+        let sorted = ChunkStats::sorted;
         let identity = vec![1.0, 0.0, 0.0, 1.0];
         let skewed = vec![2.0, 0.7, 0.7, 1.0];
         // The factor narrowing the spans: with an input, R_t and the spans are larger.
@@ -572,7 +602,7 @@ mod tests {
                     ..Options::default()
                 };
                 let mut plan = make_plan(&sys, &info, &r, &opts).unwrap();
-                let thresholds = vec![threshold; plan.times.len()];
+                let thresholds = Thresholds::uniform(plan.times.len(), plan.sys.n(), threshold);
                 let detected = sorted(plan.run_chunk(0..300, &thresholds));
                 plan.avx512 = false;
                 let avx2 = sorted(plan.run_chunk(0..300, &thresholds));
@@ -808,11 +838,7 @@ mod tests {
     /// states ([`result_paths`]).
     #[test]
     fn a_zonotope_member_is_counted_as_contains_at_decides() {
-        let sorted = |mut s: ChunkStats| {
-            s.candidates
-                .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-            s
-        };
+        let sorted = ChunkStats::sorted;
         for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
             let (sys, info) = (Sys { b: 0.0 }, info_in(0.0, metric.clone()));
             let mut r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
@@ -829,7 +855,7 @@ mod tests {
             };
             for threshold in [f64::NEG_INFINITY, 0.05] {
                 let mut plan = make_plan(&sys, &info, &r, &opts).unwrap();
-                let thresholds = vec![threshold; plan.times.len()];
+                let thresholds = Thresholds::uniform(plan.times.len(), plan.sys.n(), threshold);
                 let detected = sorted(plan.run_chunk(0..300, &thresholds));
                 plan.avx512 = false;
                 let avx2 = sorted(plan.run_chunk(0..300, &thresholds));

@@ -23,6 +23,9 @@ pub struct Part {
     /// `|X_t - x*_t|_P^2` of the shard's paths, largest first (the `j` largest of the union of
     /// all parts hold the quantile and the maximum of the whole run).
     pub top: Vec<Vec<f64>>,
+    /// The same for each state's deviation `|X_t,i - x*_t,i|`: entry `k n + i` for report time
+    /// `k` and state `i`.
+    pub state_top: Vec<Vec<f64>>,
 }
 
 /// What a simulation was: the analysis' result as the report shows it, the options, and the
@@ -37,6 +40,8 @@ pub struct RunInfo {
     pub model: String,
     /// The analysis.
     pub analysis: String,
+    /// The state names, in order.
+    pub states: Vec<String>,
     /// Its method.
     pub method: Method,
     /// Its probability level (the one simulated, with `--delta`).
@@ -84,7 +89,7 @@ pub struct RunInfo {
 }
 
 /// The analysis' radii at one report time.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct StepInfo {
     /// Time.
     pub t: f64,
@@ -92,6 +97,9 @@ pub struct StepInfo {
     pub r_t: f64,
     /// PRS radius.
     pub prs_radius: f64,
+    /// Per state, the half-width of the PRS's bounding box about the nominal state (`NaN`
+    /// where the result has none).
+    pub hull: Vec<f64>,
 }
 
 /// The counts of a set of paths (sums over shards, and a minimum).
@@ -165,10 +173,13 @@ impl Part {
         let mine = n.end - n.start;
         let steps = run.steps.len();
         let sets = run.unsafe_sets.len();
+        let n = run.states.len();
         if steps == 0
             || st.outside.len() != steps
             || st.left_tube.len() != steps
             || self.top.len() != steps
+            || self.state_top.len() != steps * n
+            || run.steps.iter().any(|s| s.hull.len() != n)
             || st.unsafe_hits.len() != sets
             || st.first_hit.len() != sets
         {
@@ -188,15 +199,24 @@ impl Part {
             return Some(format!("counts inconsistent with its {mine} paths"));
         }
         let kept = run.quantile_rank.min(mine);
-        for (k, top) in self.top.iter().enumerate() {
+        let buffers = self.top.iter().enumerate().map(|(k, top)| (k, None, top));
+        let per_state = self
+            .state_top
+            .iter()
+            .enumerate()
+            .map(|(s, top)| (s / n, Some(s % n), top));
+        for (k, state, top) in buffers.chain(per_state) {
+            let of = state.map_or(String::new(), |i| format!(" of state {i}"));
             if top.len() as u64 != kept {
                 return Some(format!(
-                    "{} distances at report time {k}, expected {kept}",
+                    "{} distances{of} at report time {k}, expected {kept}",
                     top.len()
                 ));
             }
             if top.iter().any(|d| d.is_nan() || *d < 0.0) || top.windows(2).any(|w| w[0] < w[1]) {
-                return Some(format!("the distances at report time {k} are not sorted"));
+                return Some(format!(
+                    "the distances{of} at report time {k} are not sorted"
+                ));
             }
         }
         None

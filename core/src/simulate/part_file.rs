@@ -20,7 +20,7 @@ use crate::prs::UnsafeKind;
 /// The first bytes of a part file.
 pub const MAGIC: &[u8] = b"reachc simulate part\n";
 /// The version of the layout this reachc writes and reads.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// FNV-1a, 64 bits.
 pub(crate) fn checksum(bytes: &[u8]) -> u64 {
@@ -169,6 +169,8 @@ impl Part {
         w.u64(st.diverged);
         w.u64(self.top.len() as u64);
         self.top.iter().for_each(|t| w.f64s(t));
+        w.u64(self.state_top.len() as u64);
+        self.state_top.iter().for_each(|t| w.f64s(t));
         let sum = checksum(&w.0);
         w.u64(sum);
         w.0
@@ -220,6 +222,7 @@ impl Part {
             diverged: r.u64()?,
         };
         let top = (0..r.len(8)?).map(|_| r.f64s()).collect::<Result<_, _>>()?;
+        let state_top = (0..r.len(8)?).map(|_| r.f64s()).collect::<Result<_, _>>()?;
         if r.at != body {
             return Err(format!(
                 "{} unexpected bytes before the checksum",
@@ -231,6 +234,7 @@ impl Part {
             shard,
             stats,
             top,
+            state_top,
         })
     }
 }
@@ -241,6 +245,8 @@ fn write_run(w: &mut Writer, run: &RunInfo) {
     w.str(&run.spec_hash);
     w.str(&run.model);
     w.str(&run.analysis);
+    w.u64(run.states.len() as u64);
+    run.states.iter().for_each(|s| w.str(s));
     w.u8(code_of(&METHODS, &run.method));
     w.f64(run.delta);
     w.u8(code_of(&GUARANTEES, &run.guarantee));
@@ -281,6 +287,7 @@ fn write_run(w: &mut Writer, run: &RunInfo) {
         w.f64(s.t);
         w.f64(s.r_t);
         w.f64(s.prs_radius);
+        w.f64s(&s.hull);
     }
     w.u64(run.digest);
 }
@@ -291,6 +298,7 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
         spec_hash: r.str()?,
         model: r.str()?,
         analysis: r.str()?,
+        states: (0..r.len(8)?).map(|_| r.str()).collect::<Result<_, _>>()?,
         method: r.code("method", &METHODS)?,
         delta: r.f64()?,
         guarantee: r.code("guarantee", &GUARANTEES)?,
@@ -328,12 +336,13 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
             .map(|_| Ok((r.str()?, r.code("unsafe set", &UNSAFE)?)))
             .collect::<Result<_, String>>()?,
         quantile_rank: r.u64()?,
-        steps: (0..r.len(24)?)
+        steps: (0..r.len(32)?)
             .map(|_| {
                 Ok(StepInfo {
                     t: r.f64()?,
                     r_t: r.f64()?,
                     prs_radius: r.f64()?,
+                    hull: r.f64s()?,
                 })
             })
             .collect::<Result<_, String>>()?,

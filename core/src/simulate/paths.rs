@@ -34,6 +34,7 @@ use super::regions::Region;
 use super::rng::PathRng;
 use crate::lanes::X8;
 use crate::system::System;
+use std::cmp::Ordering;
 use std::ops::Range;
 
 /// The Euler steps between two report times `t0 < t1`: `steps` equal steps of size `h`.
@@ -116,6 +117,11 @@ pub(crate) struct ChunkStats {
     pub(crate) outside: Vec<u64>,
     /// `(step, squared distance)` for those above the step's threshold at the chunk's start.
     pub(crate) candidates: Vec<(u32, f64)>,
+    /// `(k n + i, |x_i - x*_i|)` at report step `k` for those above state `i`'s threshold at
+    /// the chunk's start (non-finite deviations as `inf`).
+    pub(crate) state_candidates: Vec<(u32, f64)>,
+    /// The number of states.
+    states: usize,
     /// Paths outside the PRS at one report step at least.
     pub(crate) outside_any: u64,
     /// Paths that left the time-uniform tube at one Euler step at least (0 without a tube).
@@ -134,10 +140,12 @@ pub(crate) struct ChunkStats {
 }
 
 impl ChunkStats {
-    pub(crate) fn new(steps: usize, sets: usize) -> Self {
+    pub(crate) fn new(steps: usize, sets: usize, states: usize) -> Self {
         ChunkStats {
             outside: vec![0; steps],
             candidates: Vec::new(),
+            state_candidates: Vec::new(),
+            states,
             outside_any: 0,
             outside_tube: 0,
             left_tube: vec![0; steps],
@@ -153,6 +161,34 @@ impl ChunkStats {
     fn ended(&mut self, k: usize) {
         self.outside[k] += 1;
         self.candidates.push((k as u32, f64::INFINITY));
+        let n = self.states;
+        self.state_candidates
+            .extend((k * n..(k + 1) * n).map(|s| (s as u32, f64::INFINITY)));
+    }
+
+    /// The per-state candidates of a state `x` at report step `k` (centre `c`, thresholds
+    /// `thr`, one per state).
+    #[inline(always)]
+    fn states_at(&mut self, k: usize, x: &[f64], c: &[f64], thr: &[f64]) {
+        let first = k * self.states;
+        for (i, ((&x, &c), &thr)) in x.iter().zip(c).zip(thr).enumerate() {
+            let d = (x - c).abs();
+            // Not `d > thr`: a NaN deviation (a non-finite state) is above every quantile.
+            if let Some(Ordering::Greater) | None = d.partial_cmp(&thr) {
+                let d = if d.is_nan() { f64::INFINITY } else { d };
+                self.state_candidates.push(((first + i) as u32, d));
+            }
+        }
+    }
+
+    /// The statistics with their candidates in one order (the loops record them in different
+    /// orders).
+    #[cfg(test)]
+    pub(crate) fn sorted(mut self) -> Self {
+        for c in [&mut self.candidates, &mut self.state_candidates] {
+            c.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        }
+        self
     }
 
     /// Adds `other` (order-independent: sums, minima, concatenation).
@@ -268,6 +304,30 @@ struct Group<'a> {
     hit: &'a mut [bool],
 }
 
+/// The quantile candidates' thresholds of a batch of paths (the buffers' `j`-th largest
+/// values at its start, `-inf` before a buffer has `j`): at report step `k`, a squared
+/// distance is a candidate above `metric[k]`, state `i`'s deviation above `states[k n + i]`.
+pub(crate) struct Thresholds {
+    pub(crate) metric: Vec<f64>,
+    pub(crate) states: Vec<f64>,
+}
+
+impl Thresholds {
+    /// `v` for every step and state.
+    #[cfg(test)]
+    pub(crate) fn uniform(steps: usize, n: usize, v: f64) -> Self {
+        Thresholds {
+            metric: vec![v; steps],
+            states: vec![v; steps * n],
+        }
+    }
+
+    /// The thresholds of report step `k` for the states (`n` of them).
+    fn states_at(&self, k: usize, n: usize) -> &[f64] {
+        &self.states[k * n..][..n]
+    }
+}
+
 /// What a step ending at a report time records, besides the step itself.
 #[derive(Clone, Copy)]
 struct Report<'c> {
@@ -277,6 +337,8 @@ struct Report<'c> {
     c: &'c [f64],
     /// Its candidate threshold.
     thr: f64,
+    /// Its per-state candidate thresholds.
+    states: &'c [f64],
     /// Its bound from [`Lanes::quiet`], if any.
     quiet: Option<f64>,
 }
@@ -303,8 +365,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
         self.spans.iter().map(|s| u64::from(s.steps)).sum()
     }
 
-    /// Simulates the paths `range`; `thresholds[k]` filters the candidates of step `k`.
-    pub(crate) fn run_chunk(&self, range: Range<u64>, thresholds: &[f64]) -> ChunkStats {
+    /// Simulates the paths `range`; `thresholds` filter the candidates.
+    pub(crate) fn run_chunk(&self, range: Range<u64>, thresholds: &Thresholds) -> ChunkStats {
         match self.sys.n() {
             1 => self.run_chunk_in(Fixed::<1>, range, thresholds),
             2 => self.run_chunk_in(Fixed::<2>, range, thresholds),
@@ -315,13 +377,18 @@ impl<S: System + ?Sized> Plan<'_, S> {
     }
 
     /// [`run_chunk`](Self::run_chunk) with `dim.get() == sys.n()`.
-    fn run_chunk_in<D: Dim>(&self, dim: D, range: Range<u64>, thresholds: &[f64]) -> ChunkStats {
+    fn run_chunk_in<D: Dim>(
+        &self,
+        dim: D,
+        range: Range<u64>,
+        thresholds: &Thresholds,
+    ) -> ChunkStats {
         // Lanes are `max(n, 1)` and `max(p, 1)` wide so that chunking by them never panics.
         let (n, p, m) = (dim.get().max(1), self.sys.p().max(1), self.sys.m());
         let sets = self.unsafe_sets.len();
-        let mut st = ChunkStats::new(self.times.len(), sets);
-        let quiet = (0..thresholds.len())
-            .map(|k| Some(thresholds[k].min(self.membership.inside_below(k)?)))
+        let mut st = ChunkStats::new(self.times.len(), sets, dim.get());
+        let quiet = (0..self.times.len())
+            .map(|k| Some(thresholds.metric[k].min(self.membership.inside_below(k)?)))
             .collect();
         let path = Path {
             rng: PathRng::new(0, 0),
@@ -358,7 +425,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         dim: D,
         first: u64,
         lanes: usize,
-        thresholds: &[f64],
+        thresholds: &Thresholds,
         l: &mut Lanes,
         st: &mut ChunkStats,
     ) {
@@ -373,7 +440,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
             let x = &mut l.x[a * nn..][..n];
             self.initial.sample(&mut path.rng, self.zig, x, &mut l.init);
             let qa = self.metric.quad(x, &self.nominal[..n]);
-            self.record(0, x, qa, thresholds[0], st, path);
+            self.record(0, x, qa, thresholds.metric[0], st, path);
+            st.states_at(0, x, &self.nominal[..n], thresholds.states_at(0, n));
             self.check_tube(0, x, path, st);
             let hit = &mut l.hit[a * sets..][..sets];
             self.check_sets(0.0, x, hit, &mut path.left_domain, st);
@@ -426,7 +494,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 let report = (i + 1 == span.steps).then(|| Report {
                     k,
                     c: &self.nominal[k * n..][..n],
-                    thr: thresholds[k],
+                    thr: thresholds.metric[k],
+                    states: thresholds.states_at(k, n),
                     quiet: l.quiet.as_ref().map(|q| q[k]),
                 });
                 let step = Step {
@@ -578,6 +647,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         if !quiet {
             self.record(rep.k, x, (q, a), rep.thr, st, path);
         }
+        st.states_at(rep.k, x, rep.c, rep.states);
     }
 
     /// [`report`](Self::report)'s "quiet" answer for eight states in lanes (`(q, a)` their
@@ -628,12 +698,17 @@ impl<S: System + ?Sized> Plan<'_, S> {
         if let Some(diag) = self.metric.nonneg_diagonal() {
             w.copy_from_slice(&diag[..n]);
         }
-        let (k, quiet, thr) = match step.report {
+        let (k, quiet, thr, thr_states) = match step.report {
             Some(rep) if REPORT => {
                 c.copy_from_slice(&rep.c[..n]);
-                (rep.k, rep.quiet.unwrap_or(f64::NEG_INFINITY), rep.thr)
+                (
+                    rep.k,
+                    rep.quiet.unwrap_or(f64::NEG_INFINITY),
+                    rep.thr,
+                    rep.states,
+                )
             }
-            _ => (0, f64::NEG_INFINITY, f64::NEG_INFINITY),
+            _ => (0, f64::NEG_INFINITY, f64::NEG_INFINITY, &[][..]),
         };
         // The tube over this report interval: its box and "clearly inside" bound.
         let (mut lo, mut hi, mut q_in) = ([0.0; SMALL], [0.0; SMALL], f64::INFINITY);
@@ -672,6 +747,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 if !quiet {
                     self.record(k, x, (q, q), thr, st, path);
                 }
+                st.states_at(k, x, c, thr_states);
             }
         }
     }
@@ -690,7 +766,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         x: &mut [f64],
         paths: &mut [Path],
         quiet: &[f64],
-        thresholds: &[f64],
+        thresholds: &Thresholds,
         st: &mut ChunkStats,
     ) {
         let n = dim.get();
@@ -737,6 +813,13 @@ impl<S: System + ?Sized> Plan<'_, S> {
             // Lanes to record: ended paths, and states not below the quiet bound (or NaN).
             let c = &self.nominal[k * n..][..n];
             let (q, loud) = group.quad(n, w, c, quiet[k]);
+            let thr_states = thresholds.states_at(k, n);
+            let mut each = live;
+            while each != 0 {
+                let a = each.trailing_zeros() as usize;
+                each &= each - 1;
+                st.states_at(k, &group.lane(a)[..n], c, thr_states);
+            }
             let mut loud = loud | !live;
             while loud != 0 {
                 let a = loud.trailing_zeros() as usize;
@@ -747,7 +830,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     continue;
                 }
                 let (xa, qa) = (group.lane(a), (q.0[a], q.0[a]));
-                self.record(k, &xa[..n], qa, thresholds[k], st, path);
+                self.record(k, &xa[..n], qa, thresholds.metric[k], st, path);
                 if !path.alive {
                     live &= !(1 << a);
                 }
@@ -772,7 +855,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         dim: D,
         Group { x, paths, hit }: Group<'_>,
         quiet: Option<&[f64]>,
-        thresholds: &[f64],
+        thresholds: &Thresholds,
         st: &mut ChunkStats,
     ) {
         let (n, m, p) = (dim.get(), self.sys.m(), self.sys.p());
@@ -819,7 +902,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 let report = (i + 1 == span.steps).then(|| Report {
                     k,
                     c: &self.nominal[k * n..][..n],
-                    thr: thresholds[k],
+                    thr: thresholds.metric[k],
+                    states: thresholds.states_at(k, n),
                     quiet: quiet.map(|q| q[k]),
                 });
                 // The tube's shortcut and the distances in the lanes; the rest per lane.
@@ -842,6 +926,15 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 } else {
                     live & !inside
                 };
+                if let Some(rep) = &report {
+                    let mut each = live;
+                    while each != 0 {
+                        let a = each.trailing_zeros() as usize;
+                        each &= each - 1;
+                        let xa: [f64; SMALL] = std::array::from_fn(|j| xs[j].0[a]);
+                        st.states_at(k, &xa[..n], rep.c, rep.states);
+                    }
+                }
                 // Lane by lane in order, as the scalar loops go path by path.
                 while busy != 0 {
                     let a = busy.trailing_zeros() as usize;
@@ -1173,12 +1266,8 @@ mod tests {
             eprintln!("no AVX-512: nothing to compare");
             return;
         }
-        let sorted = |mut s: ChunkStats| {
-            // The lanes record a group's steps in turn, the scalar loops a step's paths.
-            s.candidates
-                .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-            s
-        };
+        // The lanes record a group's steps in turn, the scalar loops a step's paths.
+        let sorted = ChunkStats::sorted;
         let (mut outside, mut hits, mut late) = (0, 0, 0.0_f64);
         for method in [Method::Contraction, Method::Interval] {
             for guarantee in [Guarantee::Uniform, Guarantee::Pointwise] {
@@ -1219,7 +1308,8 @@ mod tests {
                         let mut plan = make_plan(sys, info, &r, &opts).unwrap();
                         assert!(plan.lanes_take(2) && plan.noise.diagonal().is_none());
                         assert_eq!(plan.noise.needs_matrix(), !constant);
-                        let thresholds = vec![threshold; plan.times.len()];
+                        let thresholds =
+                            Thresholds::uniform(plan.times.len(), plan.sys.n(), threshold);
                         plan.avx512 = true;
                         let lanes = sorted(plan.run_chunk(0..203, &thresholds));
                         plan.avx512 = false;

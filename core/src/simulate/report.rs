@@ -14,6 +14,8 @@ pub struct SimReport {
     pub model: String,
     /// The analysis whose PRS is checked.
     pub analysis: String,
+    /// The state names, in order (as [`SimStep::states`]).
+    pub states: Vec<String>,
     /// Its method.
     pub method: Method,
     /// The PRS's probability level: the tube should hold the whole path (uniform), or each PRS
@@ -93,6 +95,30 @@ pub struct SimStep {
     /// interval ending here (`(t_{k-1}, t_k]`; at `t = 0`, at the start); `None` for a
     /// pointwise result.
     pub left_tube: Option<u64>,
+    /// Per state: the paths' spread against the PRS's bounding box (tightness per coordinate).
+    pub states: Vec<StateSpread>,
+}
+
+/// One state's spread over the paths at a report time, next to the PRS's bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StateSpread {
+    /// The half-width of the smallest interval centred on the nominal state `x*_t,i` that
+    /// holds `1 - delta` of the paths' `X_t,i` (the `quantile_rank`-th largest deviation
+    /// `|X_t,i - x*_t,i|`); `NaN` when fewer paths than the rank were simulated.
+    pub quantile: f64,
+    /// The largest deviation over the paths.
+    pub max: f64,
+    /// The half-width of the PRS's bounding box about `x*_t,i` (the larger of its two sides;
+    /// `NaN` for a result without one).
+    pub prs: f64,
+}
+
+impl StateSpread {
+    /// How many times the empirical spread the PRS's half-width is (`prs / quantile`: 1 is
+    /// as tight as the sample allows; `NaN` or `inf` where undefined).
+    pub fn ratio(&self) -> f64 {
+        self.prs / self.quantile
+    }
 }
 
 /// Paths outside the PRS at one report time at least. A pointwise PRS bounds the probability

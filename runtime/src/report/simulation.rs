@@ -21,6 +21,7 @@ pub fn to_json(r: &SimReport) -> String {
 struct Json<'a> {
     model: &'a str,
     analysis: &'a str,
+    states: &'a [String],
     method: &'static str,
     delta: f64,
     guarantee: &'static str,
@@ -81,6 +82,17 @@ struct StepJson {
     /// Uniform results only: the paths first leaving the tube in the interval ending here.
     #[serde(skip_serializing_if = "Option::is_none")]
     left_tube: Option<u64>,
+    /// Per state, in the order of `states`.
+    states: Vec<StateJson>,
+}
+
+/// One state's spread against the PRS's bounding box at a report time.
+#[derive(Serialize)]
+struct StateJson {
+    quantile: f64,
+    max: f64,
+    prs: f64,
+    ratio: f64,
 }
 
 #[derive(Serialize)]
@@ -151,6 +163,7 @@ impl<'a> Json<'a> {
         Json {
             model: &r.model,
             analysis: &r.analysis,
+            states: &r.states,
             method: r.method.name(),
             delta: r.delta,
             guarantee: r.guarantee.name(),
@@ -192,6 +205,16 @@ impl<'a> Json<'a> {
                     fraction: s.fraction,
                     cp_upper: s.cp_upper,
                     left_tube: s.left_tube,
+                    states: s
+                        .states
+                        .iter()
+                        .map(|v| StateJson {
+                            quantile: v.quantile,
+                            max: v.max,
+                            prs: v.prs,
+                            ratio: v.ratio(),
+                        })
+                        .collect(),
                 })
                 .collect(),
             horizon: HorizonJson {
@@ -324,6 +347,50 @@ fn noise(kind: NoiseKind) -> String {
     }
 }
 
+/// States shown in the text's tightness table (the JSON has them all).
+const TIGHTNESS_STATES: usize = 6;
+
+/// The tightness table: at the summary's report times, per state, the PRS's bounding-box
+/// half-width about the nominal over the half-width holding `1 - delta` of the paths.
+fn tightness(s: &mut String, r: &SimReport) {
+    let n = r.states.len().min(TIGHTNESS_STATES);
+    if n == 0 || r.steps.iter().all(|st| st.states.is_empty()) {
+        return;
+    }
+    let more = if r.states.len() > n {
+        format!(
+            " (the first {n} of {} states; the JSON has all)",
+            r.states.len()
+        )
+    } else {
+        String::new()
+    };
+    let _ = writeln!(
+        s,
+        "  per state, the PRS's bounding box about x*_t against the paths: half-width / the \
+         half-width holding 1 - delta of the paths about x*_t{more}"
+    );
+    let _ = write!(s, "  {:>9}", "t");
+    for name in &r.states[..n] {
+        let _ = write!(s, "  {name:>22}");
+    }
+    s.push('\n');
+    for k in summary_indices(r.steps.len()) {
+        let st = &r.steps[k];
+        let _ = write!(s, "  {:>9.4}", st.t);
+        for v in st.states.iter().take(n) {
+            let ratio = v.ratio();
+            let cell = if ratio.is_finite() {
+                format!("{:.4}/{:.4} = {ratio:.2}x", v.prs, v.quantile)
+            } else {
+                format!("{:.4}/{:.4}", v.prs, v.quantile)
+            };
+            let _ = write!(s, "  {cell:>22}");
+        }
+        s.push('\n');
+    }
+}
+
 /// A readable summary: what was simulated, a table at about ten report times plus the last, the
 /// horizon-wide count, the tube's (uniform results: what was checked, paths that left it), the
 /// unsafe-set counts, and the verdict (the uniform one for a uniform result, with the
@@ -384,6 +451,7 @@ pub fn summary(r: &SimReport) -> String {
             st.cp_upper
         );
     }
+    tightness(&mut s, r);
     let _ = write!(
         s,
         "  over the horizon: {} ({:.3e}) outside the PRS at some report time (CP upper \
