@@ -194,12 +194,15 @@ class Spec:
         hold: Optional[float] = None,
         confidence: float = 0.999,
         threads: Optional[int] = None,
+        probability: bool = False,
     ) -> "Simulation":
         """Monte Carlo check of ``analysis`` as ``reachc simulate --paths PATHS --seed SEED``:
-        the same paths and statistics for the same options (whatever ``threads``)."""
+        the same paths and statistics for the same options (whatever ``threads``). With
+        ``probability``, as ``--probability``: the certified probability of safety is checked
+        against the paths that entered no unsafe set (``json()["safety"]``)."""
         return Simulation(
             self._native.simulate(
-                analysis, paths, seed, dt, delta, inputs, hold, confidence, threads
+                analysis, paths, seed, dt, delta, inputs, hold, confidence, threads, probability
             )
         )
 

@@ -385,8 +385,9 @@ impl Spec {
     }
 
     /// Monte Carlo check of the analysis `name`, as `reachc simulate --backend interp`: the PRS
-    /// (at `delta` if given), then `paths` Euler-Maruyama sample paths against it.
-    #[pyo3(signature = (name, paths, seed = 0, dt = None, delta = None, inputs = "random", hold = None, confidence = 0.999, threads = None))]
+    /// (at `delta` if given), then `paths` Euler-Maruyama sample paths against it; with
+    /// `probability`, the certified probability of safety checked against the paths too.
+    #[pyo3(signature = (name, paths, seed = 0, dt = None, delta = None, inputs = "random", hold = None, confidence = 0.999, threads = None, probability = false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate(
         &self,
@@ -400,6 +401,7 @@ impl Spec {
         hold: Option<f64>,
         confidence: f64,
         threads: Option<usize>,
+        probability: bool,
     ) -> PyResult<Simulation> {
         if let Some(d) = delta {
             if !(d > 0.0 && d < 1.0) {
@@ -411,7 +413,7 @@ impl Spec {
         if threads == Some(0) {
             return Err(PyValueError::new_err("threads must be at least 1"));
         }
-        let opts = simulate::Options {
+        let mut opts = simulate::Options {
             paths,
             seed,
             dt,
@@ -419,6 +421,7 @@ impl Spec {
             hold,
             confidence,
             threads,
+            safety_bound: None,
         };
         let inner = &*self.inner;
         let result = py.detach(|| {
@@ -426,6 +429,13 @@ impl Spec {
                 Some(d) => r.with_delta(d),
                 None => Ok(r),
             })?;
+            // As `reachc simulate --probability`: the bound where it is defined.
+            if probability && !inner.info.unsafe_sets.is_empty() {
+                opts.safety_bound = reach
+                    .safety_probability()
+                    .ok()
+                    .and_then(|p| p.lower_bound());
+            }
             reach.run()
         });
         // A result with a number that is not finite is a run error (RunError::NonFinite).

@@ -88,3 +88,18 @@ def test_simulate_equals_the_cli(
     assert all(s["prs"] >= s["quantile"] for s in last)
     assert sim.outside.dtype.kind == "i"
     assert sim.coverage["passed"] == sim.passed
+
+
+def test_simulate_probability_equals_the_cli(cli: Path, tmp_path: Path) -> None:
+    """``probability=True`` is ``--probability``: the certified probability of safety checked
+    against the paths, the same report as the CLI's."""
+    spec_path = SPECS / "vanderpol_feedback.sde"
+    spec = reachc.load(spec_path)
+    args = ["simulate", str(spec_path), "--backend", "interp", "--analysis", "contraction"]
+    args += ["--paths", "300", "--probability", "-o", str(tmp_path)]
+    done = run_cli(cli, args)
+    assert done.returncode == 0, done.stderr
+    sim = spec.simulate("contraction", paths=300, threads=2, probability=True)
+    assert sim.to_json() == (tmp_path / "contraction.sim.json").read_text()
+    safety = sim.json()["safety"]
+    assert safety["status"] == "pass" and 0.99 < safety["certified"] <= safety["cp_upper"]

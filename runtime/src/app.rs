@@ -49,8 +49,8 @@ const USAGE: &str =
 pub const SIMULATE_USAGE: &str =
     "usage: <model> simulate --paths N [--analysis NAME] [--seed S] [--dt H]
          [--delta D] [--inputs random|corners|centre] [--hold T] [--confidence C]
-         [--threads T] [--shard I/K [--spec-hash H]] [-o DIR] [--quiet] [--progress]
-         [--error-lines]
+         [--threads T] [--shard I/K [--spec-hash H]] [--probability] [-o DIR] [--quiet]
+         [--progress] [--error-lines]
   Euler-Maruyama sample paths checked against each analysis' delta-PRS; writes
   DIR/<analysis>.sim.json. Exit status 0 when every coverage check passes, 1 when one fails
   or an analysis cannot be simulated (the other reports are written), 2 on usage or I/O
@@ -69,6 +69,9 @@ pub const SIMULATE_USAGE: &str =
   --threads T        worker threads (default: all cores); results do not depend on it
   --shard I/K        run only the paths [floor(I N / K), floor((I + 1) N / K)) (0-based I)
   --spec-hash H      the spec's identity recorded in the parts (reachc passes its SHA-256)
+  --probability      also certify each analysis' probability of safety on [0, T] (unsafe sets,
+                     uniform guarantee; about a dozen runs) and check it against the paths
+                     that entered no unsafe set (Clopper-Pearson at --confidence)
   -o, --out DIR      output directory (default: reachc-out)
   -q, --quiet        do not print the summaries
   --progress         write `reachc-progress <analysis> <done> <total>` lines to stderr
@@ -143,6 +146,9 @@ pub struct SimulateOptions {
     pub spec_hash: Option<String>,
     /// Report failed analyses as [`Failure::to_line`] lines (the CLI locates them in the spec).
     pub error_lines: bool,
+    /// Certify each analysis' probability of safety ([`Reach::safety_probability`]) and test it
+    /// against the paths (`simulate::Options::safety_bound`).
+    pub probability: bool,
     /// The simulation itself.
     pub sim: simulate::Options,
 }
@@ -158,6 +164,7 @@ impl Default for SimulateOptions {
             shard: None,
             spec_hash: None,
             error_lines: false,
+            probability: false,
             sim: simulate::Options::default(),
         }
     }
@@ -253,6 +260,7 @@ fn parse_simulate(args: &[String]) -> Result<Command, String> {
             "-q" | "--quiet" => a.quiet = true,
             "--progress" => a.progress = true,
             "--error-lines" => a.error_lines = true,
+            "--probability" => a.probability = true,
             "--paths" => paths = Some(number::<u64>(flag, value()?)?),
             "--seed" => a.sim.seed = number(flag, value()?)?,
             "--dt" => a.sim.dt = Some(number(flag, value()?)?),
@@ -348,6 +356,9 @@ impl SimulateOptions {
         }
         if self.error_lines {
             args.push("--error-lines".into());
+        }
+        if self.probability {
+            args.push("--probability".into());
         }
         args
     }
@@ -661,6 +672,19 @@ fn simulate_analyses<S: System + Sync>(
             Some(d) => r.with_delta(d),
             None => Ok(r),
         });
+        // The certified probability of safety to test, where asked for and defined.
+        let mut sim_opts = opts.sim.clone();
+        if let (true, Ok(reach)) = (opts.probability && !info.unsafe_sets.is_empty(), &reach) {
+            match reach.safety_probability() {
+                Ok(p) => sim_opts.safety_bound = p.lower_bound(),
+                Err(e) => {
+                    let _ = writeln!(
+                        err,
+                        "note: analysis `{name}`: no probability of safety: {e}"
+                    );
+                }
+            }
+        }
         let result = match reach.and_then(|r| r.run()) {
             Ok(r) => r,
             Err(e @ (RunError::Unsupported(_) | RunError::NoConstants(_))) => {
@@ -683,10 +707,10 @@ fn simulate_analyses<S: System + Sync>(
             };
             match opts.shard {
                 Some(shard) => {
-                    simulate::run_part(sys, info, &result, &opts.sim, shard, &mut report_progress)
+                    simulate::run_part(sys, info, &result, &sim_opts, shard, &mut report_progress)
                         .map(Simulated::Part)
                 }
-                None => simulate::simulate(sys, info, &result, &opts.sim, &mut report_progress)
+                None => simulate::simulate(sys, info, &result, &sim_opts, &mut report_progress)
                     .map(Simulated::Report),
             }
         };
@@ -783,6 +807,7 @@ mod tests {
             shard: Some(Shard { index: 3, count: 8 }),
             spec_hash: Some("0a1b".into()),
             error_lines: true,
+            probability: true,
             sim: simulate::Options {
                 paths: 12345,
                 seed: u64::MAX,
@@ -791,6 +816,7 @@ mod tests {
                 hold: Some(0.7),
                 confidence: 0.99,
                 threads: Some(3),
+                safety_bound: None,
             },
         };
         assert_eq!(Command::parse(&sim.to_args()), Ok(Command::Simulate(sim)));

@@ -154,3 +154,54 @@ fn limits_and_refusals_are_reported() {
         Err(RunError::Unsupported(_))
     ));
 }
+
+/// `reachc simulate --probability`'s check (`simulate::Options::safety_bound`): the certified
+/// bound of the Brownian motion with drift against 20,000 Euler-Maruyama paths passes (the
+/// paths that entered no unsafe set are at least the bound, statistically), and a bound of 1
+/// fails the report, which says why, in its text and JSON.
+#[test]
+fn simulate_checks_the_certified_bound_against_the_paths() {
+    use reachc_runtime::report::simulation::{summary, to_json};
+    use reachc_runtime::simulate::{simulate, Options};
+    let (sys, info) = brownian(0.5);
+    let reach = Reach::new(&sys, &info, "a").unwrap();
+    let bound = reach.safety_probability().unwrap().lower_bound().unwrap();
+    let prs = reach.run().unwrap();
+    let check = |b: f64| {
+        let opts = Options {
+            paths: 20_000,
+            seed: 3,
+            safety_bound: Some(b),
+            ..Options::default()
+        };
+        simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap()
+    };
+    let rep = check(bound);
+    let s = rep.safety.clone().expect("a model with unsafe sets");
+    assert_eq!(
+        s.safe,
+        20_000 - rep.unsafe_sets[0].hits,
+        "one set: safe = not hit"
+    );
+    assert!(
+        s.safe < 20_000,
+        "some paths cross (exact probability 2.2e-3)"
+    );
+    assert!(
+        s.passed && s.cp_upper >= bound && rep.passed(),
+        "{}",
+        summary(&rep)
+    );
+    assert!(summary(&rep).contains("is not above it: PASS"));
+    let too_high = check(1.0);
+    let s = too_high.safety.clone().unwrap();
+    assert!(!s.passed && !too_high.passed() && too_high.verdict.passed);
+    assert!(summary(&too_high).contains("FAIL (the bound is too high)"));
+    let json: serde_json::Value = serde_json::from_str(&to_json(&too_high)).unwrap();
+    assert_eq!(json["safety"]["status"], "fail");
+    assert_eq!(json["safety"]["certified"], 1.0);
+    assert_eq!(
+        json["verdict"]["status"], "pass",
+        "the coverage itself passes"
+    );
+}

@@ -92,6 +92,10 @@ pub struct SimulateArgs {
     /// Worker threads (default: all cores); the results do not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Also certify each analysis' probability of safety on [0, T] (unsafe sets, uniform
+    /// guarantee; about a dozen runs) and check it against the paths that entered no unsafe set.
+    #[arg(long)]
+    pub probability: bool,
     /// Do not print the summaries (nor cargo's progress).
     #[arg(short, long)]
     pub quiet: bool,
@@ -128,6 +132,7 @@ impl SimulateArgs {
             spec_hash: self.shard.map(|_| spec_hash),
             // Set for the compiled backend (the interpreter's failures are typed).
             error_lines: false,
+            probability: self.probability,
             sim: simulate::Options {
                 // Required by clap unless merging.
                 paths: self.paths.unwrap_or_default(),
@@ -137,6 +142,7 @@ impl SimulateArgs {
                 hold: self.hold,
                 confidence: self.confidence,
                 threads: self.threads,
+                safety_bound: None,
             },
         }
     }

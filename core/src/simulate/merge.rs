@@ -7,7 +7,8 @@ use super::binomial;
 use super::part::{Part, PartStats, RunInfo};
 use super::part_file::run_bytes;
 use super::report::{
-    Coverage, HorizonReport, InputsReport, SimReport, SimStep, StateSpread, TubeReport, UnsafeHits,
+    Coverage, HorizonReport, InputsReport, SafetyCheck, SimReport, SimStep, StateSpread,
+    TubeReport, UnsafeHits,
 };
 use super::shard::Shard;
 use super::topk::TopK;
@@ -190,6 +191,11 @@ fn difference(a: &RunInfo, b: &RunInfo, a_bytes: &[u8]) -> Option<String> {
             format!("{:?}", a.confidence),
             format!("{:?}", b.confidence),
         ),
+        (
+            "probability bound",
+            format!("{:?}", a.safety_bound),
+            format!("{:?}", b.safety_bound),
+        ),
     ];
     if let Some((what, x, y)) = named.into_iter().find(|(_, x, y)| x != y) {
         return Some(format!("{what} {y} there, {x} in the first part"));
@@ -320,6 +326,17 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut To
                 first_hit_t: Some(total.first_hit[i]).filter(|t| t.is_finite()),
             })
             .collect(),
+        safety: (!run.unsafe_sets.is_empty()).then(|| {
+            let safe = n_paths - total.unsafe_any;
+            let cp_upper = 1.0 - binomial::lower_bound(total.unsafe_any, n_paths, alpha);
+            SafetyCheck {
+                safe,
+                fraction: frac(safe),
+                cp_upper,
+                certified: run.safety_bound,
+                passed: run.safety_bound.is_none_or(|b| b <= cp_upper),
+            }
+        }),
         left_domain: run.has_domain.then_some(total.left_domain),
         diverged: total.diverged,
         verdict: Coverage {

@@ -56,8 +56,8 @@ pub use merge::{merge, MergeError, Merger};
 pub use part::{Part, PartStats, RunInfo, StepInfo};
 pub use part_file::{FORMAT_VERSION, MAGIC};
 pub use report::{
-    Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SimReport, SimStep,
-    StateSpread, TubeReport, UnsafeHits,
+    Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SafetyCheck, SimReport,
+    SimStep, StateSpread, TubeReport, UnsafeHits,
 };
 pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
 pub use shard::Shard;
@@ -100,6 +100,10 @@ pub struct Options {
     pub confidence: f64,
     /// Worker threads (`None`: the current rayon pool). The report does not depend on it.
     pub threads: Option<usize>,
+    /// A certified lower bound of the probability that no unsafe set is entered on the
+    /// horizon ([`Reach::safety_probability`](crate::Reach::safety_probability)), tested
+    /// against the paths (see [`SafetyCheck`]).
+    pub safety_bound: Option<f64>,
 }
 
 impl Default for Options {
@@ -112,6 +116,7 @@ impl Default for Options {
             hold: None,
             confidence: 0.999,
             threads: None,
+            safety_bound: None,
         }
     }
 }
@@ -262,6 +267,7 @@ fn run_info<S: System + ?Sized>(
         inputs: opts.inputs,
         hold_option: opts.hold,
         confidence: opts.confidence,
+        safety_bound: opts.safety_bound,
         dt: plan.dt,
         steps_per_path: plan.steps_per_path(),
         initial_states: plan.initial.describe(),
@@ -335,6 +341,9 @@ fn make_plan<'a, S: System + ?Sized>(
     let hold = opts.hold.unwrap_or(result.step);
     if !(hold > 0.0 && hold.is_finite()) {
         return usage(format!("the hold time {hold} must be positive and finite"));
+    }
+    if let Some(b) = opts.safety_bound.filter(|b| !(0.0..=1.0).contains(b)) {
+        return usage(format!("the probability bound {b} must lie in [0, 1]"));
     }
     if !(opts.confidence > 0.0 && opts.confidence < 1.0) {
         return usage(format!(

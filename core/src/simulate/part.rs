@@ -62,6 +62,8 @@ pub struct RunInfo {
     pub hold_option: Option<f64>,
     /// Confidence level of the bounds and the check.
     pub confidence: f64,
+    /// A certified lower bound of the probability of safety to test (`--probability`).
+    pub safety_bound: Option<f64>,
     /// The Euler-Maruyama steps used and how they compare with the rule.
     pub dt: DtUsed,
     /// Euler-Maruyama steps per path.
@@ -117,6 +119,8 @@ pub struct PartStats {
     pub unsafe_hits: Vec<u64>,
     /// Per unsafe set, the earliest entry (`inf`: none).
     pub first_hit: Vec<f64>,
+    /// Paths that entered some unsafe set.
+    pub unsafe_any: u64,
     /// Paths that left the domain.
     pub left_domain: u64,
     /// Paths whose state became non-finite.
@@ -133,6 +137,7 @@ impl PartStats {
             left_tube: c.left_tube,
             unsafe_hits: c.unsafe_hits,
             first_hit: c.first_hit,
+            unsafe_any: c.unsafe_any,
             left_domain: c.left_domain,
             diverged: c.diverged,
         }
@@ -149,6 +154,7 @@ impl PartStats {
         }
         self.outside_any += other.outside_any;
         self.outside_tube += other.outside_tube;
+        self.unsafe_any += other.unsafe_any;
         self.left_domain += other.left_domain;
         self.diverged += other.diverged;
     }
@@ -192,7 +198,13 @@ impl Part {
             ));
         }
         let counts = st.outside.iter().chain(&st.unsafe_hits);
-        let totals = [st.outside_any, st.outside_tube, st.left_domain, st.diverged];
+        let totals = [
+            st.outside_any,
+            st.outside_tube,
+            st.unsafe_any,
+            st.left_domain,
+            st.diverged,
+        ];
         if counts.chain(&totals).any(|&c| c > mine)
             || st.left_tube.iter().sum::<u64>() != st.outside_tube
         {

@@ -165,6 +165,7 @@ impl Part {
         w.u64s(&st.left_tube);
         w.u64s(&st.unsafe_hits);
         w.f64s(&st.first_hit);
+        w.u64(st.unsafe_any);
         w.u64(st.left_domain);
         w.u64(st.diverged);
         w.u64(self.top.len() as u64);
@@ -218,6 +219,7 @@ impl Part {
             left_tube: r.u64s()?,
             unsafe_hits: r.u64s()?,
             first_hit: r.f64s()?,
+            unsafe_any: r.u64()?,
             left_domain: r.u64()?,
             diverged: r.u64()?,
         };
@@ -257,6 +259,7 @@ fn write_run(w: &mut Writer, run: &RunInfo) {
     w.u8(code_of(&INPUTS, &run.inputs));
     w.opt_f64(run.hold_option);
     w.f64(run.confidence);
+    w.opt_f64(run.safety_bound);
     let dt = &run.dt;
     w.u8(code_of(&DT_SOURCES, &dt.source));
     w.f64(dt.min);
@@ -309,6 +312,7 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
         inputs: r.code("inputs", &INPUTS)?,
         hold_option: r.opt_f64()?,
         confidence: r.f64()?,
+        safety_bound: r.opt_f64()?,
         dt: DtUsed {
             source: r.code("dt source", &DT_SOURCES)?,
             min: r.f64()?,

@@ -133,6 +133,8 @@ pub(crate) struct ChunkStats {
     pub(crate) unsafe_hits: Vec<u64>,
     /// Per unsafe set, the earliest entry time.
     pub(crate) first_hit: Vec<f64>,
+    /// Paths that entered some unsafe set.
+    pub(crate) unsafe_any: u64,
     /// Paths that left the domain.
     pub(crate) left_domain: u64,
     /// Paths whose state became non-finite.
@@ -151,6 +153,7 @@ impl ChunkStats {
             left_tube: vec![0; steps],
             unsafe_hits: vec![0; sets],
             first_hit: vec![f64::INFINITY; sets],
+            unsafe_any: 0,
             left_domain: 0,
             diverged: 0,
         }
@@ -207,6 +210,7 @@ impl ChunkStats {
         for (a, &b) in self.first_hit.iter_mut().zip(&other.first_hit) {
             *a = a.min(b);
         }
+        self.unsafe_any += other.unsafe_any;
         self.left_domain += other.left_domain;
         self.diverged += other.diverged;
     }
@@ -527,6 +531,10 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     self.general::<D, false>(dim, &step, l, st);
                 }
             }
+        }
+        if !self.unsafe_sets.is_empty() {
+            let entered = l.hit.chunks_exact(sets).take(lanes);
+            st.unsafe_any += entered.filter(|h| h.contains(&true)).count() as u64;
         }
         for path in &l.paths[..lanes] {
             st.outside_any += u64::from(path.outside_any);

@@ -51,6 +51,8 @@ pub struct SimReport {
     pub tube: Option<TubeReport>,
     /// Per unsafe set, the paths that entered it.
     pub unsafe_sets: Vec<UnsafeHits>,
+    /// With unsafe sets: the paths that entered none, against a certified bound if given.
+    pub safety: Option<SafetyCheck>,
     /// Paths that left the spec's domain at some Euler step (`None` without a domain).
     pub left_domain: Option<u64>,
     /// Paths whose state became non-finite (counted outside from then on).
@@ -199,10 +201,30 @@ pub struct Coverage {
 }
 
 impl SimReport {
-    /// Whether the coverage check passed.
+    /// Whether the coverage check passed, and the probability-of-safety check where there is
+    /// one.
     pub fn passed(&self) -> bool {
-        self.verdict.passed
+        self.verdict.passed && self.safety.as_ref().is_none_or(|s| s.passed)
     }
+}
+
+/// The paths that entered no unsafe set at any Euler-Maruyama step, an estimate of the
+/// probability of safety on the horizon, against a certified lower bound. A path can cross a
+/// set between two steps unseen, so the paths overestimate that probability a little: the
+/// check can miss a bound that is too high by that much, never fail a valid one by it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SafetyCheck {
+    /// Paths that entered no unsafe set.
+    pub safe: u64,
+    /// `safe / paths`.
+    pub fraction: f64,
+    /// One-sided Clopper-Pearson upper bound of the probability of safety at `confidence`.
+    pub cp_upper: f64,
+    /// The certified lower bound tested (`None`: none was given, nothing is tested).
+    pub certified: Option<f64>,
+    /// The bound is not above `cp_upper` (true without a bound): a valid bound fails with
+    /// probability at most `1 - confidence`.
+    pub passed: bool,
 }
 
 /// How the initial states of the paths were drawn.

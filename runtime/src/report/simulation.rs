@@ -41,6 +41,7 @@ struct Json<'a> {
     horizon: HorizonJson,
     outside_tube: Option<TubeJson>,
     unsafe_sets: Vec<UnsafeJson<'a>>,
+    safety: Option<SafetyJson>,
     left_domain: Option<u64>,
     diverged: u64,
     verdict: CoverageJson,
@@ -119,6 +120,17 @@ struct UnsafeJson<'a> {
     hits: u64,
     fraction: f64,
     first_hit_t: Option<f64>,
+}
+
+/// The paths that entered no unsafe set, against the certified probability of safety.
+#[derive(Serialize)]
+struct SafetyJson {
+    safe: u64,
+    fraction: f64,
+    cp_upper: f64,
+    certified: Option<f64>,
+    /// `pass` or `fail`; `null` without a certified bound.
+    status: Option<&'static str>,
 }
 
 #[derive(Serialize)]
@@ -241,10 +253,17 @@ impl<'a> Json<'a> {
                     first_hit_t: u.first_hit_t,
                 })
                 .collect(),
+            safety: r.safety.as_ref().map(|c| SafetyJson {
+                safe: c.safe,
+                fraction: c.fraction,
+                cp_upper: c.cp_upper,
+                certified: c.certified,
+                status: c.certified.map(|_| status(c.passed)),
+            }),
             left_domain: r.left_domain,
             diverged: r.diverged,
             verdict: CoverageJson {
-                status: status(r.passed()),
+                status: status(r.verdict.passed),
                 decided_by: r.verdict.decided_by.name(),
                 pointwise_status: status(r.verdict.pointwise_passed),
                 alpha: r.verdict.alpha,
@@ -492,6 +511,30 @@ pub fn summary(r: &SimReport) -> String {
             u.fraction
         );
     }
+    if let Some(c) = &r.safety {
+        let _ = write!(
+            s,
+            "  probability of safety: {} of {} ({:.6}) entered no unsafe set at any \
+             Euler-Maruyama step (Clopper-Pearson upper bound {:.6} at confidence {})",
+            count(c.safe, "path"),
+            r.paths,
+            c.fraction,
+            c.cp_upper,
+            r.confidence
+        );
+        match c.certified {
+            Some(b) if c.passed => {
+                let _ = writeln!(s, "; the certified lower bound {b} is not above it: PASS");
+            }
+            Some(b) => {
+                let _ = writeln!(
+                    s,
+                    "; the certified lower bound {b} is above it: FAIL (the bound is too high)"
+                );
+            }
+            None => s.push('\n'),
+        }
+    }
     if let Some(left) = r.left_domain {
         let _ = writeln!(
             s,
@@ -507,7 +550,7 @@ pub fn summary(r: &SimReport) -> String {
         );
     }
     let v = &r.verdict;
-    let verdict = if r.passed() { "PASS" } else { "FAIL" };
+    let verdict = if v.passed { "PASS" } else { "FAIL" };
     let per_time = format!(
         "{} of {} report times with a Clopper-Pearson lower bound above delta at level 1 - \
          {:.1e}; worst t = {}: {} outside, lower bound {:.3e}",
