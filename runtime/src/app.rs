@@ -674,7 +674,8 @@ fn simulate_analyses<S: System + Sync>(
         });
         // The certified probability of safety to test, where asked for and defined.
         let mut sim_opts = opts.sim.clone();
-        if let (true, Ok(reach)) = (opts.probability && !info.unsafe_sets.is_empty(), &reach) {
+        let wanted = opts.probability && !info.unsafe_sets.is_empty();
+        if let Some(reach) = reach.as_ref().ok().filter(|_| wanted) {
             match reach.safety_probability() {
                 Ok(p) => sim_opts.safety_bound = p.lower_bound(),
                 Err(e) => {

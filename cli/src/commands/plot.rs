@@ -139,12 +139,9 @@ fn quantile_of(sim: &SimFile, result: &ResultFile, source: String) -> Quantile {
     Quantile {
         values: sim.steps.iter().map(|s| s.quantile).collect(),
         states: if per_state {
-            (0..n)
-                .map(|i| StateWidths {
-                    prs: sim.steps.iter().map(|s| s.states[i].prs).collect(),
-                    quantile: sim.steps.iter().map(|s| s.states[i].quantile).collect(),
-                })
-                .collect()
+            StateWidths::per_state(&sim.steps, n, |s, i| {
+                (s.states[i].prs, s.states[i].quantile)
+            })
         } else {
             Vec::new()
         },

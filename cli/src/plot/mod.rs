@@ -105,26 +105,32 @@ pub struct StateWidths {
     pub quantile: Vec<Option<f64>>,
 }
 
+impl StateWidths {
+    /// Per state `i < n`, its widths over `steps`, `(prs, quantile)` of step `s` and state `i`
+    /// from `widths(s, i)`.
+    pub fn per_state<S>(
+        steps: &[S],
+        n: usize,
+        widths: impl Fn(&S, usize) -> (Option<f64>, Option<f64>),
+    ) -> Vec<StateWidths> {
+        (0..n)
+            .map(|i| {
+                let (prs, quantile) = steps.iter().map(|s| widths(s, i)).unzip();
+                StateWidths { prs, quantile }
+            })
+            .collect()
+    }
+}
+
 impl Quantile {
     /// The quantiles of a Monte Carlo report, described by `source`.
     pub fn of(report: &simulate::SimReport, source: String) -> Quantile {
         let finite = |v: f64| Some(v).filter(|v| v.is_finite());
         Quantile {
             values: report.steps.iter().map(|s| finite(s.quantile)).collect(),
-            states: (0..report.states.len())
-                .map(|i| StateWidths {
-                    prs: report
-                        .steps
-                        .iter()
-                        .map(|s| finite(s.states[i].prs))
-                        .collect(),
-                    quantile: report
-                        .steps
-                        .iter()
-                        .map(|s| finite(s.states[i].quantile))
-                        .collect(),
-                })
-                .collect(),
+            states: StateWidths::per_state(&report.steps, report.states.len(), |s, i| {
+                (finite(s.states[i].prs), finite(s.states[i].quantile))
+            }),
             paths: report.paths,
             source,
         }

@@ -172,7 +172,7 @@ impl ChunkStats {
     /// The per-state candidates of a state `x` at report step `k` (centre `c`, thresholds
     /// `thr`, one per state).
     #[inline(always)]
-    fn states_at(&mut self, k: usize, x: &[f64], c: &[f64], thr: &[f64]) {
+    fn record_states(&mut self, k: usize, x: &[f64], c: &[f64], thr: &[f64]) {
         let first = k * self.states;
         for (i, ((&x, &c), &thr)) in x.iter().zip(c).zip(thr).enumerate() {
             let d = (x - c).abs();
@@ -445,7 +445,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             self.initial.sample(&mut path.rng, self.zig, x, &mut l.init);
             let qa = self.metric.quad(x, &self.nominal[..n]);
             self.record(0, x, qa, thresholds.metric[0], st, path);
-            st.states_at(0, x, &self.nominal[..n], thresholds.states_at(0, n));
+            st.record_states(0, x, &self.nominal[..n], thresholds.states_at(0, n));
             self.check_tube(0, x, path, st);
             let hit = &mut l.hit[a * sets..][..sets];
             self.check_sets(0.0, x, hit, &mut path.left_domain, st);
@@ -655,7 +655,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         if !quiet {
             self.record(rep.k, x, (q, a), rep.thr, st, path);
         }
-        st.states_at(rep.k, x, rep.c, rep.states);
+        st.record_states(rep.k, x, rep.c, rep.states);
     }
 
     /// [`report`](Self::report)'s "quiet" answer for eight states in lanes (`(q, a)` their
@@ -755,7 +755,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 if !quiet {
                     self.record(k, x, (q, q), thr, st, path);
                 }
-                st.states_at(k, x, c, thr_states);
+                st.record_states(k, x, c, thr_states);
             }
         }
     }
@@ -826,7 +826,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             while each != 0 {
                 let a = each.trailing_zeros() as usize;
                 each &= each - 1;
-                st.states_at(k, &group.lane(a)[..n], c, thr_states);
+                st.record_states(k, &group.lane(a)[..n], c, thr_states);
             }
             let mut loud = loud | !live;
             while loud != 0 {
@@ -940,7 +940,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                         let a = each.trailing_zeros() as usize;
                         each &= each - 1;
                         let xa: [f64; SMALL] = std::array::from_fn(|j| xs[j].0[a]);
-                        st.states_at(k, &xa[..n], rep.c, rep.states);
+                        st.record_states(k, &xa[..n], rep.c, rep.states);
                     }
                 }
                 // Lane by lane in order, as the scalar loops go path by path.

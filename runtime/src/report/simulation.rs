@@ -373,7 +373,7 @@ const TIGHTNESS_STATES: usize = 6;
 /// half-width about the nominal over the half-width holding `1 - delta` of the paths.
 fn tightness(s: &mut String, r: &SimReport) {
     let n = r.states.len().min(TIGHTNESS_STATES);
-    if n == 0 || r.steps.iter().all(|st| st.states.is_empty()) {
+    if n == 0 {
         return;
     }
     let more = if r.states.len() > n {
