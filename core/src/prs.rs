@@ -273,8 +273,8 @@ pub struct TransformUsed {
     pub source: TransformSource,
 }
 
-/// Advice on an interval result, read off its own numbers (advisory: plain floating point, no
-/// guarantee rests on it).
+/// Advice on a result, read off its own numbers (advisory: plain floating point, no guarantee
+/// rests on it).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Hint {
     /// The box wraps: at time `t` the PRS's bounding box in `state` is more than
@@ -305,6 +305,20 @@ pub enum Hint {
         /// The domain in `state`.
         domain: Bounds,
     },
+    /// From report time `t` on, the first-order sets' (method.md 8.8) second-order remainder
+    /// exceeds their linear part: the initial set (or the input box) is too wide for one
+    /// linearisation over the horizon; smaller pieces shrink the remainder quadratically.
+    FirstOrderLoose {
+        /// The report time.
+        t: f64,
+        /// The remainder's P-radius.
+        remainder: f64,
+        /// The P-radius of the linear part (the zonotope around the nominal).
+        linear: f64,
+    },
+    /// The first-order sets (method.md 8.8) were wanted but could not be bounded on some
+    /// internal step (the a-priori remainder did not hold its own bound).
+    FirstOrderUnbounded,
 }
 
 /// The sets at one report time.
@@ -659,8 +673,8 @@ pub enum Proved {
         epochs: usize,
     },
     /// The linearised Gaussian sets (method.md 8.10): the linearisation's covariance along the
-    /// nominal (enclosed), the mixture bound on `epochs` epochs (one per internal step), and the
-    /// linearisation's error bounded path by path on that event.
+    /// nominal (enclosed), the reflection principle per coordinate on `epochs` epochs (one per
+    /// internal step), and the linearisation's error bounded path by path on that event.
     LinearisedGaussian {
         /// The number of epochs.
         epochs: usize,

@@ -50,16 +50,29 @@ pub fn linearised_member(prs: &Prs) -> (&Prs, usize) {
     (m, epochs)
 }
 
-/// The smallest `(1 + eta)(2 ln(K / delta) + n ln(1 + 1/eta))` over `eta` on a fine grid, for
-/// `K` epochs: the mixture bound's squared radius factor can be no smaller.
-pub fn mixture_factor(n: usize, epochs: usize, delta: f64) -> f64 {
-    let l = (epochs as f64 / delta).ln();
-    (1..20000)
-        .map(|k| {
-            let eta = 1e-4 * f64::from(k);
-            (1.0 + eta) * (2.0 * l + n as f64 * (1.0 / eta).ln_1p())
-        })
-        .fold(f64::INFINITY, f64::min)
+/// `z^2` with `4 Q(z) = delta / (n K)`, `Q` the standard normal upper tail: the squared factor
+/// of the linearised member's Gaussian box (method.md 8.10: the reflection principle per
+/// coordinate and epoch, `n K` events sharing `delta`). Computed independently of the crate:
+/// `Q` by its continued fraction, `z` by bisection.
+pub fn reflection_factor(n: usize, epochs: usize, delta: f64) -> f64 {
+    let target = delta / (4.0 * (n * epochs) as f64);
+    let (mut lo, mut hi) = (1.0f64, 40.0f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if normal_tail(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi * hi
+}
+
+/// `Q(z) = P(N(0, 1) > z)` for `z >= 1`: `phi(z) / (z + 1/(z + 2/(z + 3/(z + ...))))`
+/// (Laplace's continued fraction), evaluated backwards from 500 terms.
+fn normal_tail(z: f64) -> f64 {
+    let cf = (1..500).rev().fold(z, |acc, k| z + f64::from(k) / acc);
+    (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt() / cf
 }
 
 /// The workspace root.
@@ -158,5 +171,22 @@ pub fn rk4(sys: &dyn reachc_runtime::System, x: &mut [f64], t: &mut f64, until: 
             x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
         }
         *t += h;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::normal_tail;
+
+    /// Reference values of the normal upper tail (Python's `erfc(z / sqrt 2) / 2`).
+    #[test]
+    fn the_normal_tail_matches_reference_values() {
+        for (z, q) in [
+            (1.0, 0.15865525393145707),
+            (3.0, 0.0013498980316300957),
+            (5.0, 2.866515718791946e-07),
+        ] {
+            assert!((normal_tail(z) / q - 1.0).abs() < 1e-12, "Q({z})");
+        }
     }
 }

@@ -4,7 +4,7 @@
 //! is exact but whose Jacobian moves within each step). Each member's box must hold the exact
 //! set and stay close to it.
 
-use reachc_e2e::{inline, linearised_member, mixture_factor};
+use reachc_e2e::{inline, linearised_member, reflection_factor};
 use reachc_runtime::prs::Role;
 use reachc_runtime::{Prs, Reach};
 
@@ -68,9 +68,9 @@ fn the_logistic_flow_lies_in_the_first_order_sets_and_fills_them() {
 /// linear time-varying SDE. Its transition matrix `Phi` and covariance `Sigma` solve linear
 /// ODEs (`Phi' = A Phi`, `Sigma' = A Sigma + Sigma A' + G G'`), integrated here by RK4 at
 /// `h = 1e-4` (error far below the tolerances). The linearised member's box is the image
-/// `|Phi| h` of the box plus the mixture bound's `sqrt(factor Sigma_ii)`, `factor` at least the
-/// best over `eta` for its epochs: never below that, and at most 2% above it (the error bound
-/// of the Jacobian moving within each internal step).
+/// `|Phi| h` of the box plus the Gaussian box `sqrt(factor Sigma_ii)`, `factor` the squared
+/// normal quantile of the reflection bound for its epochs: never below that, and at most 2%
+/// above it (the error bound of the Jacobian moving within each internal step).
 #[test]
 fn a_linear_time_varying_sde_gets_its_exact_image_and_variance() {
     let (sys, info) = inline(
@@ -81,7 +81,7 @@ fn a_linear_time_varying_sde_gets_its_exact_image_and_variance() {
     );
     let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
     let (m, epochs) = linearised_member(&prs);
-    let factor = mixture_factor(2, epochs, m.delta);
+    let factor = reflection_factor(2, epochs, m.delta);
     // State (Phi row-major, Sigma_11, Sigma_12, Sigma_22), RK4 in time.
     let rhs = |t: f64, y: &[f64; 7]| -> [f64; 7] {
         let k = 2.0 + t.sin();

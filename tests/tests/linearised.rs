@@ -1,16 +1,19 @@
 //! The linearised Gaussian sets (method.md 8.10): against the closed form of a linear system
 //! (the exact image of the initial box plus the exact covariance's box, nothing else), against
 //! sampled noise-free flows of the nonlinear pendulum (the path-by-path error bound never below
-//! the sampled error), and how the default analyses use them (delta split, the better result).
+//! the sampled error), against exactly sampled Ornstein-Uhlenbeck paths over whole report
+//! intervals, how the default analyses use them (delta split, the better result), and the hints
+//! when first-order sets lose their shape.
 
-use reachc_e2e::{inline, linearised_member, mixture_factor, rk4, shipped, workspace};
-use reachc_runtime::prs::Role;
+use reachc_e2e::{inline, linearised_member, reflection_factor, rk4, shipped, workspace};
+use reachc_runtime::prs::{Hint, Role};
 use reachc_runtime::Reach;
 
 /// `x'' = -2 x - 3 x' + 0.2 w` (eigenvalues -1, -2) from the box `[0.9, 1.1] x [-0.1, 0.1]`:
-/// the member's box at each report time is `|e^(A t)| h + sqrt(factor Sigma_ii(t))`, with
-/// `e^(A t)` and `Sigma_t` in closed form. The linearisation is exact, so the only addition is
-/// the validated nominal's defect (method.md 8.4; about 2e-4 here): the box is never below the
+/// the member's box at each report time is `|e^(A t)| h + sqrt(factor Sigma_ii(t))` (`factor`
+/// the squared normal quantile of the reflection bound), with `e^(A t)` and `Sigma_t` in closed
+/// form. The linearisation is exact, so the only addition is the validated nominal's defect
+/// (method.md 8.4; about 2e-4 here): the box is never below the
 /// closed form and at most 2e-3 relative above it.
 #[test]
 fn a_linear_system_gets_the_exact_image_and_covariance() {
@@ -24,7 +27,7 @@ fn a_linear_system_gets_the_exact_image_and_covariance() {
     let (m, epochs) = linearised_member(&prs);
     assert_eq!(prs.delta, 1e-3);
     assert!(m.delta <= 5e-4 && m.delta > 4.99e-4, "{}", m.delta);
-    let factor = mixture_factor(2, epochs, m.delta);
+    let factor = reflection_factor(2, epochs, m.delta);
     let h = [0.1, 0.1];
     let mut worst = 0.0f64;
     for (k, st) in m.steps.iter().enumerate().skip(1) {
@@ -102,7 +105,7 @@ fn noise_free_flows_lie_in_the_member_and_fill_it() {
 
 /// The shipped pendulum's default analyses use the member: the rest of the run at delta / 2,
 /// the member at delta / 2, the PRS their intersection at delta; omega's half-width at t = 4
-/// at most 0.125 (the Monte Carlo truth of issue 27: 0.071; without the member 0.579).
+/// at most 0.1065, 1.5x the Monte Carlo truth of issue 27 (0.071; without the member 0.579).
 /// `first_order = off` turns it off with the first-order sets.
 #[test]
 fn the_default_analyses_split_delta_with_the_member() {
@@ -118,7 +121,7 @@ fn the_default_analyses_split_delta_with_the_member() {
         }
         let k = prs.steps.len() - 1;
         let omega = 0.5 * (prs.hull_at(k).unwrap()[1].hi - prs.hull_at(k).unwrap()[1].lo);
-        assert!(omega <= 0.125, "{analysis}: omega {omega}");
+        assert!(omega <= 0.1065, "{analysis}: omega {omega}");
         assert!(m.steps.iter().all(|s| s.r_t == 0.0));
     }
     let source = std::fs::read_to_string(workspace().join("specs/pendulum.sde")).unwrap();
@@ -133,4 +136,107 @@ fn the_default_analyses_split_delta_with_the_member() {
         .unwrap();
     assert!(prs.also.iter().all(|m| m.role != Role::Linearised));
     assert_eq!(prs.delta, 1e-3);
+}
+
+/// The member's Gaussian box over whole report intervals, against sampled paths: `x' = -20 x +
+/// w` (an Ornstein-Uhlenbeck process with a 0.05 s correlation time, so its supremum over the
+/// horizon is well above any one time's spread) from the worst start, sampled exactly on a
+/// grid of `1e-4` (the Gaussian recursion of the linear SDE, no discretisation error at grid
+/// points). At `delta = 0.2` the member holds at `0.1`: the fraction of paths that leave its
+/// span at some grid point must stay below that (measured: 0.0495, so the bound is sharp to a
+/// factor of two in probability), while a band at one time's 0.9 quantile is left by every
+/// path somewhere (checked, so the test can tell).
+#[test]
+fn sampled_paths_stay_in_the_member_between_report_times() {
+    let (sys, info) = inline(
+        "model ou\nstate x in [-0.01, 0.01]\nnoise w\ndrift {\n x' = -20 * x\n}\n\
+         diffusion {\n x: w\n}\nanalysis a {\n method = contraction\n metric = auto\n \
+         delta = 0.2\n horizon = 2\n step = 0.05\n}\n",
+    );
+    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let (m, _) = linearised_member(&prs);
+    assert!(m.delta <= 0.1);
+    let (rate, dt, per) = (20.0f64, 1e-4f64, 500usize);
+    let decay = (-rate * dt).exp();
+    let sd = ((1.0 - decay * decay) / (2.0 * rate)).sqrt();
+    let paths = 4000;
+    let mut rng = reachc_e2e::Rng(0x05ee_d0f0);
+    let (mut left_member, mut left_pointwise) = (0usize, 0usize);
+    // In one dimension the member's span and set are intervals (its zonotope's hull is exact).
+    let bounds: Vec<((f64, f64), (f64, f64))> = (1..m.steps.len())
+        .map(|k| {
+            let span = &m.steps[k].span;
+            assert_eq!(span.radius, 0.0);
+            let set = m.hull_at(k).unwrap()[0];
+            ((span.lo[0], span.hi[0]), (set.lo, set.hi))
+        })
+        .collect();
+    // The pointwise 0.9 band of the stationary spread: |x| <= 1.645 sqrt(1 / 40).
+    let pointwise = 1.6449 * (1.0 / (2.0 * rate)).sqrt();
+    for _ in 0..paths {
+        let mut x = 0.01f64;
+        let (mut out_m, mut out_p) = (false, false);
+        for ((lo, hi), (set_lo, set_hi)) in &bounds {
+            for _ in 0..per {
+                x = decay * x + sd * rng.normal();
+                out_m |= x <= *lo || x >= *hi;
+                out_p |= x.abs() > pointwise;
+            }
+            out_m |= x <= *set_lo || x >= *set_hi;
+        }
+        left_member += usize::from(out_m);
+        left_pointwise += usize::from(out_p);
+    }
+    let (fm, fp) = (
+        left_member as f64 / paths as f64,
+        left_pointwise as f64 / paths as f64,
+    );
+    assert!(fm <= m.delta, "{fm} of the paths left the member");
+    assert!(
+        fp > 0.5,
+        "only {fp} left the pointwise band: the test cannot tell"
+    );
+}
+
+/// A pendulum-like flow from a wide box: the first-order sets' second-order remainder outgrows
+/// their linear part at `t = 0.55`, and the result says so (a hint, with both P-radii). From a
+/// box a quarter as wide (remainder about 16 times smaller, linear part 4 times) the remainder
+/// overtakes the linear part only at `t = 2.05`, where both are below a tenth of the set's
+/// P-radius (the stochastic radius dominates), so no hint. The shipped Van der Pol oscillator's `contraction` analysis cannot bound them at
+/// all, and says that instead.
+#[test]
+fn first_order_sets_that_lose_their_shape_say_so() {
+    let wide = "model wide\nstate x in [-1.2, 1.2]\nstate v in [-1, 1]\nnoise w\n\
+         drift {\n x' = v\n v' = -4 * sin(x) - 0.5 * v\n}\ndiffusion {\n v: 0.05 * w\n}\n\
+         analysis c {\n method = contraction\n metric = auto\n delta = 1e-3\n horizon = 3\n \
+         step = 0.05\n}\n";
+    let loose = |source: &str| {
+        let (sys, info) = inline(source);
+        let prs = Reach::new(&sys, &info, "c").unwrap().run().unwrap();
+        prs.hints.iter().find_map(|h| match *h {
+            Hint::FirstOrderLoose {
+                t,
+                remainder,
+                linear,
+            } => Some((t, remainder, linear)),
+            _ => None,
+        })
+    };
+    let (t, remainder, linear) = loose(wide).expect("a hint");
+    assert!((t - 0.55).abs() < 1e-9, "{t}");
+    assert!(remainder > linear && linear > 0.0, "{remainder} {linear}");
+    let quarter = wide
+        .replace("[-1.2, 1.2]", "[-0.3, 0.3]")
+        .replace("[-1, 1]", "[-0.25, 0.25]");
+    assert_eq!(loose(&quarter), None);
+    let (sys, info) = shipped("vanderpol.sde");
+    let prs = Reach::new(&sys, &info, "contraction")
+        .unwrap()
+        .run()
+        .unwrap();
+    assert!(
+        prs.hints.contains(&Hint::FirstOrderUnbounded),
+        "{:?}",
+        prs.hints
+    );
 }

@@ -11,7 +11,7 @@ use super::embedding::Budget;
 use super::intersect::cut_by;
 use super::radius::expm1_over;
 use super::{
-    first_order, interval, local, nominal, r1, radius, rates, Detail, Run, RunError, Setting,
+    first_order, hints, interval, local, nominal, r1, radius, rates, Detail, Run, RunError, Setting,
 };
 use crate::decimal::time;
 use crate::interval::Interval;
@@ -147,22 +147,6 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         rigorous,
         not_validated,
     };
-    // The interval method's boxes of the same run, when they cut the ball somewhere
-    // (method.md section 8.7): both sets hold the noise-free solutions, so the same stochastic
-    // radii widen both and the PRS is their intersection at the same delta.
-    // (Validated runs only: the box must not add an unproved step.)
-    // (Within BOX_STEPS_PER_REPORT: where the embedding needs far more, the ball alone is the
-    // result.)
-    let boxes = (validated && n <= MAX_BOX_STATES)
-        .then(|| {
-            let budget = Budget::helper(
-                grid.len().saturating_sub(1),
-                BOX_STEPS_PER_REPORT,
-                BOX_ACCURACY_STEPS,
-            );
-            interval::deterministic(run, spec.inclusion, budget).ok()
-        })
-        .flatten();
     // The first-order sets (method.md 8.8), on the same nominal, with the same radii.
     let first = validated
         .then(|| {
@@ -177,6 +161,25 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
             )
         })
         .flatten();
+    // The interval method's boxes of the same run, when they cut the ball somewhere
+    // (method.md section 8.7): both sets hold the noise-free solutions, so the same stochastic
+    // radii widen both and the PRS is their intersection at the same delta.
+    // (Validated runs only: the box must not add an unproved step.)
+    // (Within BOX_STEPS_PER_REPORT: where the embedding needs far more, the ball alone is the
+    // result.)
+    // (Only where the first-order sets do not keep their shape: where they do, they hold the
+    // flow far tighter than a box, which then costs most of the run for nothing.)
+    let box_wanted = first.as_ref().is_none_or(|f| !f.keeps_shape());
+    let boxes = (validated && n <= MAX_BOX_STATES && box_wanted)
+        .then(|| {
+            let budget = Budget::helper(
+                grid.len().saturating_sub(1),
+                BOX_STEPS_PER_REPORT,
+                BOX_ACCURACY_STEPS,
+            );
+            interval::deterministic(run, spec.inclusion, budget).ok()
+        })
+        .flatten();
     let radii = Radii::new(run, &det, header.kappa);
     let rate = header.rate;
     let rates_proved = header.rigorous[0].clone();
@@ -188,10 +191,12 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
         header.rigorous[0] = rates_proved;
         members.push(assemble_with(run, det, header, None, radii.clone()).with_role(Role::Box));
     }
-    if let Some(first) = first {
-        members.extend(first_order::members(run, first, first_header, radii));
-    }
-    Ok(cut_by(run, ball, members))
+    let offered = first.map(|first| first_order::members(run, first, first_header, radii));
+    let hint = hints::first_order(run, offered.as_deref());
+    members.extend(offered.unwrap_or_default());
+    let mut prs = cut_by(run, ball, members);
+    prs.hints.extend(hint);
+    Ok(prs)
 }
 
 /// The pieces along the nominal's steps, `R` following `R' = c R + rho r2 + |d|_P` with the

@@ -1,15 +1,20 @@
-//! Advice on an interval result ([`Hint`]), read off its own numbers: a box that wraps (grows
-//! far beyond the P-ball its certified contraction constants give from the same initial set),
-//! or a box that leaves the spec's domain. Advisory only: plain floating point, nothing proved
-//! rests on it; the report words it.
+//! Advice on a result ([`Hint`]), read off its own numbers: an interval result's box that wraps
+//! (grows far beyond the P-ball its certified contraction constants give from the same initial
+//! set) or leaves the spec's domain, and first-order sets that do not help (their remainder
+//! outgrows their linear part, or cannot be bounded). Advisory only: plain floating point,
+//! nothing proved rests on it; the report words it.
 
-use super::Run;
+use super::{first_order, Run};
 use crate::model::Bounds;
-use crate::prs::{Hint, Prs};
+use crate::prs::{Hint, Prs, Role};
 
 /// A box is said to wrap when its PRS's bounding box is this many times wider (in some state, at
 /// some report time) than that of the contraction method's P-ball from the same constants.
 pub const WRAPPING_FACTOR: f64 = 10.0;
+
+/// A first-order remainder is worth a hint only when it is at least this part of its set's
+/// whole P-radius (the zonotope's, the remainder and `r_t`).
+const RELEVANT: f64 = 0.1;
 
 /// The hints of an interval result `prs` of `run`.
 pub(super) fn interval(run: &Run, prs: &Prs) -> Vec<Hint> {
@@ -84,6 +89,32 @@ fn leaves_domain(prs: &Prs, domain: &[Bounds]) -> Option<Hint> {
                 range: Bounds::new(lo[i], hi[i]),
                 domain: d,
             })
+        })
+    })
+}
+
+/// The hint on the first-order sets of `run` (method.md 8.8): `offered` are the members the run
+/// computed, `None` when a step could not be bounded ([`Hint::FirstOrderUnbounded`]); else the
+/// first report time where their remainder exceeds their linear part and is at least
+/// [`RELEVANT`] of their whole P-radius ([`Hint::FirstOrderLoose`]), whether or not they still
+/// cut the result there. A point start (no linear part) gives no hint: splitting has nothing to
+/// split; nor does a remainder that the stochastic radius dwarfs (a contracting flow shrinks
+/// both parts below it).
+pub(super) fn first_order(run: &Run, offered: Option<&[Prs]>) -> Option<Hint> {
+    if !first_order::wanted(run) {
+        return None;
+    }
+    let Some(members) = offered else {
+        return Some(Hint::FirstOrderUnbounded);
+    };
+    let first = members.iter().find(|m| m.role == Role::FirstOrder)?;
+    first.steps.iter().find_map(|st| {
+        let (linear, remainder) = first_order::linear_and_remainder(&st.det)?;
+        let matters = remainder > RELEVANT * (linear + remainder + st.r_t);
+        (linear > 0.0 && remainder > linear && matters).then_some(Hint::FirstOrderLoose {
+            t: st.t,
+            remainder,
+            linear,
         })
     })
 }

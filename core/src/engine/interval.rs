@@ -76,13 +76,13 @@ pub(super) fn run(run: &Run, inclusion: Inclusion) -> Result<Prs, RunError> {
     let radii = Radii::new(run, &det, header.kappa);
     let first_header = header.clone();
     let prs = assemble_with(run, det, header, local, radii.clone());
-    let members = first
-        .map(|first| first_order::members(run, first, first_header, radii))
-        .unwrap_or_default();
+    let offered = first.map(|first| first_order::members(run, first, first_header, radii));
+    let hint = hints::first_order(run, offered.as_deref());
     // Hints on what the user gets: the intersection (a box that wraps is no news where the
     // first-order set keeps the result tight).
-    let mut prs = cut_by(run, prs, members);
+    let mut prs = cut_by(run, prs, offered.unwrap_or_default());
     prs.hints = hints::interval(run, &prs);
+    prs.hints.extend(hint);
     Ok(prs)
 }
 

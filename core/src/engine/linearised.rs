@@ -13,18 +13,19 @@
 //! ```
 //!
 //! `Jbar` the mean of `D_x f` on the segment from `p` to `X`. On the event that `Z` stays in the
-//! per-step boxes of the mixture bound (probability `1 - delta`, one epoch per internal step),
+//! per-step boxes of the reflection bound (probability `1 - delta`: one epoch per internal step
+//! and coordinate),
 //! the forcing is bounded per coordinate on a box holding `X`, and `W` is propagated by the
 //! linear flow itself (a zonotope), not by a contraction rate: a remainder in a fast direction is
 //! damped as fast as the flow damps it.
 
 use super::assemble::Piece;
 use super::first_order::exp_enclosure;
-use super::gaussian::{add, best_eta, congruence, step_flow};
+use super::gaussian::{add, congruence, step_flow};
 use super::linalg::product;
 use super::{zonotope, Inputs, Run};
+use crate::chi2::chi2_quantile_upper;
 use crate::interval::Interval;
-use crate::kappa::log_inv_delta_upper;
 use crate::model::Guarantee;
 use crate::prs::{DetSet, Span};
 
@@ -77,8 +78,10 @@ pub(super) struct Tracker<'r> {
     noise: Vec<Interval>,
     /// `Sigma` at the current node.
     sigma: Vec<Interval>,
-    /// `(1 + eta) beta` of the mixture bound at `delta / K`.
-    factor: Interval,
+    /// `q` with `P(|N(0, 1)| > sqrt(q)) <= delta / (2 n K)`: by the reflection principle, each
+    /// coordinate's martingale leaves `sqrt(q)` standard deviations on an epoch with
+    /// probability at most `delta / (n K)`.
+    quantile: Interval,
     /// `W`'s zonotope (centre 0): its generators.
     gens: Vec<Vec<f64>>,
     /// Per coordinate, `sqrt((P^-1)_ii)` rounded up (P-norm bounds to coordinates).
@@ -122,19 +125,16 @@ impl<'r> Tracker<'r> {
                 (0..m).fold(Interval::ZERO, |s, l| s + g[i * m + l] * g[j * m + l])
             })
             .collect();
-        // One epoch per internal step, each at delta / K (union bound).
-        let log_inv = log_inv_delta_upper((delta / epochs as f64).next_down());
-        let eta = best_eta(n, log_inv);
-        let eta_i = Interval::point(eta);
-        let beta = Interval::point(2.0) * Interval::point(log_inv)
-            + Interval::point(n as f64) * (Interval::ONE + eta_i.recip()).ln();
-        let factor = Interval::point(((Interval::ONE + eta_i) * beta).hi());
+        // One epoch per internal step and one event per coordinate, each at delta / (n K)
+        // (union bound), of which the reflection principle spends half on each side.
+        let share = (delta / (2 * n * epochs) as f64).next_down();
+        let quantile = Interval::point(chi2_quantile_upper(1, share));
         Some(Tracker {
             run,
             n,
             noise,
             sigma: vec![Interval::ZERO; n * n],
-            factor,
+            quantile,
             gens: Vec::new(),
             w: run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect(),
             grew: vec![0.0; n],
@@ -143,7 +143,7 @@ impl<'r> Tracker<'r> {
         })
     }
 
-    /// The number of epochs of the mixture bound (one per internal step).
+    /// The number of epochs of the Gaussian bound (one per internal step).
     pub(super) fn epochs(&self) -> usize {
         self.epochs
     }
@@ -153,47 +153,26 @@ impl<'r> Tracker<'r> {
     pub(super) fn step(&mut self, d: &StepData, rates: (f64, f64)) -> Option<Piece> {
         let n = self.n;
         let point = Interval::point;
-        // Sigma at the step's end, and S >= Sigma + eps I, S = mid(Sigma) + 2 eps I.
+        // Sigma at the step's end.
         let (_, gamma) = step_flow(d.a, &self.noise, n, d.span);
         self.sigma = add(&congruence(&d.exp_h.to_vec(), &self.sigma, n), &gamma);
-        let eps = (0..n)
-            .map(|i| {
-                (0..n)
-                    .fold(Interval::ZERO, |s, j| {
-                        let v = self.sigma[i * n + j];
-                        s + point((point(v.hi()) - point(v.mid())).hi())
-                            + point((point(v.mid()) - point(v.lo())).hi())
-                    })
-                    .hi()
-            })
-            .fold(0.0, f64::max);
-        let eps = (2.0 * eps).max(f64::MIN_POSITIVE);
-        let s: Vec<Interval> = (0..n * n)
-            .map(|k| {
-                let mid = point(self.sigma[k].mid());
-                if k / n == k % n {
-                    mid + point(eps)
-                } else {
-                    mid
-                }
-            })
-            .collect();
-        // Z over the step: Z_t = e^(-A (t_(k+1) - t)) M_t, M_t in the ellipsoid factor * S.
-        let neg: Vec<f64> = d.a.iter().map(|v| -v).collect();
-        let back = exp_enclosure(&neg, n, Interval::new(0.0, d.span.hi()))?;
-        let fs = product(&back, &s, n, n, n);
-        let z_over: Vec<f64> = (0..n)
-            .map(|i| {
-                let q = (0..n).fold(Interval::ZERO, |acc, j| {
-                    acc + fs[i * n + j] * back[i * n + j]
-                });
-                (self.factor * point(q.hi().max(0.0))).sqrt().hi()
-            })
-            .collect();
+        // Z over the step: Z_t = e^(-A (t_(k+1) - t)) N_t with |N_(t, j)| <= z_end[j] for every
+        // t of the step (the reflection principle per coordinate, method.md 8.10).
         let z_end: Vec<f64> = (0..n)
             .map(|i| {
-                (self.factor * point(s[i * n + i].hi().max(0.0)))
+                (self.quantile * point(self.sigma[i * n + i].hi().max(0.0)))
                     .sqrt()
+                    .hi()
+            })
+            .collect();
+        let neg: Vec<f64> = d.a.iter().map(|v| -v).collect();
+        let back = exp_enclosure(&neg, n, Interval::new(0.0, d.span.hi()))?;
+        let z_over: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .fold(Interval::ZERO, |acc, j| {
+                        acc + point(back[i * n + j].mag()) * point(z_end[j])
+                    })
                     .hi()
             })
             .collect();

@@ -138,6 +138,12 @@ enum HintJson<'a> {
         range: [f64; 2],
         domain: [f64; 2],
     },
+    FirstOrderLoose {
+        t: f64,
+        remainder: f64,
+        linear: f64,
+    },
+    FirstOrderUnbounded,
 }
 
 #[derive(Serialize)]
@@ -330,6 +336,16 @@ impl<'a> HintJson<'a> {
                 range: [range.lo, range.hi],
                 domain: [domain.lo, domain.hi],
             },
+            Hint::FirstOrderLoose {
+                t,
+                remainder,
+                linear,
+            } => HintJson::FirstOrderLoose {
+                t,
+                remainder,
+                linear,
+            },
+            Hint::FirstOrderUnbounded => HintJson::FirstOrderUnbounded,
         }
     }
 }
@@ -572,10 +588,10 @@ fn proved(p: &Proved) -> String {
         ),
         Proved::LinearisedGaussian { epochs } => format!(
             "linearised Gaussian sets: the covariance of the linearisation along the nominal \
-             (enclosed), Ville's inequality on the method-of-mixtures martingale over {epochs} \
-             epochs (one per internal step) at their share of delta, and the linearisation's \
-             error bounded path by path on that event (interval Jacobians and input \
-             Jacobians on a box holding the state, propagated by the linear flow)"
+             (enclosed), the reflection principle for each coordinate's Gaussian martingale \
+             over {epochs} epochs (one per internal step) at their share of delta, and the \
+             linearisation's error bounded path by path on that event (interval Jacobians and \
+             input Jacobians on a box holding the state, propagated by the linear flow)"
         ),
     }
 }
@@ -1004,6 +1020,27 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
             num(domain.lo),
             num(domain.hi)
         ),
+        Hint::FirstOrderLoose {
+            t,
+            remainder,
+            linear,
+        } => format!(
+            "the first-order sets (the flow's linearisation, method.md 8.8) lose their shape \
+             from t = {}: their second-order remainder (P-radius {}) is larger than their linear \
+             part ({}), so the initial set (or the input box) is too wide for one linearisation \
+             over the horizon; the \
+             remainder shrinks with the square of their widths: split the initial set into \
+             smaller boxes and run each",
+            time(t),
+            num(remainder),
+            num(linear)
+        ),
+        Hint::FirstOrderUnbounded => "the first-order sets (the flow's linearisation, method.md \
+             8.8) could not be bounded on some internal step (the linearisation's remainder \
+             did not hold its own a-priori bound), so the result has none; the remainder \
+             shrinks with the square of the initial set's width: split the initial set into \
+             smaller boxes and run each"
+            .to_string(),
     }
 }
 
