@@ -22,7 +22,7 @@
 
 use super::assemble::{assemble_with, Deterministic, Header, Piece, Radii};
 use super::defect::NominalStep;
-use super::linalg::{product, to_intervals};
+use super::linalg::{product, product_point};
 use super::linearised::{StepData, Tracker};
 use super::local::Certifier;
 use super::radius::{expm1_over, BoxRadius};
@@ -31,14 +31,19 @@ use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Guarantee, InitialSet, Integrator, ModelInfo};
 use crate::prs::{DetSet, Proved, Prs, Role, Span};
 
-/// Terms of the Taylor series of `exp(A tau)` before the remainder bound.
+/// The most terms of the Taylor series of `exp(A tau)` before the remainder bound.
 const TAYLOR_TERMS: usize = 12;
+
+/// Fewer terms where the remainder bound is already below this (the entries of `exp(A tau)`
+/// are of order 1 on a step, so this is below their rounding): a short step of a slow flow
+/// needs 5 or 6 terms, each an `n^3` interval product.
+const TAYLOR_TAIL: f64 = 1e-18;
 
 /// Attempts per step to find an a-priori remainder that holds its own bound.
 const MAX_TRIES: usize = 12;
 
 /// The largest model that gets first-order sets: each step multiplies `n x n` interval
-/// matrices (`2 * TAYLOR_TERMS + 2` products, `n^3` each), which beyond this costs far more
+/// matrices (up to `2 * TAYLOR_TERMS + 2` products, `n^3` each), which beyond this costs far more
 /// than the rest of the run (the 1000-state chain would take hours).
 pub const MAX_FIRST_ORDER_STATES: usize = 32;
 
@@ -195,9 +200,8 @@ pub(super) fn deterministic(
         sys.jac_x(&mid, u, 0.5 * (t0 + t1), &mut a);
         let exp_h = exp_enclosure(&a, n, span)?;
         let exp_over = exp_enclosure(&a, n, Interval::new(0.0, span.hi()))?;
-        let mi = to_intervals(&m);
-        let next = product(&exp_h, &mi, n, n, n);
-        let m_over = product(&exp_over, &mi, n, n, n);
+        let next = product_point(&exp_h, &m, n, n, n);
+        let m_over = product_point(&exp_over, &m, n, n, n);
         // V = [M] Xi over the step, and H = p([t0, t1]) + V.
         let v: Vec<Interval> = (0..n)
             .map(|i| (0..n).fold(Interval::ZERO, |acc, j| acc + m_over[i * n + j] * xi[j]))
@@ -350,12 +354,12 @@ pub(super) fn members(run: &Run, first: FirstOrder, header: Header, radii: Radii
 }
 
 /// An enclosure of `exp(A tau)` for every `tau` in `tau` (`tau >= 0`): the Taylor polynomial
-/// of degree [`TAYLOR_TERMS`] in interval arithmetic plus the remainder
+/// of degree `q` (at most [`TAYLOR_TERMS`], the first whose next term is below
+/// [`TAYLOR_TAIL`]) in interval arithmetic plus the remainder
 /// `a^(q+1) / (q+1)! / (1 - a / (q+2))` on every entry, `a = |A|_inf tau_max` (the remainder
 /// matrix's infinity norm bounds each of its entries). `None` if `a >= q + 2` or the entries
 /// are not finite.
 pub(super) fn exp_enclosure(a: &[f64], n: usize, tau: Interval) -> Option<Vec<Interval>> {
-    let q = TAYLOR_TERMS;
     let norm = (0..n)
         .map(|i| {
             (0..n).fold(Interval::ZERO, |acc, j| {
@@ -364,6 +368,13 @@ pub(super) fn exp_enclosure(a: &[f64], n: usize, tau: Interval) -> Option<Vec<In
         })
         .fold(Interval::ZERO, |m, r| Interval::point(m.hi().max(r.hi())));
     let big = norm * Interval::point(tau.hi());
+    // The degree: the first whose next term is below TAYLOR_TAIL (any degree is sound: the
+    // remainder below is bounded for the one chosen).
+    let (mut q, mut next) = (1, big.hi() * big.hi() / 2.0);
+    while q < TAYLOR_TERMS && next.partial_cmp(&TAYLOR_TAIL) != Some(std::cmp::Ordering::Less) {
+        q += 1;
+        next *= big.hi() / (q + 1) as f64;
+    }
     let qi = Interval::point((q + 2) as f64);
     if big.hi().partial_cmp(&qi.lo()) != Some(std::cmp::Ordering::Less) {
         return None;

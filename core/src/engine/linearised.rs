@@ -22,7 +22,7 @@
 use super::assemble::Piece;
 use super::first_order::exp_enclosure;
 use super::gaussian::{add, congruence, step_flow};
-use super::linalg::product;
+use super::linalg::product_point;
 use super::{zonotope, Inputs, Run};
 use crate::chi2::chi2_quantile_upper;
 use crate::interval::Interval;
@@ -180,9 +180,9 @@ impl<'r> Tracker<'r> {
             return None;
         }
         // W over the step, on an a-priori box that must hold it.
-        let gi: Vec<Interval> = self.gens_matrix();
+        let gi = self.gens_matrix();
         let m = self.gens.len();
-        let fg = product(d.exp_over, &gi, n, n, m);
+        let fg = product_point(d.exp_over, &gi, n, n, m);
         let base: Vec<f64> = (0..n)
             .map(|i| {
                 (0..m)
@@ -244,7 +244,7 @@ impl<'r> Tracker<'r> {
         let (over, forced) = accepted?;
         // W at the step's end: E W_k (the midpoint's generators, the rest in a box), the
         // forcing, the node's jump.
-        let eg = product(d.exp_h, &gi, n, n, m);
+        let eg = product_point(d.exp_h, &gi, n, n, m);
         let mut boxed: Vec<f64> = (0..n)
             .map(|i| {
                 (0..m)
@@ -370,12 +370,10 @@ impl<'r> Tracker<'r> {
         }
     }
 
-    /// `W`'s generators as an `n x m` interval matrix (row-major).
-    fn gens_matrix(&self) -> Vec<Interval> {
+    /// `W`'s generators as an `n x m` matrix (row-major).
+    fn gens_matrix(&self) -> Vec<f64> {
         let m = self.gens.len();
-        (0..self.n * m)
-            .map(|k| Interval::point(self.gens[k % m][k / m]))
-            .collect()
+        (0..self.n * m).map(|k| self.gens[k % m][k / m]).collect()
     }
 
     /// Per coordinate, the half-width of `W`'s hull (rounded up).
