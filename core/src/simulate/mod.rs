@@ -73,8 +73,10 @@ use std::fmt;
 /// The version of reachc that simulates (recorded in parts: only parts of one version merge).
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
-/// Paths per chunk (the unit of parallel work).
+/// Paths per chunk (the unit of parallel work), for a model whose candidates allow it.
 const CHUNK: u64 = 256;
+/// The fewest paths per chunk (the lanes of the vectorised loops).
+const MIN_CHUNK: u64 = 8;
 /// Most paths per batch (between two progress reports and threshold updates).
 const MAX_BATCH: u64 = 1 << 16;
 /// Memory budget of one batch's candidate distances, in bytes.
@@ -194,11 +196,18 @@ pub fn run_part<S: System + Sync + ?Sized>(
             QUANTILE_BYTES >> 30
         )));
     }
-    // Batches: many chunks per batch for the threads, few enough candidates in memory.
-    let batch = (BATCH_BYTES / (16 * buffers))
-        .clamp(CHUNK, MAX_BATCH)
-        .div_ceil(CHUNK)
-        * CHUNK;
+    // Batches: many chunks per batch for the threads, few enough candidates in memory. Until a
+    // buffer has `j` values every path's distances are candidates (one per state and report
+    // time), so a large model gets shorter chunks and a first batch within the budget (the
+    // 1000-state chain: 16 paths per chunk instead of 256, its first batch of candidates 103 MB
+    // instead of 414 MB). Each path has its own random stream: the chunking changes nothing in
+    // the results.
+    let per_path = 16 * buffers;
+    let chunk = (BATCH_BYTES / per_path / MIN_CHUNK * MIN_CHUNK).clamp(MIN_CHUNK, CHUNK);
+    let batch = (BATCH_BYTES / per_path)
+        .clamp(chunk, MAX_BATCH)
+        .div_ceil(chunk)
+        * chunk;
     let workers = workers::Workers::new(opts.threads)?;
     let j = usize::try_from(j).unwrap_or(usize::MAX);
     let (mut topk, mut state_topk) = (topk::TopK::new(steps, j), topk::TopK::new(steps * n, j));
@@ -210,14 +219,14 @@ pub fn run_part<S: System + Sync + ?Sized>(
         // Small batches first: the thresholds are -inf until a step has `j` values, and every
         // path-step is a candidate until then; doubling keeps the number of batches
         // logarithmic.
-        let end = (done + done.clamp((4 * CHUNK).min(batch), batch)).min(mine);
+        let end = (done + done.clamp((4 * chunk).min(batch), batch)).min(mine);
         let thresholds = Thresholds {
             metric: topk.thresholds().to_vec(),
             states: state_topk.thresholds().to_vec(),
         };
         let chunks: Vec<(u64, u64)> = (range.start + done..range.start + end)
-            .step_by(CHUNK as usize)
-            .map(|s| (s, (s + CHUNK).min(range.start + end)))
+            .step_by(chunk as usize)
+            .map(|s| (s, (s + chunk).min(range.start + end)))
             .collect();
         let stats = workers.map(chunks, |(s, e)| plan.run_chunk(s..e, &thresholds));
         for c in &stats {
