@@ -312,7 +312,7 @@ pub(crate) fn product(
 /// underflow errs by at most `2^-1074`. The same bound as [`product`] up to rounding (exact
 /// ranges for a point `B`), at a few floating-point operations per term (no branches, no exact
 /// residuals): the first-order sets' products with their point matrices (`M`, the generators).
-/// Non-finite entries fall back to [`product`].
+/// Non-finite entries, or an overflow on the way, fall back to [`product`].
 pub(crate) fn product_point(
     a: &[Interval],
     b: &[f64],
@@ -320,11 +320,11 @@ pub(crate) fn product_point(
     k: usize,
     c: usize,
 ) -> Vec<Interval> {
+    let endpoint = || product(a, &to_intervals(b), r, k, c);
     let finite = a.iter().all(|v| v.lo().is_finite() && v.hi().is_finite())
         && b.iter().all(|v| v.is_finite());
     if !finite {
-        let b: Vec<Interval> = b.iter().map(|&v| Interval::point(v)).collect();
-        return product(a, &b, r, k, c);
+        return endpoint();
     }
     let u = f64::EPSILON / 2.0;
     let kf = k as f64;
@@ -350,10 +350,14 @@ pub(crate) fn product_point(
                 rad[j] += weight * abs_row[j];
             }
         }
-        out.extend(mid.iter().zip(&rad).map(|(&m, &t)| {
-            let r = (t * grow).next_up() + floor;
-            Interval::point(m) + Interval::new(-r, r)
-        }));
+        for (&m, &t) in mid.iter().zip(&rad) {
+            let half = (t * grow).next_up() + floor;
+            if !(m.is_finite() && half.is_finite()) {
+                // An overflow: the endpoint product saturates where this cannot.
+                return endpoint();
+            }
+            out.push(Interval::point(m) + Interval::new(-half, half));
+        }
     }
     out
 }
@@ -439,9 +443,11 @@ mod tests {
                 }
             }
         }
-        // Non-finite entries fall back to the endpoint product.
+        // Non-finite entries, or an overflow, fall back to the endpoint product.
         let a = [Interval::new(0.0, f64::INFINITY)];
         assert_eq!(product_point(&a, &[2.0], 1, 1, 1)[0].hi(), f64::INFINITY);
+        let huge = product_point(&[Interval::point(1e300)], &[1e300], 1, 1, 1)[0];
+        assert_eq!((huge.lo(), huge.hi()), (f64::MAX, f64::INFINITY));
     }
 
     #[test]

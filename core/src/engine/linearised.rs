@@ -128,6 +128,10 @@ impl<'r> Tracker<'r> {
         // One epoch per internal step and one event per coordinate, each at delta / (n K)
         // (union bound), of which the reflection principle spends half on each side.
         let share = (delta / (2 * n * epochs) as f64).next_down();
+        // (A delta so small that its share underflows: no member, rather than no quantile.)
+        if share <= 0.0 {
+            return None;
+        }
         let quantile = Interval::point(chi2_quantile_upper(1, share));
         Some(Tracker {
             run,
@@ -167,15 +171,7 @@ impl<'r> Tracker<'r> {
             .collect();
         let neg: Vec<f64> = d.a.iter().map(|v| -v).collect();
         let back = exp_enclosure(&neg, n, Interval::new(0.0, d.span.hi()))?;
-        let z_over: Vec<f64> = (0..n)
-            .map(|i| {
-                (0..n)
-                    .fold(Interval::ZERO, |acc, j| {
-                        acc + point(back[i * n + j].mag()) * point(z_end[j])
-                    })
-                    .hi()
-            })
-            .collect();
+        let z_over = abs_times(&back, &z_end);
         if z_over.iter().chain(&z_end).any(|z| !z.is_finite()) {
             return None;
         }
@@ -220,14 +216,8 @@ impl<'r> Tracker<'r> {
                 return None;
             }
             // int_0^h e^(A (h - s)) b(s) ds, and over the step: h [e^(A [0, h])] [-beta, beta].
-            let forced: Vec<f64> = (0..n)
-                .map(|i| {
-                    (0..n)
-                        .fold(Interval::ZERO, |acc, j| {
-                            acc + point(d.exp_over[i * n + j].mag()) * point(beta[j])
-                        })
-                        .hi()
-                })
+            let forced: Vec<f64> = abs_times(d.exp_over, &beta)
+                .into_iter()
                 .map(|v| (point(v) * point(d.span.hi())).hi())
                 .collect();
             let over: Vec<f64> = (0..n)
@@ -387,6 +377,21 @@ impl<'r> Tracker<'r> {
             })
             .collect()
     }
+}
+
+/// Per row `i`, `sum_j |m_ij| v_j` rounded up (`m` square, row-major; `v >= 0`): the bound of
+/// `M x` over `|x_j| <= v_j` for every matrix in the enclosure `m`.
+fn abs_times(m: &[Interval], v: &[f64]) -> Vec<f64> {
+    let n = v.len();
+    (0..n)
+        .map(|i| {
+            (0..n)
+                .fold(Interval::ZERO, |acc, j| {
+                    acc + Interval::point(m[i * n + j].mag()) * Interval::point(v[j])
+                })
+                .hi()
+        })
+        .collect()
 }
 
 /// Per state, whether it is pinned to the validated nominal: it starts at a point and no
