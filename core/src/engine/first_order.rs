@@ -23,7 +23,7 @@
 use super::assemble::{assemble_with, Deterministic, Header, Piece, Radii};
 use super::defect::NominalStep;
 use super::linalg::{product, product_point};
-use super::linearised::{StepData, Tracker};
+use super::linearised::{sliced_jacobian, StepData, Tracker};
 use super::local::Certifier;
 use super::radius::{expm1_over, BoxRadius};
 use super::{zonotope, Run};
@@ -210,7 +210,10 @@ pub(super) fn deterministic(
             .map(|i| Interval::new(step.lo[i], step.hi[i]) + v[i])
             .collect();
         let ui: Vec<Interval> = u.iter().map(|&x| Interval::point(x)).collect();
-        sys.jac_x_interval(&hbox, &ui, times, &mut jac);
+        let hull: Vec<Interval> = (0..n)
+            .map(|i| Interval::new(step.lo[i], step.hi[i]))
+            .collect();
+        sliced_jacobian(sys, &hull, &v, &ui, times, &mut jac);
         // |(A - [J](H)) V|_P.
         let lin: Vec<f64> = (0..n)
             .map(|i| {
