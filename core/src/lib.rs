@@ -1,7 +1,7 @@
 //! The core of reachc: outward-rounded intervals, the [`System`] trait generated code
 //! implements, the data model of a spec's sets and analyses, and the engines computing
 //! delta-probabilistic reachable sets, with typed results. No dependencies (rayon with the
-//! `parallel` feature, for Monte Carlo).
+//! `parallel` feature, for Monte Carlo and the pieces of a split initial set).
 
 pub mod chi2;
 pub mod decimal;
@@ -17,6 +17,7 @@ mod reach;
 pub mod simulate;
 pub mod system;
 pub mod table;
+mod workers;
 
 pub use interval::Interval;
 pub use lanes::X8;

@@ -394,13 +394,52 @@ pub struct AnalysisSpec {
     /// linearised flow's zonotope plus a certified remainder, intersected with the method's
     /// own set (up to [`crate::engine::MAX_FIRST_ORDER_STATES`] states).
     pub first_order: bool,
+    /// How the initial box is cut into pieces, each run at the full delta, the PRS their union
+    /// (method.md 8.11).
+    pub split: Split,
+}
+
+/// How an analysis cuts its initial box into pieces (method.md 8.11, `split = [..]`): each
+/// path starts in exactly one piece, so the union of the pieces' delta-PRS, each at the full
+/// delta, is a delta-PRS of the whole box.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Split {
+    /// One piece: the initial set itself.
+    Off,
+    /// `split = [k1, ..., kn]`: state `i`'s range cut into `k_i` equal parts, `k1 ... kn`
+    /// pieces (each `k_i >= 1`; at most [`MAX_PIECES`] in all).
+    Counts(Vec<usize>),
+    /// `split = auto(pieces = N)`: the pieces whose sets are largest bisected, round by round,
+    /// along their widest state (in the metric), while that shrinks their sets and the pieces
+    /// number at most `pieces` (method.md 8.11).
+    Auto {
+        /// The most pieces.
+        pieces: usize,
+    },
+}
+
+/// The budget of `split = auto` without `pieces = N`.
+pub const AUTO_PIECES: usize = 64;
+
+/// The most pieces a split may have (`split = [..]`): each is a full run.
+pub const MAX_PIECES: usize = 4096;
+
+impl Split {
+    /// The number of pieces (1 for [`Split::Off`], the budget for [`Split::Auto`]; saturating).
+    pub fn pieces(&self) -> usize {
+        match self {
+            Split::Off => 1,
+            Split::Counts(k) => k.iter().fold(1usize, |p, &k| p.saturating_mul(k)),
+            Split::Auto { pieces } => *pieces,
+        }
+    }
 }
 
 impl Default for AnalysisSpec {
     /// The language's defaults (docs/language.md) with a horizon of 1: contraction method,
     /// `delta = 1e-3`, `step = horizon / 100`, identity metric, amgf rule, certified rate,
     /// Jacobian inclusion, validated integration, a uniform guarantee, no transform, every
-    /// state reported, first-order sets on.
+    /// state reported, first-order sets on, no split.
     fn default() -> Self {
         AnalysisSpec {
             name: String::new(),
@@ -417,6 +456,7 @@ impl Default for AnalysisSpec {
             transform: None,
             outputs: Vec::new(),
             first_order: true,
+            split: Split::Off,
         }
     }
 }

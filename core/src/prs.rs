@@ -9,7 +9,7 @@ use crate::engine::zonotope;
 use crate::interval::Interval;
 use crate::model::{
     Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricRegion, Provenance,
-    RadiusRule, Rate, TransformSource, UnsafeShape,
+    RadiusRule, Rate, Split, TransformSource, UnsafeShape,
 };
 use crate::reach::InputPlan;
 
@@ -95,6 +95,15 @@ pub struct Prs {
     pub role: Role,
     /// Advice on the result (interval method: a wrapping box, a box leaving the domain).
     pub hints: Vec<Hint>,
+    /// How the initial box was split (method.md 8.11): [`Split::Off`], the counts per state
+    /// (a state whose range has no width is not cut: its count is 1), or automatically.
+    pub split: Split,
+    /// With a split, the result of each piece of the initial box, each at [`Prs::delta`]: the
+    /// PRS is their union. This result's steps then hold the union's bounding box per report
+    /// time ([`DetSet::Box`], `r_t = 0`), its spans' box, and per unsafe set the smallest
+    /// margin of any piece; [`Prs::contains`] and [`Prs::span_contains`] answer for the union
+    /// itself (in some piece's set).
+    pub pieces: Vec<Prs>,
 }
 
 /// What a result is within an intersection ([`Prs::also`]).
@@ -742,6 +751,9 @@ impl Prs {
     /// Whether `x` lies in [`Step::span`] of report step `k`, the PRS of every time of the
     /// report interval ending there: `true` only if certainly (see [`Prs::contains`]).
     pub fn span_contains(&self, k: usize, x: &[f64]) -> bool {
+        if !self.pieces.is_empty() {
+            return self.pieces.iter().any(|p| p.span_contains(k, x));
+        }
         self.own_span_contains(k, x) && self.also.iter().all(|m| m.own_span_contains(k, x))
     }
 
@@ -773,6 +785,9 @@ impl Prs {
     /// Whether `x` lies in the PRS at report step `k` (see [`Prs::contains`]). Panics if `k` is
     /// out of range or `x` has the wrong length.
     pub fn contains_at(&self, k: usize, x: &[f64]) -> bool {
+        if !self.pieces.is_empty() {
+            return self.pieces.iter().any(|p| p.contains_at(k, x));
+        }
         self.own_contains_at(k, x) && self.also.iter().all(|m| m.own_contains_at(k, x))
     }
 

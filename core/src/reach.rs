@@ -1,14 +1,17 @@
 //! [`Reach`]: one analysis of a model, checked once, run from any initial set inside what its
 //! constants were certified for.
 
-use crate::engine::{self, check_initial, Detail, Inputs, Needs, Run, RunError, Setting, Setup};
+use crate::engine::{
+    self, check_initial, union, Detail, Inputs, Needs, Run, RunError, Setting, Setup,
+};
 use crate::interval::Interval;
 use crate::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, Inclusion, InitialSet, Method, ModelInfo,
-    Rate,
+    Rate, Split,
 };
 use crate::prs::{Prs, Role, Verdict};
 use crate::system::System;
+use crate::workers::Workers;
 
 /// An analysis of a model, ready to run: its parameters checked, its certified constants
 /// checked against the model data (domain, input box, horizon) and kept private, the metric
@@ -212,6 +215,130 @@ impl<'a> Reach<'a> {
         initial: &InitialSet,
         inputs: Inputs,
     ) -> Result<Prs, RunError> {
+        if own.split.pieces() == 1 {
+            return self.run_piece(own, initial, inputs);
+        }
+        // Splitting (method.md 8.11): the initial box in pieces, each run at the full delta in
+        // parallel, the PRS their union.
+        let bounds = match initial.bounding_box() {
+            Ok(b) if initial.balls.is_empty() => b,
+            _ => {
+                return Err(RunError::Unsupported(
+                    Detail::from(
+                        "splitting an initial set that is not a box (an initial ball): give \
+                         the states ranges, or remove `split`",
+                    )
+                    .at_setting(Setting::Split),
+                ))
+            }
+        };
+        let workers = Workers::new(None).map_err(|m| RunError::Invalid(m.into()))?;
+        let run = |b: &[Bounds]| self.run_piece(own, &InitialSet::from_box(b), inputs);
+        let (split, pieces) = match &own.split {
+            Split::Counts(counts) => {
+                // A range of no width is not cut (its pieces would all be the same).
+                let counts: Vec<usize> = counts
+                    .iter()
+                    .zip(&bounds)
+                    .map(|(&k, b)| if b.lo < b.hi { k } else { 1 })
+                    .collect();
+                let results = workers.map(union::pieces(&bounds, &counts), |b| run(&b));
+                (
+                    Split::Counts(counts),
+                    results.into_iter().collect::<Result<_, _>>()?,
+                )
+            }
+            Split::Auto { pieces } => {
+                let found = self.refine(bounds, *pieces, &workers, &run)?;
+                (own.split.clone(), found)
+            }
+            Split::Off => unreachable!("one piece"),
+        };
+        Ok(union::union(
+            self.info,
+            &self.setup.checks,
+            initial,
+            split,
+            pieces,
+        ))
+    }
+
+    /// `split = auto` (method.md 8.11): from the whole box, round after round, the worse half
+    /// of the pieces still worth cutting (by the size of their sets, [`log_volume_sum`]) are
+    /// bisected along their widest state in the metric (`h_i sqrt(P_ii)`), within `budget`
+    /// pieces; a piece whose halves did not shrink its sets by [`AUTO_GAIN`] per report time is
+    /// not cut again. Every decision depends on earlier results only (deterministic, whatever
+    /// the number of threads).
+    fn refine(
+        &self,
+        whole: Vec<Bounds>,
+        budget: usize,
+        workers: &Workers,
+        run: &(dyn Fn(&[Bounds]) -> Result<Prs, RunError> + Sync),
+    ) -> Result<Vec<Prs>, RunError> {
+        let metric = &self.setup.consts.metric;
+        let n = whole.len();
+        let first = run(&whole)?;
+        // (box, result, worth cutting)
+        let mut pieces = vec![(whole, first, true)];
+        loop {
+            let room = budget.saturating_sub(pieces.len());
+            let mut order: Vec<usize> = (0..pieces.len())
+                .filter(|&j| pieces[j].2 && pieces[j].0.iter().any(|b| b.lo < b.hi))
+                .collect();
+            if room == 0 || order.is_empty() {
+                break;
+            }
+            let size: Vec<f64> = pieces.iter().map(|p| log_volume_sum(&p.1)).collect();
+            order.sort_by(|&a, &b| size[b].total_cmp(&size[a]).then(a.cmp(&b)));
+            order.truncate(order.len().div_ceil(2).min(room));
+            order.sort_unstable();
+            let halves: Vec<Vec<Bounds>> = order
+                .iter()
+                .flat_map(|&j| {
+                    let b = &pieces[j].0;
+                    // The widest state in the metric.
+                    let i = (0..n)
+                        .filter(|&i| b[i].lo < b[i].hi)
+                        .max_by(|&x, &y| {
+                            let w = |i: usize| (b[i].hi - b[i].lo) * metric[i * n + i].sqrt();
+                            w(x).total_cmp(&w(y)).then(y.cmp(&x))
+                        })
+                        .expect("a piece worth cutting has width");
+                    union::pieces(
+                        b,
+                        &(0..n).map(|s| 1 + usize::from(s == i)).collect::<Vec<_>>(),
+                    )
+                })
+                .collect();
+            let results = workers.map(halves.clone(), |b| run(&b));
+            let mut results = halves.into_iter().zip(results);
+            let steps = pieces[0].1.steps.len().saturating_sub(1).max(1) as f64;
+            let mut next = Vec::with_capacity(pieces.len() + order.len());
+            for (j, parent) in pieces.into_iter().enumerate() {
+                if order.binary_search(&j).is_err() {
+                    next.push(parent);
+                    continue;
+                }
+                let (a, b) = (results.next().unwrap(), results.next().unwrap());
+                let (a, b) = ((a.0, a.1?), (b.0, b.1?));
+                let shrunk = log_volume_sum(&a.1).max(log_volume_sum(&b.1))
+                    < size[j] - AUTO_GAIN.ln() * steps;
+                next.push((a.0, a.1, shrunk));
+                next.push((b.0, b.1, shrunk));
+            }
+            pieces = next;
+        }
+        Ok(pieces.into_iter().map(|(_, p, _)| p).collect())
+    }
+
+    /// The result of one piece of the initial set (the whole of it without a split).
+    fn run_piece(
+        &self,
+        own: &AnalysisSpec,
+        initial: &InitialSet,
+        inputs: Inputs,
+    ) -> Result<Prs, RunError> {
         // Local rates hold wherever the tube goes: the domain does not constrain them.
         check_initial(self.info, initial, own.rate != Rate::Local)?;
         // K metrics: each set at delta / K, the PRS their intersection (union bound).
@@ -309,19 +436,26 @@ fn better(a: &Prs, b: &Prs) -> bool {
     if safe(a) != safe(b) {
         return safe(a);
     }
-    let size = |p: &Prs| -> f64 {
-        (1..p.steps.len())
-            .map(|k| {
-                p.hull_at(k).map_or(f64::INFINITY, |h| {
-                    h.iter()
-                        .map(|x| (0.5 * (x.hi - x.lo)).max(1e-300).ln())
-                        .sum()
-                })
-            })
-            .sum()
-    };
-    size(a) < size(b)
+    log_volume_sum(a) < log_volume_sum(b)
 }
+
+/// The size of a result's sets: the sum over the report times after 0 of the logarithm of its
+/// bounding box's volume (half-widths, at least `1e-300`; infinite without a bounding box).
+fn log_volume_sum(p: &Prs) -> f64 {
+    (1..p.steps.len())
+        .map(|k| {
+            p.hull_at(k).map_or(f64::INFINITY, |h| {
+                h.iter()
+                    .map(|x| (0.5 * (x.hi - x.lo)).max(1e-300).ln())
+                    .sum()
+            })
+        })
+        .sum()
+}
+
+/// `split = auto` cuts a piece again only if cutting it shrank its sets by this factor per
+/// report time (in volume; see [`Reach::refine`]).
+const AUTO_GAIN: f64 = 1.1;
 
 /// A known input signal: piecewise constant on the analysis' report steps, `u(t) = f(t_k)` on
 /// `[t_k, t_(k+1))`. With a plan the sets cover the trajectories under exactly that input (no

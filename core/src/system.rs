@@ -38,8 +38,9 @@ fn lane_by_lane(x: &[X8], u: &[X8], out: &mut [X8], mut f: impl FnMut(&[f64], &[
 ///
 /// Implementations must be pure functions of their arguments. The interval versions must be
 /// inclusion functions: for every point in the argument boxes, the point result lies in the
-/// interval result (outward rounding).
-pub trait System {
+/// interval result (outward rounding). They are shared between threads (`Sync`): the pieces of
+/// a split initial set run in parallel.
+pub trait System: Sync {
     /// Number of states `n`.
     fn n(&self) -> usize;
     /// Number of inputs `p`.

@@ -381,6 +381,11 @@ impl Draw for SetsScene {
                     .draw_series(LineSeries::new(closed(&sl.prs), c.stroke_width(2 * s)))
                     .map_err(err)?;
             }
+            for piece in &sl.pieces {
+                chart
+                    .draw_series(LineSeries::new(closed(piece), c.mix(0.6).stroke_width(s)))
+                    .map_err(err)?;
+            }
             chart
                 .draw_series(
                     sl.samples

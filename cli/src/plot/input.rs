@@ -44,6 +44,27 @@ pub struct ResultFile {
     /// A member's kind; [`Role::Own`] for the result itself (no `role` in the file).
     #[serde(default)]
     pub role: Role,
+    /// A split result's pieces (the PRS is their union; `steps` hold its bounding boxes).
+    #[serde(default)]
+    pub pieces: Vec<PieceFile>,
+}
+
+/// One piece of a split, in brief: per report time its PRS's bounding box.
+#[derive(Clone, Debug, Deserialize)]
+pub struct PieceFile {
+    /// One record per report time.
+    pub steps: Vec<PieceStep>,
+}
+
+/// A piece's PRS at one report time.
+#[derive(Clone, Debug, Deserialize)]
+pub struct PieceStep {
+    /// Time.
+    pub t: f64,
+    /// Lower corner of the PRS's bounding box.
+    pub prs_hull_lo: Vec<f64>,
+    /// Upper corner.
+    pub prs_hull_hi: Vec<f64>,
 }
 
 /// What a result is within an intersection (`"metric"`, `"box"`, `"first_order"`,
@@ -273,7 +294,7 @@ impl ResultFile {
     }
 
     /// Dimensions, shapes and times agree, every number is finite; and so for the members of
-    /// an intersection, on the same report times.
+    /// an intersection and the pieces of a split, on the same report times.
     fn check(&self) -> Result<(), String> {
         self.check_own()?;
         for (j, m) in self.also.iter().enumerate() {
@@ -286,6 +307,26 @@ impl ResultFile {
                         .ok_or_else(|| "other states or report times".to_string())
                 })
                 .map_err(|e| format!("member {} of the intersection: {e}", j + 1))?;
+        }
+        let n = self.states.len();
+        for (j, p) in self.pieces.iter().enumerate() {
+            let fits = p.steps.len() == self.steps.len()
+                && p.steps.iter().zip(&self.steps).all(|(a, b)| {
+                    a.t == b.t
+                        && a.prs_hull_lo.len() == n
+                        && a.prs_hull_hi.len() == n
+                        && a.prs_hull_lo
+                            .iter()
+                            .zip(&a.prs_hull_hi)
+                            .all(|(l, h)| l.is_finite() && h.is_finite() && l <= h)
+                });
+            if !fits {
+                return Err(format!(
+                    "piece {} of the split: other states or report times, or a box that is \
+                     not finite",
+                    j + 1
+                ));
+            }
         }
         Ok(())
     }

@@ -42,8 +42,10 @@ pub struct Slice {
     pub t: f64,
     /// Boundary of the deterministic set (counter-clockwise; empty when there is none).
     pub det: Vec<Point>,
-    /// Boundary of the PRS (empty when there is none).
+    /// Boundary of the PRS (empty when there is none; a split result's: the union's box).
     pub prs: Vec<Point>,
+    /// A split result's pieces' PRS bounding boxes: the PRS is the union of the pieces' sets.
+    pub pieces: Vec<Vec<Point>>,
     /// The sample paths' states at this time.
     pub samples: Vec<Point>,
     /// The nominal state (or the set's centre) at this time.
@@ -332,12 +334,22 @@ pub fn sets_scene(
                 && det.support([0.0, 1.0]) + det.support([0.0, -1.0]) <= 0.0;
             Slice {
                 t: step.t,
-                det: if degenerate {
+                // (A union has no one deterministic set: its pieces are drawn instead.)
+                det: if degenerate || !result.pieces.is_empty() {
                     Vec::new()
                 } else {
                     det.polygon()
                 },
                 prs: intersected(result, plane, k, prs.polygon()),
+                pieces: result
+                    .pieces
+                    .iter()
+                    .filter_map(|p| {
+                        let st = p.steps.get(k)?;
+                        Some(plane.boxed(&st.prs_hull_lo, &st.prs_hull_hi).polygon())
+                    })
+                    .filter(|poly| poly.len() >= 3)
+                    .collect(),
                 samples: samples_at(&paths, k),
                 nominal: Some(plane.point(&step.nominal)),
             }
@@ -362,6 +374,15 @@ pub fn sets_scene(
         ),
         "projections onto the plotted states: exact".into(),
     ];
+    if !result.pieces.is_empty() {
+        notes[0] = format!(
+            "PRS (solid) = the union of the PRS of {} pieces of the initial box (thin: each \
+             piece's bounding box), each at δ = {}: {holds}",
+            result.pieces.len(),
+            result.delta
+        );
+        notes[1] = "solid: the union's bounding box; projections onto the plotted states".into();
+    }
     if !result.also.is_empty() {
         let of = |role: Role| result.also.iter().filter(|m| m.role == role).count();
         let k = 1 + of(Role::Metric);
@@ -436,6 +457,7 @@ pub fn paths_scene(
                 t: times[k],
                 det: Vec::new(),
                 prs: Vec::new(),
+                pieces: Vec::new(),
                 samples: samples_at(&paths, k),
                 nominal: None,
             })
@@ -510,7 +532,7 @@ pub fn radius_scene(
 
 #[cfg(test)]
 mod tests {
-    use super::super::input::{Constants, DetSet};
+    use super::super::input::{Constants, DetSet, PieceFile, PieceStep};
     use super::*;
 
     const P: [[f64; 2]; 2] = [[2.0, 0.5], [0.5, 1.0]];
@@ -559,6 +581,20 @@ mod tests {
             }],
             also,
             role: Role::Own,
+            pieces: Vec::new(),
+        }
+    }
+
+    /// The P-ball of `radius` about [`CENTER`].
+    fn p_ball(radius: f64) -> DetSet {
+        DetSet {
+            shape: Shape::PBall,
+            center: CENTER.to_vec(),
+            radius,
+            lo: None,
+            hi: None,
+            generators: None,
+            remainder: None,
         }
     }
 
@@ -616,6 +652,51 @@ mod tests {
             .any(|n| n.starts_with("first-order sets")));
     }
 
+    /// A split result: each piece's bounding box is drawn, inside the union's box (the solid
+    /// outline), no dashed deterministic set, and the legend says so.
+    #[test]
+    fn the_pieces_of_a_split_are_drawn() {
+        let hull = DetSet {
+            shape: Shape::Box,
+            center: CENTER.to_vec(),
+            radius: 3.0,
+            lo: Some(vec![-1.0, -1.0]),
+            hi: Some(vec![2.0, 2.0]),
+            generators: None,
+            remainder: None,
+        };
+        let mut union = result(Method::Contraction, hull, 0.0, vec![]);
+        let piece = |lo: [f64; 2], hi: [f64; 2]| PieceFile {
+            steps: vec![PieceStep {
+                t: 1.0,
+                prs_hull_lo: lo.to_vec(),
+                prs_hull_hi: hi.to_vec(),
+            }],
+        };
+        union.pieces = vec![
+            piece([-1.0, -1.0], [0.5, 2.0]),
+            piece([0.0, -0.5], [2.0, 1.0]),
+        ];
+        let plane = Plane::new([0, 1], &union.constants.metric).unwrap();
+        let scene = sets_scene(&union, &plane, &[0], &[], vec![]);
+        let slice = &scene.slices[0];
+        assert_eq!(slice.pieces.len(), 2);
+        assert!(slice.det.is_empty());
+        let sides = |poly: &[Point]| {
+            [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]].map(|d| reach(poly, d))
+        };
+        // (The projection rounds: within 1e-12 of the boxes' sides.)
+        let close = |a: [f64; 4], b: [f64; 4]| a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-12);
+        assert!(close(sides(&slice.pieces[0]), [0.5, 1.0, 2.0, 1.0]));
+        assert!(close(sides(&slice.pieces[1]), [2.0, 0.0, 1.0, 0.5]));
+        assert!(close(sides(&slice.prs), [2.0, 1.0, 2.0, 1.0]));
+        assert!(
+            scene.notes[0].contains("union of the PRS of 2 pieces"),
+            "{:?}",
+            scene.notes
+        );
+    }
+
     /// A P-ball cut by a zonotope member: the drawn PRS lies in both projections, and is the
     /// zonotope's where that is the smaller (the ball's radius is larger than the zonotope's
     /// reach in every direction here); the legend names the zonotope.
@@ -624,15 +705,7 @@ mod tests {
         let (remainder, r_t) = (0.05, 0.1);
         let mut member = result(Method::Contraction, zonotope(remainder), r_t, vec![]);
         member.role = Role::FirstOrder;
-        let ball = DetSet {
-            shape: Shape::PBall,
-            center: CENTER.to_vec(),
-            radius: 1.2,
-            lo: None,
-            hi: None,
-            generators: None,
-            remainder: None,
-        };
+        let ball = p_ball(1.2);
         let r = result(Method::Contraction, ball, r_t, vec![member]);
         let plane = Plane::new([0, 1], &r.constants.metric).unwrap();
         let scene = sets_scene(&r, &plane, &[0], &[], vec![]);

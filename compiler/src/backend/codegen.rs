@@ -43,7 +43,7 @@ use quote::{format_ident, quote, ToTokens};
 use reachc_core::model::{
     Analysis, AutoFit, Ball, Bounds, Constants, Guarantee, Inclusion, InitialSet, InputGain,
     Integrator, MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Provenance, RadiusRule,
-    Rate, TransformSource, UnsafeSet, UnsafeShape,
+    Rate, Split, TransformSource, UnsafeSet, UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -1612,6 +1612,17 @@ impl InfoWriter {
         };
         let outputs = indices(&a_spec.outputs);
         let first_order = a_spec.first_order;
+        let split = match &a_spec.split {
+            Split::Off => quote!(Split::Off),
+            Split::Counts(k) => {
+                let k = indices(k);
+                quote!(Split::Counts(#k))
+            }
+            Split::Auto { pieces } => {
+                let pieces = int(*pieces);
+                quote!(Split::Auto { pieces: #pieces })
+            }
+        };
         let transform = option(&a_spec.transform, |t| {
             let (matrix, inverse, frame) = (
                 self.floats(&t.matrix),
@@ -1665,6 +1676,7 @@ impl InfoWriter {
                     transform: #transform,
                     outputs: #outputs,
                     first_order: #first_order,
+                    split: #split,
                 },
                 constants: #constants,
             }

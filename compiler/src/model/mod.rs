@@ -13,7 +13,7 @@ use reachc_core::engine::Setting;
 // backends hand it on unchanged.
 pub use reachc_core::model::{
     AnalysisSpec, Ball, Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricChoice,
-    RadiusRule, Rate, Transform, UnsafeSet, UnsafeShape,
+    RadiusRule, Rate, Split, Transform, UnsafeSet, UnsafeShape, AUTO_PIECES, MAX_PIECES,
 };
 
 /// A checked spec, ready for analysis and code generation.

@@ -11,7 +11,7 @@ use super::transform::Frame;
 use super::uniform::{Scale, Tube};
 use super::Run;
 use crate::interval::Interval;
-use crate::model::{Guarantee, Inclusion, Method, ModelInfo, RadiusRule, Rate};
+use crate::model::{Guarantee, Inclusion, Method, ModelInfo, RadiusRule, Rate, Split};
 use crate::prs::{
     ConstantsUsed, DetSet, GaussianUsed, Proved, Prs, R1Bound, RateUsed, Role, RuleUsed, Span,
     Step, TransformUsed, UniformBound, Unproved, UnsafeVerdict, Validation, Verdict,
@@ -321,6 +321,8 @@ pub(super) fn assemble_with(
         also: Vec::new(),
         role: Role::Own,
         hints: Vec::new(),
+        split: Split::Off,
+        pieces: Vec::new(),
     }
 }
 

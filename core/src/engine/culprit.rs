@@ -33,11 +33,13 @@ pub enum Setting {
     Outputs,
     /// `first_order = on | off`.
     FirstOrder,
+    /// `split = [..]`.
+    Split,
 }
 
 impl Setting {
     /// Every setting, in the order docs/language.md lists them.
-    pub const ALL: [Setting; 13] = [
+    pub const ALL: [Setting; 14] = [
         Setting::Method,
         Setting::Delta,
         Setting::Horizon,
@@ -51,6 +53,7 @@ impl Setting {
         Setting::Transform,
         Setting::Outputs,
         Setting::FirstOrder,
+        Setting::Split,
     ];
 
     /// The setting's key as a spec writes it: `horizon`, `step`, ...
@@ -69,6 +72,7 @@ impl Setting {
             Setting::Transform => "transform",
             Setting::Outputs => "outputs",
             Setting::FirstOrder => "first_order",
+            Setting::Split => "split",
         }
     }
 

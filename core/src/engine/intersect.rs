@@ -6,7 +6,7 @@ use super::assemble::verdicts;
 use super::safety::Check;
 use super::Run;
 use crate::model::ModelInfo;
-use crate::prs::Prs;
+use crate::prs::{Prs, Validation};
 
 /// The intersection of `first` and `others` (results of the same analysis and run, on the same
 /// report times, each at `delta / K`) as one result at `delta`: a margin of the intersection is
@@ -41,13 +41,7 @@ pub(crate) fn intersect(
         }
     }
     for other in &others {
-        let v = &other.validation;
-        first.validation.conditional_on_domain |= v.conditional_on_domain;
-        for item in &v.not_validated {
-            if !first.validation.not_validated.contains(item) {
-                first.validation.not_validated.push(item.clone());
-            }
-        }
+        absorb(&mut first.validation, &other.validation);
     }
     let (unsafe_sets, verdict) = verdicts(info, checks, &first.steps);
     first.unsafe_sets = unsafe_sets;
@@ -55,6 +49,17 @@ pub(crate) fn intersect(
     first.delta = delta;
     first.also = others;
     first
+}
+
+/// What a result combined of `from` and others leaves unproved or conditional: `into`'s and
+/// `from`'s (each unproved item once).
+pub(super) fn absorb(into: &mut Validation, from: &Validation) {
+    into.conditional_on_domain |= from.conditional_on_domain;
+    for item in &from.not_validated {
+        if !into.not_validated.contains(item) {
+            into.not_validated.push(item.clone());
+        }
+    }
 }
 
 /// `main` intersected with those of `members` that cut it somewhere (results of the same run

@@ -39,6 +39,7 @@ mod rates;
 mod safety;
 pub(crate) mod transform;
 mod uniform;
+pub(crate) mod union;
 pub(crate) mod zonotope;
 
 pub use contraction::MAX_BOX_STATES;
@@ -52,7 +53,8 @@ pub use radius::MAX_VERTEX_COORDS;
 
 use crate::interval::Interval;
 use crate::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, RadiusRule,
+    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, RadiusRule, Split,
+    MAX_PIECES,
 };
 use crate::prs::Prs;
 use crate::reach::InputPlan;
@@ -313,6 +315,24 @@ pub(crate) fn validate(
 ) -> Result<(), RunError> {
     let bad = |m: String| Err(RunError::Invalid(m.into()));
     let bad_setting = |s: Setting, m: String| Err(RunError::Invalid(Detail::from(m).at_setting(s)));
+    if let Split::Auto { pieces } = a.split {
+        if !(1..=MAX_PIECES).contains(&pieces) {
+            return bad_setting(
+                Setting::Split,
+                format!("split = auto(pieces = {pieces}) must allow 1 to {MAX_PIECES} pieces"),
+            );
+        }
+    }
+    if let Split::Counts(k) = &a.split {
+        if k.len() != n || k.contains(&0) || a.split.pieces() > MAX_PIECES {
+            return bad_setting(
+                Setting::Split,
+                format!(
+                    "split = {k:?} must give one count of at least 1 per state ({n}), at most                      {MAX_PIECES} pieces in all"
+                ),
+            );
+        }
+    }
     if !(a.delta > 0.0 && a.delta < 1.0) {
         return bad_setting(
             Setting::Delta,

@@ -47,8 +47,8 @@ mod rng;
 mod sample;
 mod shard;
 mod topk;
-mod workers;
 
+pub use crate::workers::thread_count;
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
 pub use dt::{DtSource, DtUsed, MAX_STEPS, RULE as DT_RULE};
 pub use inputs::InputMode;
@@ -61,12 +61,12 @@ pub use report::{
 };
 pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
 pub use shard::Shard;
-pub use workers::thread_count;
 
 use crate::interval::Interval;
 use crate::model::{Guarantee, ModelInfo};
 use crate::prs::{Prs, UnsafeKind};
 use crate::system::System;
+use crate::workers::Workers;
 use paths::{ChunkStats, Plan, Span, Thresholds};
 use std::fmt;
 
@@ -208,7 +208,7 @@ pub fn run_part<S: System + Sync + ?Sized>(
         .clamp(chunk, MAX_BATCH)
         .div_ceil(chunk)
         * chunk;
-    let workers = workers::Workers::new(opts.threads)?;
+    let workers = Workers::new(opts.threads).map_err(SimError::Invalid)?;
     let j = usize::try_from(j).unwrap_or(usize::MAX);
     let (mut topk, mut state_topk) = (topk::TopK::new(steps, j), topk::TopK::new(steps * n, j));
     let mut total = ChunkStats::new(steps, plan.unsafe_sets.len(), n);

@@ -337,6 +337,71 @@ pub(crate) struct Membership<'a> {
     own: OneSet<'a>,
     /// The members, with their metrics.
     also: Vec<(Metric, OneSet<'a>)>,
+    /// A split result's pieces (method.md 8.11), in the result's metric, each with its
+    /// bounding boxes per step: the PRS is their union, inside its own bounding box (`own`).
+    pieces: Vec<(Hulls, Membership<'a>)>,
+}
+
+/// A result's bounding boxes, `[lo, hi]` per state, step after step (`n` per step): a state
+/// outside step `k`'s box is outside the result's set at `k` (a quick test before the exact
+/// one).
+#[derive(Clone, Debug)]
+pub(crate) struct Hulls {
+    n: usize,
+    bounds: Vec<(f64, f64)>,
+}
+
+impl Hulls {
+    /// Per step, [`Prs::hull_at`] (from [`Step::span`](crate::prs::Step::span) with `spans`),
+    /// or no bound where the result has none.
+    fn of(result: &Prs, spans: bool) -> Hulls {
+        let n = result.n();
+        let bounds = (0..result.steps.len())
+            .flat_map(|k| {
+                let b = if spans {
+                    span_hull(result, k)
+                } else {
+                    result.hull_at(k)
+                };
+                b.map_or_else(
+                    || vec![(f64::NEG_INFINITY, f64::INFINITY); n],
+                    |b| b.iter().map(|x| (x.lo, x.hi)).collect(),
+                )
+            })
+            .collect();
+        Hulls { n, bounds }
+    }
+
+    /// Whether `x` may lie in the set of step `k` (`false`: certainly not).
+    fn may_hold(&self, k: usize, x: &[f64]) -> bool {
+        let b = &self.bounds[k * self.n..(k + 1) * self.n];
+        x.iter().zip(b).all(|(v, (lo, hi))| lo <= v && v <= hi)
+    }
+}
+
+/// A bounding box of [`Prs::span_contains`]'s set at step `k`: the own span's box widened by
+/// its ball (the members' cut it further, but any box holding it will do).
+fn span_hull(result: &Prs, k: usize) -> Option<Vec<crate::model::Bounds>> {
+    let span = &result.steps.get(k)?.span;
+    let w = &result.constants.spread;
+    if w.len() != result.n() || span.lo.len() != w.len() || span.hi.len() != w.len() {
+        return None;
+    }
+    Some(
+        (0..w.len())
+            .map(|i| {
+                let d = if span.radius == 0.0 {
+                    Interval::ZERO
+                } else {
+                    Interval::point(span.radius) * Interval::point(w[i])
+                };
+                crate::model::Bounds::new(
+                    (Interval::point(span.lo[i]) - d).lo(),
+                    (Interval::point(span.hi[i]) + d).hi(),
+                )
+            })
+            .collect(),
+    )
 }
 
 impl<'a> Membership<'a> {
@@ -347,24 +412,33 @@ impl<'a> Membership<'a> {
         Membership {
             own: OneSet::new(result, metric),
             also,
+            // (The pieces share the analysis' metric.)
+            pieces: result
+                .pieces
+                .iter()
+                .map(|p| (Hulls::of(p, false), Membership::new(p, metric)))
+                .collect(),
         }
     }
 
     /// `Some(b)`: a squared distance `q < b` (from [`Metric::quad`]) means `x` is in the PRS of
     /// step `k`, found with one comparison (what [`inside`](Self::inside) answers). `None` when
-    /// no such bound holds (an intersection, shapes other than the P-ball, metrics with
+    /// no such bound holds (an intersection, a union, shapes other than the P-ball, metrics with
     /// off-diagonal or negative terms: see [`inside_by_shortcut`](Self::inside_by_shortcut)).
     pub(crate) fn inside_below(&self, k: usize) -> Option<f64> {
-        if self.also.is_empty() {
+        if self.also.is_empty() && self.pieces.is_empty() {
             self.own.inside_below(k)
         } else {
             None
         }
     }
 
-    /// Whether [`inside_by_shortcut`](Self::inside_by_shortcut) can ever answer `true`.
+    /// Whether [`inside_by_shortcut`](Self::inside_by_shortcut) can ever answer `true` (never
+    /// for a union: its own set is the pieces' bounding box).
     pub(crate) fn has_shortcuts(&self) -> bool {
-        self.own.has_shortcuts() && self.also.iter().all(|(_, s)| s.has_shortcuts())
+        self.pieces.is_empty()
+            && self.own.has_shortcuts()
+            && self.also.iter().all(|(_, s)| s.has_shortcuts())
     }
 
     /// Whether `x` is, by the shortcuts alone, in the PRS of step `k` (then
@@ -378,7 +452,7 @@ impl<'a> Membership<'a> {
         q: f64,
         a: f64,
     ) -> bool {
-        if !self.own.inside_by_shortcut(metric, k, x, q, a) {
+        if !self.pieces.is_empty() || !self.own.inside_by_shortcut(metric, k, x, q, a) {
             return false;
         }
         // A loop rather than `all`, which might not be inlined into the hot loops.
@@ -402,6 +476,9 @@ impl<'a> Membership<'a> {
         q: X8,
         a: X8,
     ) -> u8 {
+        if !self.pieces.is_empty() {
+            return 0;
+        }
         let mut mask = self.own.inside_by_shortcut_x8(metric, k, x, || (q, a));
         for (m, s) in &self.also {
             if mask == 0 {
@@ -426,15 +503,26 @@ impl<'a> Membership<'a> {
         q: f64,
         a: f64,
     ) -> bool {
+        let at = |m: &Metric, c: &[f64]| {
+            let (q, a) = m.quad(x, c);
+            // As `record` does for the own metric: rounding can make `q` slightly negative
+            // only with off-diagonal terms.
+            (if a == q { q } else { q.max(0.0) }, a)
+        };
         self.own.inside(metric, k, x, c, q, a)
             && self.also.iter().all(|(m, s)| {
                 let c = s.centre(k);
-                let (q, a) = m.quad(x, c);
-                // As `record` does for the own metric: rounding can make `q` slightly negative
-                // only with off-diagonal terms.
-                let q = if a == q { q } else { q.max(0.0) };
+                let (q, a) = at(m, c);
                 s.inside(m, k, x, c, q, a)
             })
+            && (self.pieces.is_empty()
+                || self.pieces.iter().any(|(hulls, p)| {
+                    hulls.may_hold(k, x) && {
+                        let c = p.own.centre(k);
+                        let (q, a) = at(metric, c);
+                        p.inside(metric, k, x, c, q, a)
+                    }
+                }))
     }
 }
 
@@ -834,6 +922,10 @@ pub(crate) struct Tube<'a> {
     /// The spans of the members of an intersection (`result.also`), with their metrics: a
     /// state is in the tube when it is in every member's span.
     also: Vec<(Metric, OneSpan<'a>)>,
+    /// A split result's pieces' tubes (method.md 8.11), in the result's metric, each with the
+    /// bounding boxes of its spans: a state is in the union's tube when it is in some piece's
+    /// (and in `own`, their bounding box).
+    pieces: Vec<(Hulls, Tube<'a>)>,
 }
 
 impl<'a> Tube<'a> {
@@ -844,6 +936,11 @@ impl<'a> Tube<'a> {
         Ok(Tube {
             own: OneSpan::new(result, metric)?,
             also,
+            pieces: result
+                .pieces
+                .iter()
+                .map(|p| Ok((Hulls::of(p, true), Tube::new(p, metric)?)))
+                .collect::<Result<_, String>>()?,
         })
     }
 
@@ -854,7 +951,7 @@ impl<'a> Tube<'a> {
     #[inline(always)]
     pub(crate) fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
         let (lo, hi, q_in) = self.own.diag_bounds(k);
-        let q_in = if self.also.is_empty() {
+        let q_in = if self.also.is_empty() && self.pieces.is_empty() {
             q_in
         } else {
             f64::NEG_INFINITY
@@ -868,7 +965,8 @@ impl<'a> Tube<'a> {
     /// [`diag_bounds`](Self::diag_bounds).
     #[inline(always)]
     pub(crate) fn inside_by_shortcut(&self, metric: &Metric, k: usize, x: &[f64]) -> bool {
-        self.own.inside_by_shortcut(metric, k, x)
+        self.pieces.is_empty()
+            && self.own.inside_by_shortcut(metric, k, x)
             && self.also.iter().all(|(m, s)| s.inside_by_shortcut(m, k, x))
     }
 
@@ -884,6 +982,9 @@ impl<'a> Tube<'a> {
     /// the same answer as for that state alone.
     #[inline(always)]
     pub(crate) fn inside_by_shortcut_x8(&self, metric: &Metric, k: usize, x: &[X8]) -> u8 {
+        if !self.pieces.is_empty() {
+            return 0;
+        }
         let mut mask = self.own.inside_by_shortcut_x8(metric, k, x);
         for (m, s) in &self.also {
             mask &= s.inside_by_shortcut_x8(m, k, x);
@@ -900,7 +1001,13 @@ impl<'a> Tube<'a> {
         if !x.iter().all(|v| v.is_finite()) {
             return false;
         }
-        self.own.decide(metric, k, x) && self.also.iter().all(|(m, s)| s.decide(m, k, x))
+        self.own.decide(metric, k, x)
+            && self.also.iter().all(|(m, s)| s.decide(m, k, x))
+            && (self.pieces.is_empty()
+                || self
+                    .pieces
+                    .iter()
+                    .any(|(hulls, p)| hulls.may_hold(k, x) && p.inside_slow(metric, k, x)))
     }
 }
 

@@ -2,7 +2,7 @@
 
 use super::probability::ProbabilityJson;
 use super::{count, csv_field, num, summary_indices, time};
-use reachc_core::model::{AutoFit, Guarantee, Method, Rate, TransformSource};
+use reachc_core::model::{AutoFit, Guarantee, Method, Rate, Split, TransformSource};
 use reachc_core::probability::SafetyProbability;
 use reachc_core::prs::{
     BallBound, DetSet, Hint, Proved, Prs, R1Method, Role, Step, TransformUsed, UniformBound,
@@ -67,6 +67,81 @@ struct Json<'a> {
     /// A member's kind (`metric`, `box`, `first_order`); absent for the result itself.
     #[serde(skip_serializing_if = "Option::is_none")]
     role: Option<&'static str>,
+    /// The split (absent without one; method.md 8.11): the counts per state, or
+    /// `{"auto": {"pieces": N}}` (the budget).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    split: Option<SplitJson<'a>>,
+    /// With a split, each piece in brief (the PRS is their union: `steps[..].prs_hull_lo/hi`
+    /// are the union's bounding boxes, the margins and verdicts the union's).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pieces: Vec<PieceJson<'a>>,
+}
+
+/// One piece of a split (method.md 8.11), in brief: its initial box, its verdict, and per report
+/// time its PRS's bounding box and margins. (Written in full, with their members' zonotopes,
+/// the 64 pieces of `specs/vanderpol.sde` made files of 100 to 160 MB.)
+#[derive(Serialize)]
+struct PieceJson<'a> {
+    initial_box: Vec<[f64; 2]>,
+    verdict: VerdictJson<'a>,
+    steps: Vec<PieceStepJson<'a>>,
+}
+
+#[derive(Serialize)]
+struct PieceStepJson<'a> {
+    t: f64,
+    prs_hull_lo: Vec<f64>,
+    prs_hull_hi: Vec<f64>,
+    margins: &'a [f64],
+}
+
+impl<'a> PieceJson<'a> {
+    fn of(p: &'a Prs) -> PieceJson<'a> {
+        PieceJson {
+            initial_box: p
+                .initial
+                .bounding_box()
+                .unwrap_or_default()
+                .iter()
+                .map(|x| [x.lo, x.hi])
+                .collect(),
+            verdict: VerdictJson::of(p),
+            steps: p
+                .steps
+                .iter()
+                .enumerate()
+                .map(|(k, st)| {
+                    let (lo, hi) = p
+                        .hull_at(k)
+                        .unwrap_or_default()
+                        .iter()
+                        .map(|b| (b.lo, b.hi))
+                        .unzip();
+                    PieceStepJson {
+                        t: st.t,
+                        prs_hull_lo: lo,
+                        prs_hull_hi: hi,
+                        margins: &st.margins,
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
+/// How the initial box was split.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum SplitJson<'a> {
+    /// `split = [..]`.
+    Counts(&'a [usize]),
+    /// `split = auto(pieces = N)`.
+    Auto { auto: AutoJson },
+}
+
+#[derive(Serialize)]
+struct AutoJson {
+    pieces: usize,
 }
 
 #[derive(Serialize)]
@@ -211,6 +286,20 @@ enum VerdictJson<'a> {
     NotShownSafe { t: f64, step: usize, set: &'a str },
 }
 
+impl<'a> VerdictJson<'a> {
+    fn of(prs: &'a Prs) -> VerdictJson<'a> {
+        match prs.verdict {
+            Verdict::Safe => VerdictJson::Safe,
+            Verdict::NoUnsafeSets => VerdictJson::NoUnsafeSets,
+            Verdict::NotShownSafe { t, step, set } => VerdictJson::NotShownSafe {
+                t,
+                step,
+                set: &prs.unsafe_sets[set].name,
+            },
+        }
+    }
+}
+
 #[derive(Serialize)]
 struct ValidationJson {
     rigorous: Vec<String>,
@@ -287,15 +376,7 @@ impl<'a> Json<'a> {
             input_center: &prs.input_center,
             steps: (0..prs.steps.len()).map(|k| StepJson::of(prs, k)).collect(),
             unsafe_sets: prs.unsafe_sets.iter().map(UnsafeJson::of).collect(),
-            verdict: match prs.verdict {
-                Verdict::Safe => VerdictJson::Safe,
-                Verdict::NoUnsafeSets => VerdictJson::NoUnsafeSets,
-                Verdict::NotShownSafe { t, step, set } => VerdictJson::NotShownSafe {
-                    t,
-                    step,
-                    set: &prs.unsafe_sets[set].name,
-                },
-            },
+            verdict: VerdictJson::of(prs),
             safety_probability: None,
             validated: ValidationJson {
                 rigorous: prs.validation.rigorous.iter().map(proved).collect(),
@@ -305,6 +386,14 @@ impl<'a> Json<'a> {
             hints: prs.hints.iter().map(|h| HintJson::of(prs, h)).collect(),
             also: prs.also.iter().map(Json::of).collect(),
             role: (prs.role != Role::Own).then(|| prs.role.name()),
+            split: match &prs.split {
+                Split::Off => None,
+                Split::Counts(k) => Some(SplitJson::Counts(k)),
+                Split::Auto { pieces } => Some(SplitJson::Auto {
+                    auto: AutoJson { pieces: *pieces },
+                }),
+            },
+            pieces: prs.pieces.iter().map(PieceJson::of).collect(),
         }
     }
 }
@@ -776,7 +865,12 @@ pub fn summary(prs: &Prs) -> String {
             );
         }
         Rate::Local => {
-            let sigma = prs.regions.iter().map(|r| r.sigma).fold(0.0, f64::max);
+            // (A split result's regions are its pieces'.)
+            let sigma = std::iter::once(prs)
+                .chain(&prs.pieces)
+                .flat_map(|p| &p.regions)
+                .map(|r| r.sigma)
+                .fold(0.0, f64::max);
             let _ = writeln!(
                 s,
                 "  rates: local, c_t in [{}, {}], sigma_t at most {} (global: c = {}, sigma = \
@@ -850,7 +944,9 @@ pub fn summary(prs: &Prs) -> String {
         prs.kappa
     );
     summary_metrics(prs, &mut s);
-    if zonotopes(prs) {
+    if !prs.pieces.is_empty() {
+        summary_split(prs, &mut s);
+    } else if zonotopes(prs) {
         let _ = writeln!(
             s,
             "  deterministic sets: first-order zonotopes (the initial box under the flow's \
@@ -1029,8 +1125,8 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
              from t = {}: their second-order remainder (P-radius {}) is larger than their linear \
              part ({}), so the initial set (or the input box) is too wide for one linearisation \
              over the horizon; the \
-             remainder shrinks with the square of their widths: split the initial set into \
-             smaller boxes and run each",
+             remainder shrinks with the square of their widths: split the initial set \
+             (`split = [..]` in the analysis, one count per state)",
             time(t),
             num(remainder),
             num(linear)
@@ -1038,8 +1134,8 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
         Hint::FirstOrderUnbounded => "the first-order sets (the flow's linearisation, method.md \
              8.8) could not be bounded on some internal step (the linearisation's remainder \
              did not hold its own a-priori bound), so the result has none; the remainder \
-             shrinks with the square of the initial set's width: split the initial set into \
-             smaller boxes and run each"
+             shrinks with the square of the initial set's width: split the initial set \
+             (`split = [..]` in the analysis, one count per state)"
             .to_string(),
     }
 }
@@ -1147,6 +1243,11 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             num(last)
         );
     }
+    hull_table(prs, s);
+}
+
+/// The table of the PRS's bounding boxes (of an intersection or a union) per report time.
+fn hull_table(prs: &Prs, s: &mut String) {
     let names: Vec<String> = prs.states.iter().map(|x| format!("{x} [lo, hi]")).collect();
     let header: Vec<String> = names.iter().map(|x| format!("{x:>28}")).collect();
     let _ = writeln!(s, "  {:>10}  {}", "t", header.join("  "));
@@ -1159,6 +1260,70 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             .map(|b| format!("[{:>12}, {:>12}]", num(b.lo), num(b.hi)))
             .collect();
         let _ = writeln!(s, "  {:>10.4}  {}", prs.steps[i].t, cells.join("  "));
+    }
+}
+
+/// A split result (method.md 8.11) in words: the pieces, the union's bounding boxes, and which
+/// pieces are not shown safe.
+fn summary_split(prs: &Prs, s: &mut String) {
+    let how = match &prs.split {
+        Split::Counts(k) => {
+            let counts: Vec<String> = k.iter().map(|k| k.to_string()).collect();
+            format!(
+                "cut into {} = {} pieces",
+                counts.join(" x "),
+                prs.pieces.len()
+            )
+        }
+        Split::Auto { pieces } => format!(
+            "cut automatically into {} pieces (at most {pieces}: the pieces with the largest \
+             sets halved along their widest state, while that shrank them)",
+            prs.pieces.len()
+        ),
+        Split::Off => String::new(),
+    };
+    let _ = writeln!(
+        s,
+        "  split: the initial box {how}, each run at delta = {} (method.md 8.11); the PRS is \
+         their union (a path starts in one piece and stays in that piece's PRS with probability \
+         at least {}); the boxes below are the union's bounding boxes, the margins and verdicts \
+         the union's",
+        prs.delta,
+        1.0 - prs.delta
+    );
+    let cut: usize = prs.pieces.iter().filter(|p| !p.also.is_empty()).count();
+    if cut > 0 {
+        let _ = writeln!(
+            s,
+            "  pieces cut by further sets of their own run (interval box, first-order or \
+             linearised sets): {cut} of {}",
+            prs.pieces.len()
+        );
+    }
+    hull_table(prs, s);
+    let unsafe_pieces: Vec<(usize, &Prs)> = prs
+        .pieces
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| matches!(p.verdict, Verdict::NotShownSafe { .. }))
+        .collect();
+    if let Some((j, p)) = unsafe_pieces.first() {
+        let range: Vec<String> = p
+            .initial
+            .bounding_box()
+            .unwrap_or_default()
+            .iter()
+            .zip(&prs.states)
+            .map(|(b, x)| format!("{x} in [{}, {}]", num(b.lo), num(b.hi)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "  pieces not shown safe: {} of {} (the first, piece {}: {})",
+            unsafe_pieces.len(),
+            prs.pieces.len(),
+            j + 1,
+            range.join(", ")
+        );
     }
 }
 

@@ -10,7 +10,7 @@ use crate::ir::ExprId;
 use crate::limits::{MAX_REPORT_STEPS, MIN_REPORT_STEP};
 use crate::model::{
     Analysis, AnalysisSpec, Bounds, Guarantee, Inclusion, Integrator, Method,
-    MetricChoice as Metric, RadiusRule, Rate, Transform,
+    MetricChoice as Metric, RadiusRule, Rate, Split, Transform, AUTO_PIECES, MAX_PIECES,
 };
 use crate::syntax::ast::{Arg, Block, Expr, ExprKind, Ident};
 use reachc_core::engine::Setting;
@@ -49,6 +49,7 @@ const KEYS: &[&str] = &[
     "transform",
     "outputs",
     "first_order",
+    "split",
 ];
 
 impl Checker<'_> {
@@ -179,6 +180,10 @@ impl Checker<'_> {
         else {
             return;
         };
+        let split = match f.get("split") {
+            None => Some(Split::Off),
+            Some((e, _)) => self.split(e, n),
+        };
         let (
             Some(metric),
             Some(radius),
@@ -186,7 +191,8 @@ impl Checker<'_> {
             Some(transform),
             Some(outputs),
             Some(first_order),
-        ) = (metric, radius, rate, transform, outputs, first_order)
+            Some(split),
+        ) = (metric, radius, rate, transform, outputs, first_order, split)
         else {
             return;
         };
@@ -291,6 +297,7 @@ impl Checker<'_> {
                 transform,
                 outputs,
                 first_order,
+                split,
             },
             span,
             name_span: name.span.clone(),
@@ -574,6 +581,113 @@ impl Checker<'_> {
                 )
             }
         }
+    }
+
+    /// `split = [k1, ..., kn]`: one whole count of at least 1 per state, at most
+    /// [`MAX_PIECES`] pieces in all (method.md 8.11).
+    fn split(&mut self, e: &Expr, n: usize) -> Option<Split> {
+        match &e.kind {
+            ExprKind::Name(id) if id.name == "auto" => {
+                return Some(Split::Auto {
+                    pieces: AUTO_PIECES,
+                })
+            }
+            ExprKind::Call { func, args } if func.name == "auto" => {
+                return self.auto_split(e, args)
+            }
+            _ => {}
+        }
+        let ExprKind::List(items) = &e.kind else {
+            return self.fail(
+                Diagnostic::error(
+                    "unknown split",
+                    e.span.clone(),
+                    "expected a list of counts or `auto`",
+                )
+                .with_help(format!(
+                    "write one count per state ({n}), e.g. `split = [{}]`: state i's initial \
+                     range is cut into that many equal parts; or `split = auto` (at most \
+                     {AUTO_PIECES} pieces, `auto(pieces = N)` for another budget)",
+                    vec!["2"; n].join(", ")
+                )),
+            );
+        };
+        if items.len() != n {
+            return self.fail(
+                Diagnostic::error(
+                    format!(
+                        "split has {} count{}, the model {n} state{}",
+                        items.len(),
+                        if items.len() == 1 { "" } else { "s" },
+                        if n == 1 { "" } else { "s" }
+                    ),
+                    e.span.clone(),
+                    "one count per state",
+                )
+                .with_help("in the order the states are declared; 1 leaves a state whole"),
+            );
+        }
+        let mut counts = Vec::with_capacity(n);
+        for item in items {
+            let v = self.constant(item, &[])?;
+            if !(v >= 1.0 && v.fract() == 0.0 && v <= MAX_PIECES as f64) {
+                return self.fail(
+                    Diagnostic::error(
+                        format!("a split count must be a whole number from 1 to {MAX_PIECES}, but it is {v}"),
+                        item.span.clone(),
+                        "not a count",
+                    )
+                    .with_help("1 leaves the state's range whole, k cuts it into k equal parts"),
+                );
+            }
+            counts.push(v as usize);
+        }
+        let split = Split::Counts(counts);
+        if split.pieces() > MAX_PIECES {
+            return self.fail(
+                Diagnostic::error(
+                    format!("split into {} pieces; at most {MAX_PIECES}", split.pieces()),
+                    e.span.clone(),
+                    "too many pieces",
+                )
+                .with_help("each piece is a full run of the analysis: use smaller counts"),
+            );
+        }
+        Some(split)
+    }
+
+    /// `split = auto(pieces = N)`: a budget of 1 to [`MAX_PIECES`] pieces.
+    fn auto_split(&mut self, e: &Expr, args: &[Arg]) -> Option<Split> {
+        let [arg] = args else {
+            return self.fail(
+                Diagnostic::error("bad `auto` split", e.span.clone(), "expected `pieces = N`")
+                    .with_help("write `split = auto` or `split = auto(pieces = 16)`"),
+            );
+        };
+        if arg.name.as_ref().map(|n| n.name.as_str()) != Some("pieces") {
+            return self.fail(
+                Diagnostic::error(
+                    "bad `auto` split",
+                    arg.value.span.clone(),
+                    "expected `pieces = N`",
+                )
+                .with_help(
+                    "the one argument of `auto` is the budget of pieces: `auto(pieces = 16)`",
+                ),
+            );
+        }
+        let v = self.constant(&arg.value, &[])?;
+        if !(v >= 1.0 && v.fract() == 0.0 && v <= MAX_PIECES as f64) {
+            return self.fail(
+                Diagnostic::error(
+                    format!("the pieces of an automatic split must be a whole number from 1 to {MAX_PIECES}, but it is {v}"),
+                    arg.value.span.clone(),
+                    "not a count",
+                )
+                .with_help("each piece is a full run of the analysis"),
+            );
+        }
+        Some(Split::Auto { pieces: v as usize })
     }
 
     /// `auto(states = [a, b, ..])`: one metric per named state (at most

@@ -1,11 +1,9 @@
-//! Where the Monte Carlo chunks run: on a rayon pool with the `parallel` feature, otherwise in
-//! order on the calling thread. Chunks are independent and merged in order, so the results are
-//! the same either way.
+//! Where independent work runs (the Monte Carlo chunks, the pieces of a split initial set): on a
+//! rayon pool with the `parallel` feature, otherwise in order on the calling thread. Items are
+//! independent and their results come back in order, so the results are the same either way.
 
-use super::SimError;
-
-/// The workers of one simulation.
-pub(super) struct Workers {
+/// The workers of one simulation or one split run.
+pub(crate) struct Workers {
     /// A pool of the requested size (`None`: the current rayon pool).
     #[cfg(feature = "parallel")]
     pool: Option<rayon::ThreadPool>,
@@ -14,7 +12,7 @@ pub(super) struct Workers {
 impl Workers {
     /// `threads` workers, or the current rayon pool when `None` (one thread without the
     /// `parallel` feature, whatever is asked).
-    pub(super) fn new(threads: Option<usize>) -> Result<Workers, SimError> {
+    pub(crate) fn new(threads: Option<usize>) -> Result<Workers, String> {
         #[cfg(feature = "parallel")]
         {
             let pool = match threads {
@@ -22,7 +20,7 @@ impl Workers {
                     rayon::ThreadPoolBuilder::new()
                         .num_threads(t)
                         .build()
-                        .map_err(|e| SimError::Invalid(format!("cannot start {t} threads: {e}")))?,
+                        .map_err(|e| format!("cannot start {t} threads: {e}"))?,
                 ),
                 None => None,
             };
@@ -36,7 +34,7 @@ impl Workers {
     }
 
     /// `f` of each item, in the items' order.
-    pub(super) fn map<T: Send, R: Send>(&self, items: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
+    pub(crate) fn map<T: Send, R: Send>(&self, items: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
