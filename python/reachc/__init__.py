@@ -413,6 +413,14 @@ class Result:
         return [Result(m) for m in self._native.members]
 
     @property
+    def pieces(self) -> List["Result"]:
+        """A split result's pieces (``split = [..]`` or ``split = auto``; empty without a
+        split): each piece's :class:`Result`, from its part of the initial box, at the same
+        ``delta``. The PRS is their union: this result's hulls, margins and verdict are the
+        union's, and :meth:`contains` asks the pieces."""
+        return [Result(p) for p in self._native.pieces]
+
+    @property
     def role(self) -> str:
         """What this result is within an intersection: ``"own"`` for an analysis' result,
         ``"metric"`` (a further metric's, at ``delta / K``), ``"box"`` (the interval box of a

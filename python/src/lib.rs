@@ -951,6 +951,19 @@ impl ReachResult {
             .collect()
     }
 
+    /// A split result's pieces (method.md 8.11; empty without a split): each piece's own
+    /// result, from its part of the initial box, at the same delta; the PRS is their union.
+    #[getter]
+    fn pieces(&self) -> Vec<ReachResult> {
+        self.prs
+            .pieces
+            .iter()
+            .map(|p| ReachResult {
+                prs: Arc::new(p.clone()),
+            })
+            .collect()
+    }
+
     /// What this result is within an intersection: `"own"` for an analysis' result,
     /// `"metric"`, `"box"`, `"first_order"` or `"linearised"` for a member.
     #[getter]

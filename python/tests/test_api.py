@@ -189,6 +189,23 @@ def test_sweep_of_100_initial_boxes(pendulum: reachc.Spec) -> None:
     assert reach.run(base).to_json() == reach.run().to_json()
 
 
+def test_a_split_result_is_the_union_of_its_pieces() -> None:
+    # specs/vanderpol.sde splits its initial box 8 x 8 (method.md 8.11).
+    spec = reachc.load(SPECS / "vanderpol.sde")
+    res = spec.reach("contraction").run()
+    assert len(res.pieces) == 64
+    assert res.json()["split"] == [8, 8]
+    for t in (0.5, 2.0):
+        hull = res.hull(t)
+        lo = np.min([p.hull(t)[:, 0] for p in res.pieces], axis=0)
+        hi = np.max([p.hull(t)[:, 1] for p in res.pieces], axis=0)
+        assert hull[:, 0].tolist() == lo.tolist() and hull[:, 1].tolist() == hi.tolist()
+        # A point of some piece is in the union; a point beyond every piece is not.
+        centre = res.pieces[5].hull(t).mean(axis=1)
+        assert res.pieces[5].contains(centre, t) == res.contains(centre, t)
+        assert res.contains(hi + 1.0, t) is False
+
+
 def test_initial_box_outside_the_domain_is_an_analysis_error() -> None:
     spec = reachc.load(SPECS / "vanderpol.sde")
     a = spec.analyses[0]
