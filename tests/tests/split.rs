@@ -5,6 +5,7 @@
 use reachc_e2e::inline;
 use reachc_runtime::engine::{Culprit, RunError, Setting};
 use reachc_runtime::model::Split;
+use reachc_runtime::probability::SafetyLimit;
 use reachc_runtime::prs::{DetSet, Prs, Verdict};
 use reachc_runtime::report::simulation::summary;
 use reachc_runtime::simulate::{self, Options};
@@ -222,6 +223,29 @@ fn an_automatic_split_tiles_the_box_within_its_budget() {
         assert!(a[i].hi - a[i].lo < 0.8 * (b[i].hi - b[i].lo));
     }
     assert_eq!(run("split = auto(pieces = 12)").steps, auto.steps);
+}
+
+/// The probability of safety of a split analysis (method.md 8.9): the deterministic sets are
+/// the pieces' (the union's own boxes hold the stochastic part too), so a union not shown safe
+/// at its `delta` whose pieces' deterministic sets avoid the unsafe set still gets a bound from
+/// the search. (With the union's boxes taken as deterministic, the search stopped at once.)
+#[test]
+fn a_split_analysis_gets_a_probability_of_safety() {
+    let source = spec("split = [4, 3]").replace("x >= 1.35", "x >= 1.38");
+    let (sys, info) = inline(&source);
+    let reach = Reach::new(&sys, &info, "a").unwrap();
+    assert!(matches!(
+        reach.run().unwrap().verdict,
+        Verdict::NotShownSafe { .. }
+    ));
+    let p = reach.safety_probability().unwrap();
+    let delta = p.delta.expect("a bound");
+    assert!(delta > 1e-2 && delta < 0.2, "{delta}");
+    assert!(
+        !matches!(p.limit, SafetyLimit::Deterministic { .. }),
+        "{:?}",
+        p.limit
+    );
 }
 
 /// Only a box can be split: an initial ball is refused with a diagnostic at the setting.

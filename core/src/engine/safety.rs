@@ -302,12 +302,21 @@ fn box_margin(
 /// time (or a metric cannot be factorised, which leaves nothing to say).
 ///
 /// Each member's margin is computed in its own metric; the intersection's margin is the largest
-/// (as for the PRS). Parallelotopes are checked through their hulls (no frame): one-sided like
+/// (as for the PRS); a union's limit is its pieces' earliest. Parallelotopes are checked through their hulls (no frame): one-sided like
 /// every margin here, so "not shown" rather than "touches".
 pub(crate) fn deterministic_limit(
     sets: &[UnsafeSet],
     prs: &crate::prs::Prs,
 ) -> Option<(usize, usize)> {
+    // A union (method.md 8.11): its deterministic sets are the pieces' (its own steps' boxes
+    // hold the stochastic part too), so the earliest of the pieces' limits.
+    if !prs.pieces.is_empty() {
+        return prs
+            .pieces
+            .iter()
+            .filter_map(|p| deterministic_limit(sets, p))
+            .min();
+    }
     let n = prs.n();
     let members: Vec<&crate::prs::Prs> = std::iter::once(prs).chain(&prs.also).collect();
     let mut checks = Vec::with_capacity(members.len());
