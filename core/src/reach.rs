@@ -233,7 +233,20 @@ impl<'a> Reach<'a> {
             }
         };
         let workers = Workers::new(None).map_err(|m| RunError::Invalid(m.into()))?;
-        let run = |b: &[Bounds]| self.run_piece(own, &InitialSet::from_box(b), inputs);
+        // A piece's failure says which piece.
+        let run = |b: &[Bounds]| {
+            self.run_piece(own, &InitialSet::from_box(b), inputs)
+                .map_err(|e| {
+                    let ranges: Vec<String> = self
+                        .info
+                        .states
+                        .iter()
+                        .zip(b)
+                        .map(|(x, r)| format!("{x} in [{}, {}]", r.lo, r.hi))
+                        .collect();
+                    e.in_piece(&ranges.join(", "))
+                })
+        };
         let (split, pieces) = match &own.split {
             Split::Counts(counts) => {
                 // A range of no width is not cut (its pieces would all be the same).

@@ -248,6 +248,26 @@ fn a_split_analysis_gets_a_probability_of_safety() {
     );
 }
 
+/// A piece that cannot run fails the analysis, and the diagnostic says which piece (the first
+/// in order): here `x' = x^2` blows up at `t = 1 / x0`, and from `[2, 3]` the tube around it
+/// cannot be closed before the horizon; from `[0, 2]` it can.
+#[test]
+fn a_failing_piece_is_named() {
+    let source = "model blow\nstate x in [0, 4]\nnoise w\ndrift { x' = x^2 }\n\
+                  diffusion { x: 0.01 * w }\nanalysis a { horizon = 0.3  split = [4] }\n";
+    let (sys, info) = inline(source);
+    let err = Reach::new(&sys, &info, "a").unwrap().run().unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("(in the piece x in [2, 3] of the split initial box)"),
+        "{text}"
+    );
+    // The first two pieces alone run.
+    let fine = source.replace("[0, 4]", "[0, 2]").replace("[4]", "[2]");
+    let (sys, info) = inline(&fine);
+    assert_eq!(Reach::new(&sys, &info, "a").unwrap().run().unwrap().pieces.len(), 2);
+}
+
 /// Only a box can be split: an initial ball is refused with a diagnostic at the setting.
 #[test]
 fn an_initial_ball_cannot_be_split() {

@@ -98,6 +98,26 @@ impl RunError {
     }
 }
 
+impl RunError {
+    /// The same failure, said to be of `piece` (a part of a split initial set, in words).
+    pub(crate) fn in_piece(self, piece: &str) -> RunError {
+        let note = |d: Detail| Detail {
+            message: format!(
+                "{} (in the piece {piece} of the split initial box)",
+                d.message
+            ),
+            culprit: d.culprit,
+        };
+        match self {
+            RunError::UnknownAnalysis { .. } => self,
+            RunError::Unsupported(d) => RunError::Unsupported(note(d)),
+            RunError::NoConstants(d) => RunError::NoConstants(note(d)),
+            RunError::Invalid(d) => RunError::Invalid(note(d)),
+            RunError::NonFinite(d) => RunError::NonFinite(note(d)),
+        }
+    }
+}
+
 impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
