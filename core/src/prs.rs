@@ -757,6 +757,34 @@ impl Prs {
         self.own_span_contains(k, x) && self.also.iter().all(|m| m.own_span_contains(k, x))
     }
 
+    /// A bounding box of this result's own span at report step `k` ([`Step::span`]: its box
+    /// widened by its P-ball, rounded outward; the members of an intersection cut it further):
+    /// `None` if [`ConstantsUsed::spread`] is missing or the span has the wrong length. Panics
+    /// if `k` is out of range.
+    pub(crate) fn own_span_hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
+        let span = &self.steps[k].span;
+        let w = &self.constants.spread;
+        let n = self.n();
+        if w.len() != n || span.lo.len() != n || span.hi.len() != n {
+            return None;
+        }
+        // (A span without a ball adds nothing, even where a spread is infinite.)
+        let d = |i: usize| match span.radius {
+            0.0 => Interval::ZERO,
+            r => Interval::point(r) * Interval::point(w[i]),
+        };
+        Some(
+            (0..n)
+                .map(|i| {
+                    Bounds::new(
+                        (Interval::point(span.lo[i]) - d(i)).lo(),
+                        (Interval::point(span.hi[i]) + d(i)).hi(),
+                    )
+                })
+                .collect(),
+        )
+    }
+
     /// [`Prs::span_contains`] for this result's own metric.
     pub(crate) fn own_span_contains(&self, k: usize, x: &[f64]) -> bool {
         let span = &self.steps[k].span;

@@ -324,8 +324,12 @@ impl<'a> Reach<'a> {
                     )
                 })
                 .collect();
-            let results = workers.map(halves.clone(), |b| run(&b));
-            let mut results = halves.into_iter().zip(results);
+            let mut results = workers
+                .map(halves, |b| {
+                    let r = run(&b);
+                    (b, r)
+                })
+                .into_iter();
             let steps = pieces[0].1.steps.len().saturating_sub(1).max(1) as f64;
             let mut next = Vec::with_capacity(pieces.len() + order.len());
             for (j, parent) in pieces.into_iter().enumerate() {

@@ -942,26 +942,14 @@ impl ReachResult {
     /// first-order zonotopes; each a result of its own (its sets, metric, hulls, membership).
     #[getter]
     fn members(&self) -> Vec<ReachResult> {
-        self.prs
-            .also
-            .iter()
-            .map(|m| ReachResult {
-                prs: Arc::new(m.clone()),
-            })
-            .collect()
+        results(&self.prs.also)
     }
 
     /// A split result's pieces (method.md 8.11; empty without a split): each piece's own
     /// result, from its part of the initial box, at the same delta; the PRS is their union.
     #[getter]
     fn pieces(&self) -> Vec<ReachResult> {
-        self.prs
-            .pieces
-            .iter()
-            .map(|p| ReachResult {
-                prs: Arc::new(p.clone()),
-            })
-            .collect()
+        results(&self.prs.pieces)
     }
 
     /// What this result is within an intersection: `"own"` for an analysis' result,
@@ -996,6 +984,15 @@ impl ReachResult {
             self.prs.steps.len()
         )
     }
+}
+
+/// Each of `prs` as a result of its own (a member of an intersection, a piece of a split).
+fn results(prs: &[Prs]) -> Vec<ReachResult> {
+    prs.iter()
+        .map(|p| ReachResult {
+            prs: Arc::new(p.clone()),
+        })
+        .collect()
 }
 
 /// A Monte Carlo check of a PRS.

@@ -265,7 +265,15 @@ fn a_failing_piece_is_named() {
     // The first two pieces alone run.
     let fine = source.replace("[0, 4]", "[0, 2]").replace("[4]", "[2]");
     let (sys, info) = inline(&fine);
-    assert_eq!(Reach::new(&sys, &info, "a").unwrap().run().unwrap().pieces.len(), 2);
+    assert_eq!(
+        Reach::new(&sys, &info, "a")
+            .unwrap()
+            .run()
+            .unwrap()
+            .pieces
+            .len(),
+        2
+    );
 }
 
 /// Only a box can be split: an initial ball is refused with a diagnostic at the setting.

@@ -504,11 +504,13 @@ pub(super) fn sliced_jacobian(
     out: &mut [Interval],
 ) {
     let n = hull.len();
-    let mut part = vec![Interval::ZERO; n * n];
+    let (mut part, mut region) = (vec![Interval::ZERO; n * n], vec![Interval::ZERO; n]);
     out.iter_mut().for_each(|v| *v = Interval::ZERO);
     for i in 0..SLICES {
         let th = Interval::point((i + 1) as f64) / Interval::point(SLICES as f64);
-        let region: Vec<Interval> = (0..n).map(|k| hull[k] + th * dev[k]).collect();
+        for (r, (h, d)) in region.iter_mut().zip(hull.iter().zip(dev)) {
+            *r = *h + th * *d;
+        }
         sys.jac_x_interval(&region, u, times, &mut part);
         for (o, p) in out.iter_mut().zip(&part) {
             *o += *p;

@@ -62,9 +62,7 @@ pub(crate) fn union(
     if let Ok(b) = initial.bounding_box() {
         u.initial_center = b.iter().map(|x| Interval::new(x.lo, x.hi).mid()).collect();
     }
-    let spread = u.constants.spread.clone();
     let norm = BoxRadius::new(&u.constants.metric, n);
-    let widen = |lo: &[f64], hi: &[f64], r: f64| widen_in(&spread, lo, hi, r);
     let hull = |a: Option<Vec<Bounds>>, b: Vec<Bounds>| -> Vec<Bounds> {
         match a {
             None => b,
@@ -85,10 +83,9 @@ pub(crate) fn union(
                 let st = &p.steps[k];
                 set = Some(hull(set, p.hull_at(k).unwrap_or_else(everything)));
                 // The piece's span: its own, cut by its members' (an intersection).
-                let own = widen(&st.span.lo, &st.span.hi, st.span.radius);
+                let own = p.own_span_hull_at(k).unwrap_or_else(everything);
                 let cut = p.also.iter().fold(own, |b, m| {
-                    let s = &m.steps[k].span;
-                    let w = widen_in(&m.constants.spread, &s.lo, &s.hi, s.radius);
+                    let w = m.own_span_hull_at(k).unwrap_or_else(everything);
                     b.iter()
                         .zip(&w)
                         .map(|(a, o)| {
@@ -176,23 +173,4 @@ pub(crate) fn union(
     u.split = split;
     u.pieces = pieces;
     u
-}
-
-/// The box `[lo, hi]` widened by the P-ball of radius `r`, `spread` the metric's
-/// `sqrt((P^-1)_ii)` bounds (rounded outward; unbounded where `spread` is missing).
-fn widen_in(spread: &[f64], lo: &[f64], hi: &[f64], r: f64) -> Vec<Bounds> {
-    (0..lo.len())
-        .map(|i| {
-            let w = spread.get(i).copied().unwrap_or(f64::INFINITY);
-            let d = if r == 0.0 {
-                Interval::ZERO
-            } else {
-                Interval::point(r) * Interval::point(w)
-            };
-            Bounds::new(
-                (Interval::point(lo[i]) - d).lo(),
-                (Interval::point(hi[i]) + d).hi(),
-            )
-        })
-        .collect()
 }

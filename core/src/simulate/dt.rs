@@ -119,19 +119,11 @@ fn bound_on<S: System + ?Sized>(
 ) -> f64 {
     let n = sys.n();
     let hull = |r: &Prs| -> Option<Vec<Interval>> {
-        let span = &r.steps.get(k)?.span;
-        let w = &r.constants.spread;
-        if w.len() != n || span.lo.len() != n || span.hi.len() != n {
-            return None;
-        }
-        (0..n)
-            .map(|i| {
-                let d = Interval::point(span.radius) * Interval::point(w[i]);
-                Interval::try_new(
-                    (Interval::point(span.lo[i]) - d).lo(),
-                    (Interval::point(span.hi[i]) + d).hi(),
-                )
-            })
+        r.steps.get(k)?;
+        (r.n() == n).then_some(())?;
+        r.own_span_hull_at(k)?
+            .iter()
+            .map(|b| Interval::try_new(b.lo, b.hi))
             .collect()
     };
     let Some(mut x) = hull(result) else {

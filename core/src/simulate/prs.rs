@@ -52,6 +52,7 @@ use crate::engine::interval::ParallelotopeTest;
 use crate::engine::zonotope::ZonotopeTest;
 use crate::interval::Interval;
 use crate::lanes::{Real, X8};
+use crate::model::Bounds;
 use crate::prs::{DetSet, Prepared, Prs};
 
 /// The quadratic form `d' P d` as a list of terms.
@@ -352,18 +353,12 @@ pub(crate) struct Hulls {
 }
 
 impl Hulls {
-    /// Per step, [`Prs::hull_at`] (from [`Step::span`](crate::prs::Step::span) with `spans`),
-    /// or no bound where the result has none.
-    fn of(result: &Prs, spans: bool) -> Hulls {
+    /// Per step of `result`, the box `hull` gives (no bound where it gives none).
+    fn of(result: &Prs, hull: impl Fn(usize) -> Option<Vec<Bounds>>) -> Hulls {
         let n = result.n();
         let bounds = (0..result.steps.len())
             .flat_map(|k| {
-                let b = if spans {
-                    span_hull(result, k)
-                } else {
-                    result.hull_at(k)
-                };
-                b.map_or_else(
+                hull(k).map_or_else(
                     || vec![(f64::NEG_INFINITY, f64::INFINITY); n],
                     |b| b.iter().map(|x| (x.lo, x.hi)).collect(),
                 )
@@ -379,31 +374,6 @@ impl Hulls {
     }
 }
 
-/// A bounding box of [`Prs::span_contains`]'s set at step `k`: the own span's box widened by
-/// its ball (the members' cut it further, but any box holding it will do).
-fn span_hull(result: &Prs, k: usize) -> Option<Vec<crate::model::Bounds>> {
-    let span = &result.steps.get(k)?.span;
-    let w = &result.constants.spread;
-    if w.len() != result.n() || span.lo.len() != w.len() || span.hi.len() != w.len() {
-        return None;
-    }
-    Some(
-        (0..w.len())
-            .map(|i| {
-                let d = if span.radius == 0.0 {
-                    Interval::ZERO
-                } else {
-                    Interval::point(span.radius) * Interval::point(w[i])
-                };
-                crate::model::Bounds::new(
-                    (Interval::point(span.lo[i]) - d).lo(),
-                    (Interval::point(span.hi[i]) + d).hi(),
-                )
-            })
-            .collect(),
-    )
-}
-
 impl<'a> Membership<'a> {
     /// For `result` (its steps), with `metric` built from its metric.
     pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Self {
@@ -416,7 +386,7 @@ impl<'a> Membership<'a> {
             pieces: result
                 .pieces
                 .iter()
-                .map(|p| (Hulls::of(p, false), Membership::new(p, metric)))
+                .map(|p| (Hulls::of(p, |k| p.hull_at(k)), Membership::new(p, metric)))
                 .collect(),
         }
     }
@@ -939,7 +909,12 @@ impl<'a> Tube<'a> {
             pieces: result
                 .pieces
                 .iter()
-                .map(|p| Ok((Hulls::of(p, true), Tube::new(p, metric)?)))
+                .map(|p| {
+                    Ok((
+                        Hulls::of(p, |k| p.own_span_hull_at(k)),
+                        Tube::new(p, metric)?,
+                    ))
+                })
                 .collect::<Result<_, String>>()?,
         })
     }

@@ -587,18 +587,12 @@ impl Checker<'_> {
     /// [`MAX_PIECES`] pieces in all (method.md 8.11).
     fn split(&mut self, e: &Expr, n: usize) -> Option<Split> {
         match &e.kind {
-            ExprKind::Name(id) if id.name == "auto" => {
-                return Some(Split::Auto {
-                    pieces: AUTO_PIECES,
-                })
-            }
-            ExprKind::Call { func, args } if func.name == "auto" => {
-                return self.auto_split(e, args)
-            }
-            _ => {}
-        }
-        let ExprKind::List(items) = &e.kind else {
-            return self.fail(
+            ExprKind::Name(id) if id.name == "auto" => Some(Split::Auto {
+                pieces: AUTO_PIECES,
+            }),
+            ExprKind::Call { func, args } if func.name == "auto" => self.auto_split(e, args),
+            ExprKind::List(items) => self.split_counts(e, items, n),
+            _ => self.fail(
                 Diagnostic::error(
                     "unknown split",
                     e.span.clone(),
@@ -610,8 +604,12 @@ impl Checker<'_> {
                      {AUTO_PIECES} pieces, `auto(pieces = N)` for another budget)",
                     vec!["2"; n].join(", ")
                 )),
-            );
-        };
+            ),
+        }
+    }
+
+    /// `split = [k1, ..., kn]` (the list `items` of `e`).
+    fn split_counts(&mut self, e: &Expr, items: &[Expr], n: usize) -> Option<Split> {
         if items.len() != n {
             return self.fail(
                 Diagnostic::error(
@@ -627,21 +625,16 @@ impl Checker<'_> {
                 .with_help("in the order the states are declared; 1 leaves a state whole"),
             );
         }
-        let mut counts = Vec::with_capacity(n);
-        for item in items {
-            let v = self.constant(item, &[])?;
-            if !(v >= 1.0 && v.fract() == 0.0 && v <= MAX_PIECES as f64) {
-                return self.fail(
-                    Diagnostic::error(
-                        format!("a split count must be a whole number from 1 to {MAX_PIECES}, but it is {v}"),
-                        item.span.clone(),
-                        "not a count",
-                    )
-                    .with_help("1 leaves the state's range whole, k cuts it into k equal parts"),
-                );
-            }
-            counts.push(v as usize);
-        }
+        let counts = items
+            .iter()
+            .map(|item| {
+                self.piece_count(
+                    item,
+                    "a split count",
+                    "1 leaves the state's range whole, k cuts it into k equal parts",
+                )
+            })
+            .collect::<Option<Vec<_>>>()?;
         let split = Split::Counts(counts);
         if split.pieces() > MAX_PIECES {
             return self.fail(
@@ -676,18 +669,28 @@ impl Checker<'_> {
                 ),
             );
         }
-        let v = self.constant(&arg.value, &[])?;
-        if !(v >= 1.0 && v.fract() == 0.0 && v <= MAX_PIECES as f64) {
-            return self.fail(
-                Diagnostic::error(
-                    format!("the pieces of an automatic split must be a whole number from 1 to {MAX_PIECES}, but it is {v}"),
-                    arg.value.span.clone(),
-                    "not a count",
-                )
-                .with_help("each piece is a full run of the analysis"),
-            );
+        let pieces = self.piece_count(
+            &arg.value,
+            "the pieces of an automatic split",
+            "each piece is a full run of the analysis",
+        )?;
+        Some(Split::Auto { pieces })
+    }
+
+    /// A whole number from 1 to [`MAX_PIECES`] (`what` names it in the diagnostic).
+    fn piece_count(&mut self, e: &Expr, what: &str, help: &str) -> Option<usize> {
+        let v = self.constant(e, &[])?;
+        if v >= 1.0 && v.fract() == 0.0 && v <= MAX_PIECES as f64 {
+            return Some(v as usize);
         }
-        Some(Split::Auto { pieces: v as usize })
+        self.fail(
+            Diagnostic::error(
+                format!("{what} must be a whole number from 1 to {MAX_PIECES}, but it is {v}"),
+                e.span.clone(),
+                "not a count",
+            )
+            .with_help(help),
+        )
     }
 
     /// `auto(states = [a, b, ..])`: one metric per named state (at most
