@@ -364,7 +364,8 @@ fn simulate_chooses_dt_from_the_dynamics_on_a_stiff_system() {
     assert_eq!(o.status.code(), Some(0), "{out}\n{err}");
     assert!(
         out.contains(
-            "Euler-Maruyama with dt = 0.0025 (800 steps per path; chosen by the rule h L <= 0.05)"
+            "Euler-Maruyama with dt = 0.0025 (800 steps per path; chosen by the rules h L <= \
+             0.05 and bias <= 0.05 of the half-width)"
         ),
         "{out}"
     );
@@ -393,8 +394,9 @@ fn simulate_chooses_dt_from_the_dynamics_on_a_stiff_system() {
     assert_eq!(o.status.code(), Some(1), "{out}\n{err}");
     assert!(
         err.contains(
-            "warning: analysis `contraction`: --dt 0.1 is coarser than the rule h L <= 0.05 asks \
-             on 20 report intervals (h L up to 2.000; the rule's step: 0.0025)"
+            "warning: analysis `contraction`: --dt 0.1 is coarser than the rules h L <= 0.05 \
+             and bias <= 0.05 of the half-width ask on 20 report intervals (h L up to 2.000, \
+             Euler-Maruyama's bias up to 0.762 of the sets' half-width; the rules' step: 0.0025)"
         ),
         "{err}"
     );
@@ -403,5 +405,55 @@ fn simulate_chooses_dt_from_the_dynamics_on_a_stiff_system() {
     assert_eq!(json["dt_rule"]["coarse_intervals"], 20);
     assert_eq!(json["steps_per_path"], 20);
     assert_eq!(json["verdict"]["status"], "fail");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A small set moving fast (`x' = 2 - x` from a box of half-width 0.01, noise 0.002,
+/// tests/good/drift_bias.sde): the stability rule alone (`L = 1`) takes `h = 0.05`, where
+/// Euler-Maruyama's drift error on every path, about `(h / 2) |f' f| t`, is larger than the
+/// exact Gaussian PRS: every path is outside. The bias rule (method.md, the Euler-Maruyama step)
+/// takes steps down to 0.0011 and the check passes.
+#[test]
+fn simulate_keeps_euler_maruyama_bias_small_against_the_set() {
+    let dir = std::env::temp_dir().join(format!("reachc-cli-sim-bias-{}", std::process::id()));
+    let d = dir.to_str().unwrap();
+    let bias = spec("../tests/good/drift_bias.sde");
+    let sim = |extra: &[&str]| {
+        let mut args = vec![
+            "simulate",
+            &bias,
+            "--backend",
+            "interp",
+            "--paths",
+            "2000",
+            "-o",
+            d,
+        ];
+        args.extend_from_slice(extra);
+        let o = reachc(&args);
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("exact.sim.json")).unwrap())
+                .unwrap();
+        (o, json)
+    };
+    let (o, json) = sim(&[]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert_eq!(json["verdict"]["status"], "pass");
+    assert_eq!(json["outside_tube"]["count"], 0);
+    let rule = &json["dt_rule"];
+    assert_eq!(rule["status"], "met");
+    assert_eq!(rule["accuracy"], 0.05);
+    let bias_max = rule["bias_max"].as_f64().unwrap();
+    assert!(bias_max <= 0.05 * (1.0 + 1e-9), "{bias_max}");
+    let dt_min = json["dt_min"].as_f64().unwrap();
+    assert!(dt_min < 0.002, "{dt_min}");
+    // The stability rule's step alone: every path outside.
+    let (o, json) = sim(&["--dt", "0.05"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert_eq!(json["dt_rule"]["status"], "coarser");
+    let hl = json["dt_rule"]["hl_max"].as_f64().unwrap();
+    assert!((hl - 0.05).abs() < 1e-12, "{hl}");
+    assert_eq!(json["outside_tube"]["count"], 2000);
     std::fs::remove_dir_all(&dir).unwrap();
 }

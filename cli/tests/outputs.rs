@@ -245,8 +245,8 @@ fn messages_count_in_the_singular_and_plural() {
     let t = text(&o);
     assert!(
         t.contains(
-            "  1 path (seed 0), Euler-Maruyama with dt = 0.0166666666667 (60 steps per path; \
-             chosen by the rule h L <= 0.05)"
+            "  1 path (seed 0), Euler-Maruyama with dt = 0.00103092783505 to 0.01 (463 steps \
+             per path; chosen by the rules h L <= 0.05 and bias <= 0.05 of the half-width)"
         ),
         "{t}"
     );

@@ -328,6 +328,12 @@ pub enum Hint {
     /// The first-order sets (method.md 8.8) were wanted but could not be bounded on some
     /// internal step (the a-priori remainder did not hold its own bound).
     FirstOrderUnbounded,
+    /// The analysis' own sets (its ball or box) could not be bounded: the PRS is the linearised
+    /// Gaussian set alone at the full delta (method.md 8.12); `why` is what stopped them.
+    LinearisedAlone {
+        /// The diagnostic of the analysis' own run.
+        why: String,
+    },
 }
 
 /// The sets at one report time.

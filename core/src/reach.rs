@@ -411,7 +411,31 @@ impl<'a> Reach<'a> {
                 delta: (own.delta / 2.0).next_down(),
                 ..own.clone()
             };
-            pick(plain, run_with(setup, &half, Some(half.delta)), own.delta)
+            let best = pick(plain, run_with(setup, &half, Some(half.delta)), own.delta);
+            let Err(failed) = best else {
+                return best;
+            };
+            // Where the analysis' own sets cannot be bounded, the linearised set alone.
+            let alone = engine::run_alone(
+                &Run {
+                    sys: self.sys,
+                    info: self.info,
+                    spec: own,
+                    setup,
+                    initial,
+                    inputs,
+                    gaussian: Some(own.delta),
+                },
+                &failed,
+            );
+            match alone {
+                Ok(Some(prs)) => Ok(prs),
+                Ok(None) => Err(failed.noted(
+                    "the linearised Gaussian set alone (method.md 8.12) could not be bounded \
+                     over the horizon either",
+                )),
+                Err(_) => Err(failed),
+            }
         };
         // Alternatives: the result with the smallest box at the horizon (where one fails, the
         // others still stand).

@@ -85,8 +85,19 @@ pub fn workspace() -> PathBuf {
 
 /// Every shipped spec, sorted by name.
 pub fn shipped_specs() -> Vec<PathBuf> {
-    let mut specs: Vec<PathBuf> = std::fs::read_dir(workspace().join("specs"))
-        .expect("specs/ exists")
+    specs_in("specs")
+}
+
+/// The field's benchmarks, `specs/arch/` (their runs take minutes: only the checks that cost
+/// little take them all, and their own tests the rest), sorted by name.
+pub fn benchmark_specs() -> Vec<PathBuf> {
+    specs_in("specs/arch")
+}
+
+/// The `.sde` files of the workspace folder `dir`, sorted by name.
+fn specs_in(dir: &str) -> Vec<PathBuf> {
+    let mut specs: Vec<PathBuf> = std::fs::read_dir(workspace().join(dir))
+        .unwrap_or_else(|e| panic!("{dir}: {e}"))
         .map(|e| e.expect("readable entry").path())
         .filter(|p| p.extension().is_some_and(|e| e == "sde"))
         .collect();

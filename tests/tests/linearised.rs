@@ -5,8 +5,13 @@
 //! intervals, how the default analyses use them (delta split, the better result), and the hints
 //! when first-order sets lose their shape.
 
-use reachc_e2e::{inline, linearised_member, reflection_factor, rk4, shipped, workspace};
-use reachc_runtime::prs::{Hint, Role};
+use reachc_compiler::driver::load;
+use reachc_e2e::{
+    inline, interpreter_of, linearised_member, reflection_factor, rk4, shipped, workspace,
+};
+use reachc_runtime::prs::{Hint, Proved, Role, Verdict};
+use reachc_runtime::report::simulation::summary;
+use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::Reach;
 
 /// `x'' = -2 x - 3 x' + 0.2 w` (eigenvalues -1, -2) from the box `[0.9, 1.1] x [-0.1, 0.1]`:
@@ -243,5 +248,90 @@ fn first_order_sets_that_lose_their_shape_say_so() {
         prs.hints.contains(&Hint::FirstOrderUnbounded),
         "{:?}",
         prs.hints
+    );
+}
+
+/// Laub-Loomis (`specs/arch/laub_loomis.sde`, 7 states, no contracting metric) to `t = 4`: the
+/// ball's local rates cannot close a region from `t = 2.95` on, so the result is the linearised
+/// Gaussian set alone at the full delta (method.md 8.12), labelled so. Noise-free flows (RK4)
+/// from the initial box's corners lie in its sets, 400 simulated paths stay in its tube (the
+/// default Euler-Maruyama steps), and it shows the ARCH property `x4 < 4.5`.
+#[test]
+fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
+    let path = workspace().join("specs/arch/laub_loomis.sde");
+    let (sys, mut info) = interpreter_of(load(&path).unwrap().model);
+    info.analyses[0].spec.horizon = 4.0;
+    let prs = Reach::new(&sys, &info, "contraction")
+        .unwrap()
+        .run()
+        .unwrap();
+    assert_eq!(prs.role, Role::Linearised);
+    assert!(prs.also.is_empty());
+    assert_eq!(prs.delta, 1e-2);
+    let why = prs
+        .hints
+        .iter()
+        .find_map(|h| match h {
+            Hint::LinearisedAlone { why } => Some(why.clone()),
+            _ => None,
+        })
+        .expect("the hint says why");
+    assert!(
+        why.contains("the local rates cannot be certified at t = 2.95"),
+        "{why}"
+    );
+    assert!(prs.validation.not_validated.is_empty());
+    assert!(prs
+        .validation
+        .rigorous
+        .iter()
+        .any(|p| matches!(p, Proved::LinearisedGaussian { .. })));
+    assert!(matches!(prs.verdict, Verdict::Safe));
+    // Noise-free flows from the corners (a sample of 16 of the 128) and the centre.
+    let bounds = prs.initial.bounding_box().unwrap();
+    let mut starts: Vec<Vec<f64>> = (0..16u32)
+        .map(|c| {
+            (0..7)
+                .map(|i| match (c >> (i % 4)) & 1 {
+                    0 => bounds[i].lo,
+                    _ => bounds[i].hi,
+                })
+                .collect()
+        })
+        .collect();
+    starts.push(bounds.iter().map(|b| 0.5 * (b.lo + b.hi)).collect());
+    for start in starts {
+        let (mut x, mut t) = (start, 0.0);
+        for (k, st) in prs.steps.iter().enumerate().skip(1).step_by(8) {
+            rk4(&sys, &mut x, &mut t, st.t, 1e-3);
+            assert!(prs.contains_at(k, &x), "t = {}: {x:?}", st.t);
+        }
+    }
+    let opts = Options {
+        paths: 400,
+        seed: 3,
+        ..Options::default()
+    };
+    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    assert!(report.passed(), "{}", summary(&report));
+    assert_eq!(report.tube.as_ref().map(|t| t.outside), Some(0));
+}
+
+/// Where the linearised set alone cannot be bounded either, the analysis fails with the first
+/// diagnostic, noted so: `x' = x^2` from `[2, 3]` leaves every bound before `t = 1 / 3`.
+#[test]
+fn the_linearised_set_alone_that_cannot_be_bounded_either_says_so() {
+    let (sys, info) = inline(
+        "model blow\nstate x in [2, 3]\nnoise w\ndrift { x' = x^2 }\n\
+         diffusion { x: 0.01 * w }\nanalysis a { horizon = 0.33 }\n",
+    );
+    let err = Reach::new(&sys, &info, "a").unwrap().run().unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains(
+            "(the linearised Gaussian set alone (method.md 8.12) could not be bounded over the \
+             horizon either)"
+        ),
+        "{text}"
     );
 }

@@ -1,5 +1,6 @@
-//! Every shipped spec checks, its symbolic derivatives agree with central finite differences at
-//! random points, and every expression `inspect` prints parses back to the same function.
+//! Every shipped spec (and benchmark, `specs/arch/`) checks, its symbolic derivatives agree with
+//! central finite differences at random points, and every expression `inspect` prints parses
+//! back to the same function.
 
 use std::collections::HashMap;
 
@@ -7,7 +8,7 @@ use reachc_compiler::analysis::Derivatives;
 use reachc_compiler::driver::{check_source, load};
 use reachc_compiler::ir::{ExprId, Names, VarValues};
 use reachc_compiler::model::Model;
-use reachc_e2e::{relative, shipped_specs, Rng};
+use reachc_e2e::{benchmark_specs, relative, shipped_specs, Rng};
 
 /// A random point: states in the domain (or within 3 of the initial set where unbounded),
 /// inputs in their box, time in [0, 5].
@@ -82,7 +83,7 @@ fn central(model: &Model, exprs: &[ExprId], p: &Point, j: usize, input: bool) ->
 
 #[test]
 fn derivatives_match_finite_differences() {
-    for path in shipped_specs() {
+    for path in shipped_specs().into_iter().chain(benchmark_specs()) {
         let mut model = load(&path)
             .unwrap_or_else(|e| panic!("{}:\n{e}", relative(&path)))
             .model;
@@ -164,6 +165,7 @@ fn derivatives_match_finite_differences() {
 fn printed_expressions_parse_back_to_the_same_function() {
     for path in shipped_specs()
         .into_iter()
+        .chain(benchmark_specs())
         .filter(|p| !p.ends_with("chain1000.sde"))
     {
         let loaded = load(&path).unwrap();

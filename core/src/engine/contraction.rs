@@ -157,7 +157,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
                 &grid,
                 &inputs,
                 r2,
-                run.gaussian,
+                first_order::Linearised::member(run.gaussian),
             )
         })
         .flatten();

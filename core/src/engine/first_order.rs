@@ -115,11 +115,31 @@ pub(super) fn linear_and_remainder(set: &DetSet) -> Option<(f64, f64)> {
     }
 }
 
+/// Which linearised Gaussian sets (method.md 8.10) a run of [`deterministic`] computes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Linearised {
+    /// None.
+    Off,
+    /// Beside the first-order sets, at this share of delta.
+    Member(f64),
+    /// Alone, at this delta (method.md 8.12): the first-order sets' remainder, which needs the
+    /// contraction rates, is not computed, and a step the linearised sets cannot bound ends
+    /// the run.
+    Alone(f64),
+}
+
+impl Linearised {
+    /// The member at a run's share `gaussian`, if any.
+    pub(super) fn member(gaussian: Option<f64>) -> Linearised {
+        gaussian.map_or(Linearised::Off, Linearised::Member)
+    }
+}
+
 /// The first-order sets of a run on the validated nominal's `steps` (each with its report
 /// interval), from the initial box `[x0 - half, x0 + half]`, inputs `inputs[k]` held by the
 /// nominal on report interval `k` and `r2` the input uncertainty; `None` when the run is not
 /// [`wanted`] or a step cannot be bounded (the result then goes without these sets). With
-/// `gaussian = Some(delta')`, also the linearised Gaussian sets at `delta'` where they apply.
+/// `linearised`, also the linearised Gaussian sets where they apply ([`Linearised`]).
 pub(super) fn deterministic(
     run: &Run,
     steps: &[(NominalStep, usize)],
@@ -127,11 +147,16 @@ pub(super) fn deterministic(
     grid: &[f64],
     inputs: &[Vec<f64>],
     r2: f64,
-    gaussian: Option<f64>,
+    linearised: Linearised,
 ) -> Option<FirstOrder> {
     if !wanted(run) {
         return None;
     }
+    let (gaussian, alone) = match linearised {
+        Linearised::Off => (None, false),
+        Linearised::Member(delta) => (Some(delta), false),
+        Linearised::Alone(delta) => (Some(delta), true),
+    };
 
     let n = run.setup.n;
     let sys = run.sys;
@@ -190,6 +215,7 @@ pub(super) fn deterministic(
     let mut grew = 0.0f64;
     let mut pieces = Vec::with_capacity(steps.len());
     let mut jac = vec![Interval::ZERO; n * n];
+    let alive = !alone;
     for (step, k) in steps {
         let (t1, u) = (step.t1, &inputs[*k]);
         let span = Interval::point(t1) - Interval::point(t0);
@@ -213,51 +239,63 @@ pub(super) fn deterministic(
         let hull: Vec<Interval> = (0..n)
             .map(|i| Interval::new(step.lo[i], step.hi[i]))
             .collect();
-        sliced_jacobian(sys, &hull, &v, &ui, times, &mut jac);
-        // |(A - [J](H)) V|_P.
-        let lin: Vec<f64> = (0..n)
-            .map(|i| {
-                (0..n)
-                    .fold(Interval::ZERO, |acc, j| {
-                        acc + (Interval::point(a[i * n + j]) - jac[i * n + j]) * v[j]
-                    })
-                    .mag()
-            })
-            .collect();
-        let forcing = Interval::point(step.defect) + Interval::point(norm.bound(&lin));
-        // The remainder over the step, on a region that must hold it (a-priori guess `cap`).
-        let mut cap = 1.25 * (rho.hi() + grew) + f64::MIN_POSITIVE;
-        let mut accepted = None;
-        for _ in 0..MAX_TRIES {
-            let region: Vec<Interval> = hbox
-                .iter()
-                .zip(&w)
-                .map(|(b, &wi)| {
-                    let d = Interval::point(cap) * Interval::point(wi);
-                    Interval::new(
-                        (Interval::point(b.lo()) - d).lo(),
-                        (Interval::point(b.hi()) + d).hi(),
-                    )
+        // The remainder over the step, while the first-order sets last (after they end,
+        // `alone` keeps the linearised Gaussian sets going without them).
+        let remainder = 'rem: {
+            if !alive {
+                break 'rem None;
+            }
+            sliced_jacobian(sys, &hull, &v, &ui, times, &mut jac);
+            // |(A - [J](H)) V|_P.
+            let lin: Vec<f64> = (0..n)
+                .map(|i| {
+                    (0..n)
+                        .fold(Interval::ZERO, |acc, j| {
+                            acc + (Interval::point(a[i * n + j]) - jac[i * n + j]) * v[j]
+                        })
+                        .mag()
                 })
                 .collect();
-            let (lo, hi): (Vec<f64>, Vec<f64>) = region.iter().map(|r| (r.lo(), r.hi())).unzip();
-            let lean = cert.may_lean(&lo, &hi, &w);
-            let Ok((rates, _)) = cert.rates(&region, times, lean) else {
-                return None;
-            };
-            if !(rates.c.is_finite() && rates.rho.is_finite()) {
-                return None;
+            let forcing = Interval::point(step.defect) + Interval::point(norm.bound(&lin));
+            // The remainder over the step, on a region that must hold it (a-priori guess `cap`).
+            let mut cap = 1.25 * (rho.hi() + grew) + f64::MIN_POSITIVE;
+            let mut accepted = None;
+            for _ in 0..MAX_TRIES {
+                let region: Vec<Interval> = hbox
+                    .iter()
+                    .zip(&w)
+                    .map(|(b, &wi)| {
+                        let d = Interval::point(cap) * Interval::point(wi);
+                        Interval::new(
+                            (Interval::point(b.lo()) - d).lo(),
+                            (Interval::point(b.hi()) + d).hi(),
+                        )
+                    })
+                    .collect();
+                let (lo, hi): (Vec<f64>, Vec<f64>) =
+                    region.iter().map(|r| (r.lo(), r.hi())).unzip();
+                let lean = cert.may_lean(&lo, &hi, &w);
+                let Ok((rates, _)) = cert.rates(&region, times, lean) else {
+                    break 'rem None;
+                };
+                if !(rates.c.is_finite() && rates.rho.is_finite()) {
+                    break 'rem None;
+                }
+                let f = forcing + Interval::point(rates.rho) * Interval::point(r2);
+                let end =
+                    rho * (Interval::point(rates.c) * span).exp() + f * expm1_over(rates.c, span);
+                let top = rho.hi().max(end.hi());
+                if top < cap {
+                    accepted = Some((end, rates));
+                    break;
+                }
+                cap = (2.0 * cap).max(1.25 * top);
             }
-            let f = forcing + Interval::point(rates.rho) * Interval::point(r2);
-            let end = rho * (Interval::point(rates.c) * span).exp() + f * expm1_over(rates.c, span);
-            let top = rho.hi().max(end.hi());
-            if top < cap {
-                accepted = Some((end, rates));
-                break;
-            }
-            cap = (2.0 * cap).max(1.25 * top);
+            accepted
+        };
+        if remainder.is_none() && !alone {
+            return None;
         }
-        let (end, rates) = accepted?;
         // The node: M_(k+1) the midpoint of exp(A h) M_k, the jump into the remainder.
         let m_next: Vec<f64> = next.iter().map(|e| e.mid()).collect();
         let jump: Vec<f64> = (0..n)
@@ -269,12 +307,24 @@ pub(super) fn deterministic(
                     .mag()
             })
             .collect();
-        let after = Interval::point(end.hi()) + Interval::point(norm.bound(&jump));
-        if !after.hi().is_finite() || m_next.iter().any(|v| !v.is_finite()) {
+        if m_next.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        grew = (after.hi() - rho.hi()).max(0.0);
         let report = t1 == grid[k + 1];
+        // The first-order set's remainder at the node.
+        let after = remainder.map(|(end, rates)| {
+            (
+                Interval::point(end.hi()) + Interval::point(norm.bound(&jump)),
+                end,
+                rates,
+            )
+        });
+        if after
+            .as_ref()
+            .is_some_and(|(after, ..)| !after.hi().is_finite())
+        {
+            return None;
+        }
         if let Some(tr) = tracker.as_mut() {
             let hull: Vec<Interval> = (0..n)
                 .map(|i| Interval::new(step.lo[i], step.hi[i]))
@@ -295,22 +345,44 @@ pub(super) fn deterministic(
                 half: &h,
                 report,
             };
-            match tr.step(&data, (rates.c, rates.sigma)) {
+            // Alone, the rates shown are those certified on the region the set spans (the
+            // set does not use them; infinite where they cannot be certified).
+            let rates = after
+                .as_ref()
+                .map_or((0.0, 0.0), |(_, _, r)| (r.c, r.sigma));
+            match tr.step(&data, rates) {
+                Some(mut piece) if alone => {
+                    let region: Vec<Interval> = piece
+                        .over
+                        .lo
+                        .iter()
+                        .zip(&piece.over.hi)
+                        .map(|(&lo, &hi)| Interval::new(lo, hi))
+                        .collect();
+                    piece.rates = cert
+                        .rates(&region, times, false)
+                        .map_or((f64::INFINITY, f64::INFINITY), |(r, _)| (r.c, r.sigma));
+                    gauss_pieces.push(piece);
+                }
                 Some(piece) => gauss_pieces.push(piece),
+                None if alone => return None,
                 None => tracker = None,
             }
         }
-        pieces.push(Piece {
-            t1,
-            rates: (rates.c, rates.sigma),
-            over: Span {
-                lo: hbox.iter().map(|b| b.lo()).collect(),
-                hi: hbox.iter().map(|b| b.hi()).collect(),
-                radius: rho.hi().max(end.hi()),
-            },
-            end: report.then(|| zonotope_at(&step.x1, &m_next, after.hi())),
-        });
-        rho = Interval::point(after.hi());
+        if let Some((after, end, rates)) = after {
+            grew = (after.hi() - rho.hi()).max(0.0);
+            pieces.push(Piece {
+                t1,
+                rates: (rates.c, rates.sigma),
+                over: Span {
+                    lo: hbox.iter().map(|b| b.lo()).collect(),
+                    hi: hbox.iter().map(|b| b.hi()).collect(),
+                    radius: rho.hi().max(end.hi()),
+                },
+                end: report.then(|| zonotope_at(&step.x1, &m_next, after.hi())),
+            });
+            rho = Interval::point(after.hi());
+        }
         m = m_next;
         x.clone_from(&step.x1);
         t0 = t1;

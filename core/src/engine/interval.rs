@@ -93,7 +93,15 @@ fn first_order_of(run: &Run, r1: f64, x0: &[f64]) -> Option<first_order::FirstOr
     let grid = nominal::time_grid(run.spec.horizon, run.spec.step);
     let (inputs, r2) = run.nominal_inputs(&grid);
     let steps = contraction::nominal_steps(run, x0, r1, &grid, &inputs).ok()?;
-    first_order::deterministic(run, &steps, x0, &grid, &inputs, r2, run.gaussian)
+    first_order::deterministic(
+        run,
+        &steps,
+        x0,
+        &grid,
+        &inputs,
+        r2,
+        first_order::Linearised::member(run.gaussian),
+    )
 }
 
 /// The deterministic part of an interval run (the embedding's boxes on its steps, with the

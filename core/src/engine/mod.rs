@@ -17,6 +17,7 @@
 //! Runs go through [`Reach`](crate::Reach), which checks the analysis and its constants once;
 //! [`run`] runs one analysis of a model as the spec wrote it.
 
+mod alone;
 mod assemble;
 mod contraction;
 mod culprit;
@@ -101,11 +102,13 @@ impl RunError {
 impl RunError {
     /// The same failure, said to be of `piece` (a part of a split initial set, in words).
     pub(crate) fn in_piece(self, piece: &str) -> RunError {
+        self.noted(&format!("in the piece {piece} of the split initial box"))
+    }
+
+    /// The same failure with `note` added to its message, in parentheses.
+    pub(crate) fn noted(self, note: &str) -> RunError {
         let note = |d: Detail| Detail {
-            message: format!(
-                "{} (in the piece {piece} of the split initial box)",
-                d.message
-            ),
+            message: format!("{} ({note})", d.message),
             culprit: d.culprit,
         };
         match self {
@@ -319,6 +322,17 @@ pub(crate) fn run_engine(run: &Run) -> Result<Prs, RunError> {
     }?;
     finite::check(&prs)?;
     Ok(prs)
+}
+
+/// The linearised Gaussian set of a run alone at its whole delta (method.md 8.12), for an
+/// analysis whose own sets cannot be bounded (`failed` says why); `None` where that set does
+/// not apply or cannot be bounded either.
+pub(crate) fn run_alone(run: &Run, failed: &RunError) -> Result<Option<Prs>, RunError> {
+    let Some(prs) = alone::run(run, failed)? else {
+        return Ok(None);
+    };
+    finite::check(&prs)?;
+    Ok(Some(prs))
 }
 
 /// Shortest report step an analysis may have: the integrators subdivide a report step down to

@@ -356,6 +356,7 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut To
 
 #[cfg(test)]
 mod tests {
+    use super::super::part_file::FORMAT_VERSION;
     use super::super::tests::{info, narrow, Sys};
     use super::super::{run_part, simulate, Options};
     use super::*;
@@ -548,7 +549,7 @@ mod tests {
         version[MAGIC_LEN] = 9;
         assert_eq!(
             read(&version),
-            "part file format version 9; this reachc reads version 3"
+            format!("part file format version 9; this reachc reads version {FORMAT_VERSION}")
         );
         let mut longer = bytes.clone();
         longer.extend_from_slice(&[0; 8]);

@@ -50,7 +50,7 @@ mod topk;
 
 pub use crate::workers::thread_count;
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
-pub use dt::{DtSource, DtUsed, MAX_STEPS, RULE as DT_RULE};
+pub use dt::{DtSource, DtUsed, ACCURACY as DT_ACCURACY, MAX_STEPS, RULE as DT_RULE};
 pub use inputs::InputMode;
 pub use merge::{merge, MergeError, Merger};
 pub use part::{Part, PartStats, RunInfo, StepInfo};

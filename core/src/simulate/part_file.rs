@@ -20,7 +20,7 @@ use crate::prs::UnsafeKind;
 /// The first bytes of a part file.
 pub const MAGIC: &[u8] = b"reachc simulate part\n";
 /// The version of the layout this reachc writes and reads.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 /// FNV-1a, 64 bits.
 pub(crate) fn checksum(bytes: &[u8]) -> u64 {
@@ -266,6 +266,7 @@ fn write_run(w: &mut Writer, run: &RunInfo) {
     w.f64(dt.max);
     w.f64(dt.rule_min);
     w.f64(dt.hl_max);
+    w.f64(dt.bias_max);
     w.u64(dt.coarse);
     w.u64(run.steps_per_path);
     w.u8(code_of(&INITIAL, &run.initial_states));
@@ -319,6 +320,7 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
             max: r.f64()?,
             rule_min: r.f64()?,
             hl_max: r.f64()?,
+            bias_max: r.f64()?,
             coarse: r.u64()?,
         },
         steps_per_path: r.u64()?,

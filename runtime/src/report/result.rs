@@ -219,6 +219,9 @@ enum HintJson<'a> {
         linear: f64,
     },
     FirstOrderUnbounded,
+    LinearisedAlone {
+        why: &'a str,
+    },
 }
 
 #[derive(Serialize)]
@@ -326,7 +329,10 @@ impl<'a> Json<'a> {
             outputs: &prs.outputs,
             rate: RateJson {
                 kind: prs.rate.rate.name(),
-                note: rate_note(prs.rate.rate),
+                note: match prs.role {
+                    Role::Linearised => ALONE_NOTE.to_string(),
+                    _ => rate_note(prs.rate.rate),
+                },
                 paths: match prs.rate.rate {
                     Rate::Empirical { paths } => Some(paths),
                     Rate::Local | Rate::Global => None,
@@ -399,7 +405,7 @@ impl<'a> Json<'a> {
 }
 
 impl<'a> HintJson<'a> {
-    fn of(prs: &'a Prs, hint: &Hint) -> HintJson<'a> {
+    fn of(prs: &'a Prs, hint: &'a Hint) -> HintJson<'a> {
         match *hint {
             Hint::Wrapping {
                 t,
@@ -435,6 +441,7 @@ impl<'a> HintJson<'a> {
                 linear,
             },
             Hint::FirstOrderUnbounded => HintJson::FirstOrderUnbounded,
+            Hint::LinearisedAlone { ref why } => HintJson::LinearisedAlone { why },
         }
     }
 }
@@ -519,6 +526,11 @@ pub(crate) fn unsafe_kind(kind: UnsafeKind) -> &'static str {
 
 /// One sentence on where the rate came from; an empirical rate says plainly that it is no
 /// guarantee.
+/// The rate note of the linearised Gaussian set alone (method.md 8.12).
+const ALONE_NOTE: &str = "none used: the PRS is the linearised Gaussian set alone (method.md \
+     8.12), at the full delta; min_c and max_c are the rates certified on its own spans, for the \
+     record";
+
 fn rate_note(rate: Rate) -> String {
     match rate {
         Rate::Local => "c_t, sigma_t and rho_t certified on each internal step over a box \
@@ -856,7 +868,17 @@ pub fn summary(prs: &Prs) -> String {
     );
     let _ = writeln!(s, "  {}", guarantee_sentence(prs));
     let k = &prs.constants;
+    // The linearised Gaussian set alone (method.md 8.12) uses no rate.
+    let alone = prs.role == Role::Linearised;
     match prs.rate.rate {
+        _ if alone => {
+            let _ = writeln!(
+                s,
+                "  rates: {ALONE_NOTE}: c_t in [{}, {}]",
+                num(prs.rate.min_c),
+                num(prs.rate.max_c)
+            );
+        }
         Rate::Global => {
             let _ = writeln!(
                 s,
@@ -903,7 +925,7 @@ pub fn summary(prs: &Prs) -> String {
             );
         }
     }
-    if prs.rate.rate != Rate::Global {
+    if prs.rate.rate != Rate::Global && !alone {
         let _ = writeln!(s, "  rate: {}", rate_note(prs.rate.rate));
     }
     let n = prs.n().max(1);
@@ -1137,6 +1159,12 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
              shrinks with the square of the initial set's width: split the initial set \
              (`split = [..]` in the analysis, one count per state)"
             .to_string(),
+        Hint::LinearisedAlone { ref why } => format!(
+            "the analysis' own sets could not be bounded ({why}); the PRS is the linearised \
+             Gaussian set alone (method.md 8.12), at the full delta, which needs no contraction \
+             rate: a smaller initial set (`split = [..]`) or less noise keeps its second-order \
+             error small"
+        ),
     }
 }
 

@@ -5,7 +5,8 @@ use super::result::unsafe_kind;
 use super::{count, summary_indices, time};
 use reachc_core::model::Guarantee;
 use reachc_core::simulate::{
-    DtSource, DtUsed, InitialSampling, InputMode, NoiseKind, SimReport, DT_RULE, MAX_STEPS,
+    DtSource, DtUsed, InitialSampling, InputMode, NoiseKind, SimReport, DT_ACCURACY, DT_RULE,
+    MAX_STEPS,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -47,7 +48,8 @@ struct Json<'a> {
     verdict: CoverageJson,
 }
 
-/// How the Euler-Maruyama steps compare with the rule `h L_k <= 0.05`.
+/// How the Euler-Maruyama steps compare with the rules `h L_k <= 0.05` and
+/// `(h_k / 2) a_k tau_k <= 0.05 w_k`.
 #[derive(Serialize)]
 struct DtRuleJson {
     /// `rule` (chosen by it) or `option` (`--dt`).
@@ -57,6 +59,8 @@ struct DtRuleJson {
     status: &'static str,
     bound: f64,
     hl_max: f64,
+    accuracy: f64,
+    bias_max: f64,
     rule_min: f64,
     coarse_intervals: u64,
     max_steps: u32,
@@ -188,6 +192,8 @@ impl<'a> Json<'a> {
                 status: dt_status(&r.dt),
                 bound: DT_RULE,
                 hl_max: r.dt.hl_max,
+                accuracy: DT_ACCURACY,
+                bias_max: r.dt.bias_max,
                 rule_min: r.dt.rule_min,
                 coarse_intervals: r.dt.coarse,
                 max_steps: MAX_STEPS,
@@ -298,29 +304,39 @@ fn dt_range(dt: &DtUsed) -> String {
     }
 }
 
-/// A warning when some Euler-Maruyama steps are coarser than the rule `h L_k <= 0.05` asks
-/// (the check may then test the integrator's error, not the PRS); `None` when they all meet it.
+/// A warning when some Euler-Maruyama steps are coarser than the rules `h L_k <= 0.05` and
+/// `(h_k / 2) a_k tau_k <= 0.05 w_k` ask (the check may then test the integrator's error, not
+/// the PRS); `None` when they all meet them.
 pub fn dt_warning(dt: &DtUsed) -> Option<String> {
     let hl = if dt.hl_max.is_finite() {
         format!("h L up to {:.3}", dt.hl_max)
     } else {
         "no finite bound L of the drift's Jacobian over the sets".to_string()
     };
+    let bias = if dt.bias_max.is_finite() {
+        format!(
+            "Euler-Maruyama's bias up to {:.3} of the sets' half-width",
+            dt.bias_max
+        )
+    } else {
+        "no finite bound of Euler-Maruyama's bias".to_string()
+    };
+    let rules = format!("the rules h L <= {DT_RULE} and bias <= {DT_ACCURACY} of the half-width");
     match (dt.meets_rule(), dt.source) {
         (true, _) => None,
         (false, DtSource::Rule) => Some(format!(
             "the Euler-Maruyama step is capped at {MAX_STEPS} steps per report interval on {}, \
-             coarser than the rule h L <= {DT_RULE} asks ({hl}): Euler-Maruyama's own error may \
-             show as paths outside; a smaller --dt checks more finely",
+             coarser than {rules} ask ({hl}, {bias}): Euler-Maruyama's own error may show as \
+             paths outside; a smaller --dt checks more finely",
             count(dt.coarse, "report interval")
         )),
         (false, DtSource::Option) => Some(format!(
-            "--dt {} is coarser than the rule h L <= {DT_RULE} asks on {} ({hl}{}): \
-             Euler-Maruyama's own error may show as paths outside",
+            "--dt {} is coarser than {rules} ask on {} ({hl}, {bias}{}): Euler-Maruyama's own \
+             error may show as paths outside",
             time(dt.max),
             count(dt.coarse, "report interval"),
             if dt.rule_min > 0.0 {
-                format!("; the rule's step: {}", time(dt.rule_min))
+                format!("; the rules' step: {}", time(dt.rule_min))
             } else {
                 String::new()
             }
@@ -434,7 +450,9 @@ pub fn summary(r: &SimReport) -> String {
         dt_range(&r.dt),
         count(r.steps_per_path, "step"),
         match r.dt.source {
-            DtSource::Rule => format!("chosen by the rule h L <= {DT_RULE}"),
+            DtSource::Rule => format!(
+                "chosen by the rules h L <= {DT_RULE} and bias <= {DT_ACCURACY} of the half-width"
+            ),
             DtSource::Option => "--dt".to_string(),
         }
     );
