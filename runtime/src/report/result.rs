@@ -968,6 +968,15 @@ pub fn summary(prs: &Prs) -> String {
     summary_metrics(prs, &mut s);
     if !prs.pieces.is_empty() {
         summary_split(prs, &mut s);
+    } else if alone {
+        let _ = writeln!(
+            s,
+            "  sets: linearised Gaussian zonotopes (the initial box under the flow's \
+             linearisation along the nominal, the Gaussian part's box and the linearisation's \
+             error, method.md 8.10), which hold the stochastic part themselves (r_t = 0; the \
+             remainder is a millionth of the radius); columns: the zonotope's hull"
+        );
+        box_table(prs, &mut s);
     } else if zonotopes(prs) {
         let _ = writeln!(
             s,
