@@ -409,12 +409,15 @@ pub enum Split {
     /// `split = [k1, ..., kn]`: state `i`'s range cut into `k_i` equal parts, `k1 ... kn`
     /// pieces (each `k_i >= 1`; at most [`MAX_PIECES`] in all).
     Counts(Vec<usize>),
-    /// `split = auto(pieces = N)`: the pieces whose sets are largest bisected, round by round,
-    /// along their widest state (in the metric), while that shrinks their sets and the pieces
-    /// number at most `pieces` (method.md 8.11).
+    /// `split = auto(pieces = N, seconds = S)`: the pieces whose sets are largest bisected,
+    /// round by round, along their widest state (in the metric), while that shrinks their sets,
+    /// the pieces number at most `pieces` and (with `seconds`) the refinement has run for less
+    /// than that long (method.md 8.11).
     Auto {
         /// The most pieces.
         pieces: usize,
+        /// The time budget: no round starts after this many seconds of the analysis' run.
+        seconds: Option<u64>,
     },
 }
 
@@ -430,7 +433,7 @@ impl Split {
         match self {
             Split::Off => 1,
             Split::Counts(k) => k.iter().fold(1usize, |p, &k| p.saturating_mul(k)),
-            Split::Auto { pieces } => *pieces,
+            Split::Auto { pieces, .. } => *pieces,
         }
     }
 }

@@ -12,6 +12,7 @@ use crate::model::{
 use crate::prs::{Prs, Role, Verdict};
 use crate::system::System;
 use crate::workers::Workers;
+use std::time::{Duration, Instant};
 
 /// An analysis of a model, ready to run: its parameters checked, its certified constants
 /// checked against the model data (domain, input box, horizon) and kept private, the metric
@@ -261,8 +262,9 @@ impl<'a> Reach<'a> {
                     results.into_iter().collect::<Result<_, _>>()?,
                 )
             }
-            Split::Auto { pieces } => {
-                let found = self.refine(bounds, *pieces, &workers, &run)?;
+            Split::Auto { pieces, seconds } => {
+                let deadline = seconds.map(|s| Instant::now() + Duration::from_secs(s));
+                let found = self.refine(bounds, (*pieces, deadline), &workers, &run)?;
                 (own.split.clone(), found)
             }
             Split::Off => unreachable!("one piece"),
@@ -277,32 +279,39 @@ impl<'a> Reach<'a> {
     }
 
     /// `split = auto` (method.md 8.11): from the whole box, round after round, the worse half
-    /// of the pieces still worth cutting (by the size of their sets, [`log_volume_sum`]) are
-    /// bisected along their widest state in the metric (`h_i sqrt(P_ii)`), within `budget`
-    /// pieces; a piece whose halves did not shrink its sets by [`AUTO_GAIN`] per report time is
-    /// not cut again. Every decision depends on earlier results only (deterministic, whatever
-    /// the number of threads).
+    /// of the pieces still worth cutting (by the size of their sets, [`log_volume_sum`];
+    /// pieces that cannot run first) are bisected along their widest state in the metric
+    /// (`h_i sqrt(P_ii)`), within `budget` pieces and no round starting after the deadline (the
+    /// time budget; the whole box always runs); a piece whose halves did not shrink its sets
+    /// by [`AUTO_GAIN`] per report time is not cut again. The first piece that still cannot run
+    /// when the budget is spent is the analysis' error. Every decision depends on earlier
+    /// results only (deterministic, whatever the number of threads), except where the deadline
+    /// ends the refinement.
     fn refine(
         &self,
         whole: Vec<Bounds>,
-        budget: usize,
+        (budget, deadline): (usize, Option<Instant>),
         workers: &Workers,
         run: &(dyn Fn(&[Bounds]) -> Result<Prs, RunError> + Sync),
     ) -> Result<Vec<Prs>, RunError> {
         let metric = &self.setup.consts.metric;
         let n = whole.len();
-        let first = run(&whole)?;
-        // (box, result, worth cutting)
+        let first = run(&whole);
+        // (box, result, worth cutting): a piece that cannot run is cut like one whose sets are
+        // infinite, and the analysis fails only if one is left when the budget is spent.
         let mut pieces = vec![(whole, first, true)];
         loop {
             let room = budget.saturating_sub(pieces.len());
             let mut order: Vec<usize> = (0..pieces.len())
                 .filter(|&j| pieces[j].2 && pieces[j].0.iter().any(|b| b.lo < b.hi))
                 .collect();
-            if room == 0 || order.is_empty() {
+            if room == 0 || order.is_empty() || deadline.is_some_and(|d| Instant::now() >= d) {
                 break;
             }
-            let size: Vec<f64> = pieces.iter().map(|p| log_volume_sum(&p.1)).collect();
+            let size: Vec<f64> = pieces
+                .iter()
+                .map(|p| p.1.as_ref().map_or(f64::INFINITY, log_volume_sum))
+                .collect();
             order.sort_by(|&a, &b| size[b].total_cmp(&size[a]).then(a.cmp(&b)));
             order.truncate(order.len().div_ceil(2).min(room));
             order.sort_unstable();
@@ -330,7 +339,6 @@ impl<'a> Reach<'a> {
                     (b, r)
                 })
                 .into_iter();
-            let steps = pieces[0].1.steps.len().saturating_sub(1).max(1) as f64;
             let mut next = Vec::with_capacity(pieces.len() + order.len());
             for (j, parent) in pieces.into_iter().enumerate() {
                 if order.binary_search(&j).is_err() {
@@ -338,15 +346,21 @@ impl<'a> Reach<'a> {
                     continue;
                 }
                 let (a, b) = (results.next().unwrap(), results.next().unwrap());
-                let (a, b) = ((a.0, a.1?), (b.0, b.1?));
-                let shrunk = log_volume_sum(&a.1).max(log_volume_sum(&b.1))
-                    < size[j] - AUTO_GAIN.ln() * steps;
+                // Halves that both run are worth cutting again while they shrank the sets;
+                // a half that cannot run always is.
+                let shrunk = match (&a.1, &b.1) {
+                    (Ok(x), Ok(y)) => {
+                        let steps = x.steps.len().saturating_sub(1).max(1) as f64;
+                        log_volume_sum(x).max(log_volume_sum(y)) < size[j] - AUTO_GAIN.ln() * steps
+                    }
+                    _ => true,
+                };
                 next.push((a.0, a.1, shrunk));
                 next.push((b.0, b.1, shrunk));
             }
             pieces = next;
         }
-        Ok(pieces.into_iter().map(|(_, p, _)| p).collect())
+        pieces.into_iter().map(|(_, p, _)| p).collect()
     }
 
     /// The result of one piece of the initial set (the whole of it without a split).

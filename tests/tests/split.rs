@@ -189,7 +189,13 @@ fn the_union_passes_the_monte_carlo_check() {
 fn an_automatic_split_tiles_the_box_within_its_budget() {
     let auto = run("split = auto(pieces = 12)");
     let plain = run("");
-    assert_eq!(auto.split, Split::Auto { pieces: 12 });
+    assert_eq!(
+        auto.split,
+        Split::Auto {
+            pieces: 12,
+            seconds: None
+        }
+    );
     let n = auto.pieces.len();
     assert!((2..=12).contains(&n), "{n} pieces");
     let area: f64 = auto
@@ -288,4 +294,57 @@ fn an_initial_ball_cannot_be_split() {
     };
     assert_eq!(detail.culprit, Some(Culprit::Setting(Setting::Split)));
     assert!(detail.message.contains("not a box"), "{}", detail.message);
+}
+
+/// `split = auto` cuts a piece that cannot run like one whose sets are infinite: `x' = x^2`
+/// from `[0, 3]` to `t = 0.3` cannot be run whole (the tube around the solution from 3, which
+/// reaches 30, cannot be closed), but 16 pieces can, and every closed-form solution
+/// `x0 / (1 - x0 t)` from a grid of starts lies in the union at every report time. With a budget
+/// of one piece, the whole box's failure is the analysis'.
+#[test]
+fn split_auto_cuts_pieces_that_cannot_run() {
+    let source = "model blow\nstate x in [0, 3]\nnoise w\ndrift { x' = x^2 }\n\
+                  diffusion { x: 0.01 * w }\nanalysis whole { horizon = 0.3 }\n\
+                  analysis auto { horizon = 0.3  split = auto(pieces = 16) }\n\
+                  analysis one { horizon = 0.3  split = auto(pieces = 1) }\n";
+    let (sys, info) = inline(source);
+    let whole = Reach::new(&sys, &info, "whole").unwrap().run().unwrap_err();
+    let one = Reach::new(&sys, &info, "one").unwrap().run().unwrap_err();
+    // (A budget of one piece is the unsplit run.)
+    assert_eq!(one, whole);
+    let prs = Reach::new(&sys, &info, "auto").unwrap().run().unwrap();
+    assert!(
+        prs.pieces.len() > 1 && prs.pieces.len() <= 16,
+        "{}",
+        prs.pieces.len()
+    );
+    for i in 0..=60 {
+        let x0 = 3.0 * f64::from(i) / 60.0;
+        for (k, st) in prs.steps.iter().enumerate() {
+            let x = x0 / (1.0 - x0 * st.t);
+            assert!(prs.contains_at(k, &[x]), "x0 = {x0}, t = {}: {x}", st.t);
+        }
+    }
+}
+
+/// The time budget of `split = auto`: with `seconds = 0` no round of cuts starts (the whole box
+/// alone, whose sets are the unsplit run's); with an hour, the same pieces as without a budget.
+#[test]
+fn the_time_budget_of_an_automatic_split() {
+    let none = run("split = auto(seconds = 0)");
+    let plain = run("");
+    assert_eq!(none.pieces.len(), 1);
+    assert_eq!(none.pieces[0].steps, plain.steps);
+    let hour = run("split = auto(pieces = 12, seconds = 3600)");
+    let free = run("split = auto(pieces = 12)");
+    assert_eq!(
+        hour.split,
+        Split::Auto {
+            pieces: 12,
+            seconds: Some(3600)
+        }
+    );
+    let boxes = |p: &Prs| -> Vec<_> { p.pieces.iter().map(|q| q.initial.clone()).collect() };
+    assert_eq!(boxes(&hour), boxes(&free));
+    assert_eq!(hour.steps, free.steps);
 }

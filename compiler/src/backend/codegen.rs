@@ -1618,9 +1618,13 @@ impl InfoWriter {
                 let k = indices(k);
                 quote!(Split::Counts(#k))
             }
-            Split::Auto { pieces } => {
+            Split::Auto { pieces, seconds } => {
                 let pieces = int(*pieces);
-                quote!(Split::Auto { pieces: #pieces })
+                let seconds = option(seconds, |&s| {
+                    let s = proc_macro2::Literal::u64_unsuffixed(s);
+                    quote!(#s)
+                });
+                quote!(Split::Auto { pieces: #pieces, seconds: #seconds })
             }
         };
         let transform = option(&a_spec.transform, |t| {

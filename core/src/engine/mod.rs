@@ -349,7 +349,7 @@ pub(crate) fn validate(
 ) -> Result<(), RunError> {
     let bad = |m: String| Err(RunError::Invalid(m.into()));
     let bad_setting = |s: Setting, m: String| Err(RunError::Invalid(Detail::from(m).at_setting(s)));
-    if let Split::Auto { pieces } = a.split {
+    if let Split::Auto { pieces, .. } = a.split {
         if !(1..=MAX_PIECES).contains(&pieces) {
             return bad_setting(
                 Setting::Split,

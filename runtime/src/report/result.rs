@@ -135,13 +135,14 @@ impl<'a> PieceJson<'a> {
 enum SplitJson<'a> {
     /// `split = [..]`.
     Counts(&'a [usize]),
-    /// `split = auto(pieces = N)`.
+    /// `split = auto(pieces = N, seconds = S)`.
     Auto { auto: AutoJson },
 }
 
 #[derive(Serialize)]
 struct AutoJson {
     pieces: usize,
+    seconds: Option<u64>,
 }
 
 #[derive(Serialize)]
@@ -395,8 +396,11 @@ impl<'a> Json<'a> {
             split: match &prs.split {
                 Split::Off => None,
                 Split::Counts(k) => Some(SplitJson::Counts(k)),
-                Split::Auto { pieces } => Some(SplitJson::Auto {
-                    auto: AutoJson { pieces: *pieces },
+                Split::Auto { pieces, seconds } => Some(SplitJson::Auto {
+                    auto: AutoJson {
+                        pieces: *pieces,
+                        seconds: *seconds,
+                    },
                 }),
             },
             pieces: prs.pieces.iter().map(PieceJson::of).collect(),
@@ -1312,10 +1316,11 @@ fn summary_split(prs: &Prs, s: &mut String) {
                 prs.pieces.len()
             )
         }
-        Split::Auto { pieces } => format!(
-            "cut automatically into {} pieces (at most {pieces}: the pieces with the largest \
+        Split::Auto { pieces, seconds } => format!(
+            "cut automatically into {} pieces (at most {pieces}{}: the pieces with the largest \
              sets halved along their widest state, while that shrank them)",
-            prs.pieces.len()
+            prs.pieces.len(),
+            seconds.map_or(String::new(), |s| format!(", no round started after {s} s"))
         ),
         Split::Off => String::new(),
     };

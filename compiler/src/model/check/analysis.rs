@@ -589,6 +589,7 @@ impl Checker<'_> {
         match &e.kind {
             ExprKind::Name(id) if id.name == "auto" => Some(Split::Auto {
                 pieces: AUTO_PIECES,
+                seconds: None,
             }),
             ExprKind::Call { func, args } if func.name == "auto" => self.auto_split(e, args),
             ExprKind::List(items) => self.split_counts(e, items, n),
@@ -601,7 +602,7 @@ impl Checker<'_> {
                 .with_help(format!(
                     "write one count per state ({n}), e.g. `split = [{}]`: state i's initial \
                      range is cut into that many equal parts; or `split = auto` (at most \
-                     {AUTO_PIECES} pieces, `auto(pieces = N)` for another budget)",
+                     {AUTO_PIECES} pieces, `auto(pieces = N, seconds = S)` for other budgets)",
                     vec!["2"; n].join(", ")
                 )),
             ),
@@ -649,32 +650,74 @@ impl Checker<'_> {
         Some(split)
     }
 
-    /// `split = auto(pieces = N)`: a budget of 1 to [`MAX_PIECES`] pieces.
+    /// `split = auto(pieces = N, seconds = S)`, either argument optional, each at most once: a
+    /// budget of 1 to [`MAX_PIECES`] pieces (default [`AUTO_PIECES`]) and a whole number of
+    /// seconds after which no round of cuts starts.
     fn auto_split(&mut self, e: &Expr, args: &[Arg]) -> Option<Split> {
-        let [arg] = args else {
-            return self.fail(
-                Diagnostic::error("bad `auto` split", e.span.clone(), "expected `pieces = N`")
-                    .with_help("write `split = auto` or `split = auto(pieces = 16)`"),
-            );
-        };
-        if arg.name.as_ref().map(|n| n.name.as_str()) != Some("pieces") {
+        let (mut pieces, mut seconds) = (None, None);
+        for arg in args {
+            let name = arg.name.as_ref().map(|n| n.name.as_str());
+            let problem = match name {
+                Some("pieces") if pieces.is_some() => Some("given twice"),
+                Some("seconds") if seconds.is_some() => Some("given twice"),
+                Some("pieces" | "seconds") => None,
+                _ => Some("expected `pieces = N` or `seconds = S`"),
+            };
+            if let Some(problem) = problem {
+                return self.fail(
+                    Diagnostic::error("bad `auto` split", arg.value.span.clone(), problem)
+                        .with_help(
+                            "`auto` takes a budget of pieces and one of time, each at most \
+                             once: `auto(pieces = 16, seconds = 30)`",
+                        ),
+                );
+            }
+            if name == Some("pieces") {
+                pieces = Some(self.piece_count(
+                    &arg.value,
+                    "the pieces of an automatic split",
+                    "each piece is a full run of the analysis",
+                )?);
+            } else {
+                seconds = Some(self.seconds(&arg.value)?);
+            }
+        }
+        if args.is_empty() {
             return self.fail(
                 Diagnostic::error(
                     "bad `auto` split",
-                    arg.value.span.clone(),
-                    "expected `pieces = N`",
+                    e.span.clone(),
+                    "expected `pieces = N` or `seconds = S`",
                 )
-                .with_help(
-                    "the one argument of `auto` is the budget of pieces: `auto(pieces = 16)`",
-                ),
+                .with_help("write `split = auto` or `split = auto(pieces = 16, seconds = 30)`"),
             );
         }
-        let pieces = self.piece_count(
-            &arg.value,
-            "the pieces of an automatic split",
-            "each piece is a full run of the analysis",
-        )?;
-        Some(Split::Auto { pieces })
+        Some(Split::Auto {
+            pieces: pieces.unwrap_or(AUTO_PIECES),
+            seconds,
+        })
+    }
+
+    /// The time budget of an automatic split: a whole number of seconds from 0 to a year.
+    fn seconds(&mut self, e: &Expr) -> Option<u64> {
+        const YEAR: f64 = 365.0 * 86400.0;
+        let v = self.constant(e, &[])?;
+        if v >= 0.0 && v.fract() == 0.0 && v <= YEAR {
+            return Some(v as u64);
+        }
+        self.fail(
+            Diagnostic::error(
+                format!(
+                    "the time budget of an automatic split must be a whole number of seconds \
+                     from 0 to {YEAR}, but it is {v}"
+                ),
+                e.span.clone(),
+                "not a number of seconds",
+            )
+            .with_help(
+                "no round of cuts starts after it; the whole box always runs: `seconds = 30`",
+            ),
+        )
     }
 
     /// A whole number from 1 to [`MAX_PIECES`] (`what` names it in the diagnostic).
