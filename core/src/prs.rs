@@ -6,6 +6,7 @@
 
 use crate::engine::interval;
 use crate::engine::zonotope;
+use crate::engine::RunError;
 use crate::interval::Interval;
 use crate::model::{
     Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricRegion, Provenance,
@@ -329,10 +330,10 @@ pub enum Hint {
     /// internal step (the a-priori remainder did not hold its own bound).
     FirstOrderUnbounded,
     /// The analysis' own sets (its ball or box) could not be bounded: the PRS is the linearised
-    /// Gaussian set alone at the full delta (method.md 8.12); `why` is what stopped them.
+    /// Gaussian set alone at the full delta (method.md 8.12).
     LinearisedAlone {
-        /// The diagnostic of the analysis' own run.
-        why: String,
+        /// What stopped the analysis' own run.
+        failed: RunError,
     },
 }
 

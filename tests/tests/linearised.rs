@@ -272,7 +272,7 @@ fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
         .hints
         .iter()
         .find_map(|h| match h {
-            Hint::LinearisedAlone { why } => Some(why.clone()),
+            Hint::LinearisedAlone { failed } => Some(failed.to_string()),
             _ => None,
         })
         .expect("the hint says why");

@@ -64,7 +64,7 @@ pub(super) fn run(run: &Run, failed: &RunError) -> Result<Option<Prs>, RunError>
     let reports = det.pieces.iter().filter(|p| p.end.is_some()).count();
     let mut prs = assemble_with(run, det, header, None, Radii::inside(reports));
     prs.hints.push(Hint::LinearisedAlone {
-        why: failed.to_string(),
+        failed: failed.clone(),
     });
     Ok(Some(prs.with_role(Role::Linearised)))
 }

@@ -215,7 +215,6 @@ pub(super) fn deterministic(
     let mut grew = 0.0f64;
     let mut pieces = Vec::with_capacity(steps.len());
     let mut jac = vec![Interval::ZERO; n * n];
-    let alive = !alone;
     for (step, k) in steps {
         let (t1, u) = (step.t1, &inputs[*k]);
         let span = Interval::point(t1) - Interval::point(t0);
@@ -239,10 +238,10 @@ pub(super) fn deterministic(
         let hull: Vec<Interval> = (0..n)
             .map(|i| Interval::new(step.lo[i], step.hi[i]))
             .collect();
-        // The remainder over the step, while the first-order sets last (after they end,
-        // `alone` keeps the linearised Gaussian sets going without them).
+        // The remainder over the step (not computed alone: the linearised Gaussian sets go
+        // without it).
         let remainder = 'rem: {
-            if !alive {
+            if alone {
                 break 'rem None;
             }
             sliced_jacobian(sys, &hull, &v, &ui, times, &mut jac);

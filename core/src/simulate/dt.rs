@@ -158,10 +158,10 @@ fn steps_of(w: f64, h: f64) -> f64 {
 /// [`Scales`] on the report interval `[t0, t1]` ending at report step `k`, over the bounding
 /// box `X` of the span of `k` (intersected with the other metrics' boxes and with the domain),
 /// the input box and `[t0, t1]`: `L_k` [`norm_bound`] of `D_x f`; `a_k` the largest entry of
-/// `D_x f f` at the centre of `X` (over the inputs and times); `tau_k = t1`, or `1 / |mu|` where the Jacobian's logarithmic norm `mu`
-/// (infinity norm) is negative and that is shorter (a damped bias stops growing); the smallest
-/// positive half-width of the result's bounding boxes at report steps `k - 1` and `k` (of `X`
-/// where one has none).
+/// `D_x f f` at the centre of `X` (over the inputs and times); `tau_k = t1`, or `1 / |mu|`
+/// where the Jacobian's logarithmic norm `mu` (infinity norm) is negative and that is shorter
+/// (a damped bias stops growing); the smallest positive half-width of the result's bounding
+/// boxes at report steps `k - 1` and `k` (of `X` where one has none).
 fn bound_on<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
@@ -241,20 +241,13 @@ fn bound_on<S: System + ?Sized>(
         .fold(f64::NEG_INFINITY, f64::max);
     // The set's own width at the interval's ends (the span's box also holds its motion over
     // the interval, which is no width of the set).
-    let widths = |b: Vec<Bounds>| -> Vec<f64> { b.iter().map(|b| 0.5 * (b.hi - b.lo)).collect() };
-    let ends = [k - 1, k].map(|i| result.hull_at(i).map(widths));
+    let ends: Vec<Bounds> = match (result.hull_at(k - 1), result.hull_at(k)) {
+        (Some(a), Some(b)) => a.into_iter().chain(b).collect(),
+        _ => x.iter().map(|xi| Bounds::new(xi.lo(), xi.hi())).collect(),
+    };
     let half = ends
         .iter()
-        .flatten()
-        .flatten()
-        .copied()
-        .chain(
-            ends.iter()
-                .any(Option::is_none)
-                .then(|| x.iter().map(|xi| 0.5 * (xi.hi() - xi.lo())))
-                .into_iter()
-                .flatten(),
-        )
+        .map(|b| 0.5 * (b.hi - b.lo))
         .filter(|&h| h > 0.0)
         .fold(f64::INFINITY, f64::min);
     Scales {

@@ -221,7 +221,7 @@ enum HintJson<'a> {
     },
     FirstOrderUnbounded,
     LinearisedAlone {
-        why: &'a str,
+        why: String,
     },
 }
 
@@ -445,7 +445,9 @@ impl<'a> HintJson<'a> {
                 linear,
             },
             Hint::FirstOrderUnbounded => HintJson::FirstOrderUnbounded,
-            Hint::LinearisedAlone { ref why } => HintJson::LinearisedAlone { why },
+            Hint::LinearisedAlone { ref failed } => HintJson::LinearisedAlone {
+                why: failed.to_string(),
+            },
         }
     }
 }
@@ -1172,8 +1174,8 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
              shrinks with the square of the initial set's width: split the initial set \
              (`split = [..]` in the analysis, one count per state)"
             .to_string(),
-        Hint::LinearisedAlone { ref why } => format!(
-            "the analysis' own sets could not be bounded ({why}); the PRS is the linearised \
+        Hint::LinearisedAlone { ref failed } => format!(
+            "the analysis' own sets could not be bounded ({failed}); the PRS is the linearised \
              Gaussian set alone (method.md 8.12), at the full delta, which needs no contraction \
              rate: a smaller initial set (`split = [..]`) or less noise keeps its second-order \
              error small"
