@@ -8,7 +8,7 @@ pub mod result;
 pub mod simulation;
 
 pub use reachc_core::decimal::time;
-pub use result::{summary, to_json, to_json_with, write_csv};
+pub use result::{summary, to_json, to_json_with, to_json_within, write_csv, MEMBERS_BUDGET};
 
 /// `n` and the noun, singular or plural: `1 thread`, `4 threads`.
 pub fn count(n: u64, noun: &str) -> String {

@@ -8,21 +8,98 @@ use reachc_core::prs::{
     BallBound, DetSet, Hint, Proved, Prs, R1Method, Role, Step, TransformUsed, UniformBound,
     Unproved, UnsafeKind, UnsafeVerdict, Verdict,
 };
+use reachc_core::Interval;
 use serde::Serialize;
+use std::borrow::Cow;
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
-/// Pretty-printed JSON of a result. Non-finite numbers (e.g. an infinite margin) are `null`.
+/// The size above which a result file writes the members of its intersection as their
+/// bounding boxes ([`to_json_with`]): 32 MiB.
+pub const MEMBERS_BUDGET: usize = 32 << 20;
+
+/// Pretty-printed JSON of a result (arrays of numbers or strings on one line). Non-finite
+/// numbers (e.g. an infinite margin) are `null`.
 pub fn to_json(prs: &Prs) -> String {
     to_json_with(prs, None)
 }
 
-/// [`to_json`] with the analysis' probability of safety (`reachc run --probability`).
+/// [`to_json`] with the analysis' probability of safety (`reachc run --probability`), within
+/// [`MEMBERS_BUDGET`] (see [`to_json_within`]).
 pub fn to_json_with(prs: &Prs, probability: Option<&SafetyProbability>) -> String {
-    let mut json = Json::of(prs);
-    json.safety_probability = probability.map(|p| ProbabilityJson::of(prs, p));
-    // Plain data with string keys: serialising cannot fail.
-    serde_json::to_string_pretty(&json).expect("a result serialises")
+    to_json_within(prs, probability, MEMBERS_BUDGET)
+}
+
+/// [`to_json_with`] for a size budget of `budget` bytes: where the file would be larger with the
+/// members of the intersection written in full (first-order and linearised zonotopes over
+/// thousands of report times: a 12-state chain at 5000 report times wrote 235 MB), each member
+/// is written as its PRS's bounding box per report time instead (`"boxed": true`; a larger set,
+/// so still a PRS; the result's own sets, boxes, margins and verdicts are unchanged).
+pub fn to_json_within(prs: &Prs, probability: Option<&SafetyProbability>, budget: usize) -> String {
+    let write = |boxed: bool| {
+        let mut json = Json::of(prs);
+        if boxed {
+            json.also = prs.also.iter().map(Json::boxed).collect();
+        }
+        json.safety_probability = probability.map(|p| ProbabilityJson::of(prs, p));
+        // Plain data with string keys: serialising cannot fail.
+        inline_scalar_arrays(&serde_json::to_string_pretty(&json).expect("a result serialises"))
+    };
+    let full = write(false);
+    if full.len() > budget && !prs.also.is_empty() {
+        write(true)
+    } else {
+        full
+    }
+}
+
+/// serde_json's pretty output with every array of scalars (numbers, strings, `null`, booleans)
+/// on one line: `[\n  1.0,\n  2.0\n]` becomes `[1.0, 2.0]` (half the size of a result file, and
+/// one line per vector). serde_json writes each array item on its own line and never a newline
+/// inside a string, so a line is an item.
+pub(crate) fn inline_scalar_arrays(pretty: &str) -> String {
+    let lines: Vec<&str> = pretty.lines().collect();
+    let mut out = String::with_capacity(pretty.len());
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        if line.ends_with('[') {
+            // The items up to the closing bracket at this line's indentation, if all scalars.
+            let indent = line.len() - line.trim_start().len();
+            let end = lines[i + 1..].iter().position(|l| {
+                let t = l.trim_start();
+                l.len() - t.len() == indent && (t == "]" || t == "],")
+            });
+            if let Some(end) = end {
+                let items = &lines[i + 1..i + 1 + end];
+                if items.iter().all(|l| scalar(l.trim().trim_end_matches(','))) {
+                    out.push_str(line);
+                    for (j, item) in items.iter().enumerate() {
+                        if j > 0 {
+                            out.push(' ');
+                        }
+                        out.push_str(item.trim());
+                    }
+                    out.push_str(lines[i + 1 + end].trim_start());
+                    out.push('\n');
+                    i += end + 2;
+                    continue;
+                }
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+        i += 1;
+    }
+    out.pop();
+    out
+}
+
+/// Whether one item of serde_json's output is a scalar (a string, number, `null`, `true` or
+/// `false`), not the start of an object or array.
+fn scalar(item: &str) -> bool {
+    let string = item.len() >= 2 && item.starts_with('"') && item.ends_with('"');
+    string || !(item.starts_with('{') || item.starts_with('[') || item.is_empty())
 }
 
 /// The JSON document, field for field (the order is the documented one).
@@ -67,6 +144,9 @@ struct Json<'a> {
     /// A member's kind (`metric`, `box`, `first_order`); absent for the result itself.
     #[serde(skip_serializing_if = "Option::is_none")]
     role: Option<&'static str>,
+    /// A member written as its PRS's bounding boxes ([`MEMBERS_BUDGET`]); absent otherwise.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    boxed: bool,
     /// The split (absent without one; method.md 8.11): the counts per state, or
     /// `{"auto": {"pieces": N}}` (the budget).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -252,13 +332,13 @@ struct SpanJson<'a> {
 #[derive(Serialize)]
 struct DetSetJson<'a> {
     shape: &'static str,
-    center: &'a [f64],
+    center: Cow<'a, [f64]>,
     radius: f64,
     metric: &'static str,
     #[serde(skip_serializing_if = "Option::is_none")]
-    lo: Option<&'a [f64]>,
+    lo: Option<Cow<'a, [f64]>>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    hi: Option<&'a [f64]>,
+    hi: Option<Cow<'a, [f64]>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     hull_lo: Option<&'a [f64]>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -393,6 +473,7 @@ impl<'a> Json<'a> {
             hints: prs.hints.iter().map(|h| HintJson::of(prs, h)).collect(),
             also: prs.also.iter().map(Json::of).collect(),
             role: (prs.role != Role::Own).then(|| prs.role.name()),
+            boxed: false,
             split: match &prs.split {
                 Split::Off => None,
                 Split::Counts(k) => Some(SplitJson::Counts(k)),
@@ -404,6 +485,20 @@ impl<'a> Json<'a> {
                 }),
             },
             pieces: prs.pieces.iter().map(PieceJson::of).collect(),
+        }
+    }
+}
+
+impl<'a> Json<'a> {
+    /// A member of the intersection written as its PRS's bounding box per report time (see
+    /// [`to_json_with`]).
+    fn boxed(member: &'a Prs) -> Json<'a> {
+        Json {
+            steps: (0..member.steps.len())
+                .map(|k| StepJson::boxed(member, k))
+                .collect(),
+            boxed: true,
+            ..Json::of(member)
         }
     }
 }
@@ -453,6 +548,58 @@ impl<'a> HintJson<'a> {
 }
 
 impl<'a> StepJson<'a> {
+    /// Report step `k` of a member written as its PRS's bounding box: a `"box"` (its centre the
+    /// box's midpoint, its radius an upper bound of the box's P-radius about it) with
+    /// `r_t = r_pointwise = 0` (the box holds the stochastic part too), the rest as
+    /// [`StepJson::of`] writes it.
+    fn boxed(member: &'a Prs, k: usize) -> StepJson<'a> {
+        let full = StepJson::of(member, k);
+        let (lo, hi) = (full.prs_hull_lo.clone(), full.prs_hull_hi.clone());
+        let (center, half): (Vec<f64>, Vec<Interval>) = lo
+            .iter()
+            .zip(&hi)
+            .map(|(&l, &h)| {
+                let m = 0.5 * l + 0.5 * h;
+                let half = (Interval::point(h) - Interval::point(m))
+                    .hi()
+                    .max((Interval::point(m) - Interval::point(l)).hi());
+                (m, Interval::point(half))
+            })
+            .unzip();
+        // |d|_P^2 <= sum_ij |P_ij| |d_i| |d_j| over the box, rounded up.
+        let p = &member.constants.metric;
+        let n = half.len();
+        let mut q = Interval::ZERO;
+        if p.len() == n * n {
+            for i in 0..n {
+                for j in 0..n {
+                    q += Interval::point(p[i * n + j].abs()) * half[i] * half[j];
+                }
+            }
+        } else {
+            q = Interval::point(f64::INFINITY);
+        }
+        let radius = q.sqrt().hi();
+        StepJson {
+            det_set: DetSetJson {
+                shape: "box",
+                center: center.into(),
+                radius,
+                metric: "constants.metric",
+                lo: Some(lo.into()),
+                hi: Some(hi.into()),
+                hull_lo: None,
+                hull_hi: None,
+                generators: None,
+                remainder: None,
+            },
+            r_t: 0.0,
+            r_pointwise: 0.0,
+            prs_radius: radius,
+            ..full
+        }
+    }
+
     fn of(prs: &'a Prs, k: usize) -> StepJson<'a> {
         let st = &prs.steps[k];
         let (prs_lo, prs_hi) = prs
@@ -474,11 +621,11 @@ impl<'a> StepJson<'a> {
             nominal: st.nominal(),
             det_set: DetSetJson {
                 shape: st.det.shape(),
-                center: st.det.center(),
+                center: st.det.center().into(),
                 radius: st.det.radius(),
                 metric: "constants.metric",
-                lo,
-                hi,
+                lo: lo.map(Cow::from),
+                hi: hi.map(Cow::from),
                 hull_lo,
                 hull_hi,
                 generators: zonotope.then(|| st.det.generators()),
@@ -1426,5 +1573,44 @@ fn box_table(prs: &Prs, s: &mut String) {
         }
         let _ = write!(row, "  {:>12.6}", st.r_t);
         let _ = writeln!(s, "{row}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::inline_scalar_arrays;
+
+    /// Arrays of scalars go on one line, other arrays keep one item per line, and the text
+    /// parses back to the same value (strings holding brackets, commas and escapes included).
+    #[test]
+    fn scalar_arrays_inline() {
+        let v = serde_json::json!({
+            "states": ["x[1]", "y, [z]", "q\"[", ""],
+            "lo": [1.0, -2.5e-300, null],
+            "empty": [],
+            "nested": [[1, 2], [3]],
+            "objects": [{"a": [true, false]}, {"b": {}}],
+            "mixed": [1, [2], {"c": 3}],
+        });
+        let pretty = serde_json::to_string_pretty(&v).unwrap();
+        let inline = inline_scalar_arrays(&pretty);
+        let back: serde_json::Value = serde_json::from_str(&inline).unwrap();
+        assert_eq!(back, v);
+        assert!(
+            inline.contains(r#""states": ["x[1]", "y, [z]", "q\"[", ""]"#),
+            "{inline}"
+        );
+        assert!(
+            inline.contains(r#""lo": [1.0, -2.5e-300, null],"#),
+            "{inline}"
+        );
+        assert!(inline.contains("\"empty\": [],"), "{inline}");
+        assert!(inline.contains("    [1, 2],\n    [3]\n"), "{inline}");
+        assert!(inline.contains("\"a\": [true, false]"), "{inline}");
+        assert!(
+            inline.contains("\"mixed\": [\n    1,\n    [2],\n"),
+            "{inline}"
+        );
+        assert!(inline.len() < pretty.len());
     }
 }

@@ -1,7 +1,7 @@
 //! Renderings of a Monte Carlo [`SimReport`]: JSON (documented in docs/results.md) and a text
 //! summary.
 
-use super::result::unsafe_kind;
+use super::result::{inline_scalar_arrays, unsafe_kind};
 use super::{count, summary_indices, time};
 use reachc_core::model::Guarantee;
 use reachc_core::simulate::{
@@ -11,10 +11,13 @@ use reachc_core::simulate::{
 use serde::Serialize;
 use std::fmt::Write as _;
 
-/// Pretty-printed JSON of a report (non-finite numbers as `null`).
+/// Pretty-printed JSON of a report (arrays of scalars on one line, non-finite numbers as
+/// `null`).
 pub fn to_json(r: &SimReport) -> String {
     // Plain data with string keys: serialising cannot fail.
-    serde_json::to_string_pretty(&Json::of(r)).expect("a Monte Carlo report serialises")
+    let pretty =
+        serde_json::to_string_pretty(&Json::of(r)).expect("a Monte Carlo report serialises");
+    inline_scalar_arrays(&pretty)
 }
 
 /// The JSON document, field for field.
