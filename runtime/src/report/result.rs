@@ -31,7 +31,7 @@ pub fn to_json_with(prs: &Prs, probability: Option<&SafetyProbability>) -> Strin
 }
 
 /// [`to_json_with`] for a size budget of `budget` bytes: where the file would be larger with the
-/// members of the intersection written in full (first-order and linearised zonotopes over
+/// members of the intersection written in full (estimated from the count of their numbers) (first-order and linearised zonotopes over
 /// thousands of report times: a 12-state chain at 5000 report times wrote 235 MB), each member
 /// is written as its PRS's bounding box per report time instead (`"boxed": true`; a larger set,
 /// so still a PRS; the result's own sets, boxes, margins and verdicts are unchanged).
@@ -45,13 +45,20 @@ pub fn to_json_within(prs: &Prs, probability: Option<&SafetyProbability>, budget
         // Plain data with string keys: serialising cannot fail.
         inline_scalar_arrays(&serde_json::to_string_pretty(&json).expect("a result serialises"))
     };
-    let full = write(false);
-    if full.len() > budget && !prs.also.is_empty() {
-        write(true)
-    } else {
-        full
-    }
+    // The members' sets dominate such a file: each number in it takes about 20 bytes (the
+    // budget is checked on that count before anything is written, rather than on a text of
+    // hundreds of megabytes).
+    let numbers: usize = prs
+        .also
+        .iter()
+        .flat_map(|m| &m.steps)
+        .map(|st| (st.det.generators().len() + 4) * st.det.center().len())
+        .sum();
+    write(numbers.saturating_mul(BYTES_PER_NUMBER) > budget)
 }
+
+/// About what one number takes in a result file (17 significant digits, a separator).
+const BYTES_PER_NUMBER: usize = 20;
 
 /// serde_json's pretty output with every array of scalars (numbers, strings, `null`, booleans)
 /// on one line: `[\n  1.0,\n  2.0\n]` becomes `[1.0, 2.0]` (half the size of a result file, and
