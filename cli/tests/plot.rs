@@ -492,3 +492,33 @@ fn envelope_and_reference_trajectory_of_the_unicycle() {
     assert!(plain.matches("<polygon").count() < 20);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn goals_are_reported_and_drawn() {
+    let dir = temp_dir("goals");
+    let plots = dir.join("plots");
+    let o = run_and_plot("../tests/good/goals.sde", &dir, &["--plot-paths", "10"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    for line in [
+        "goal `home` (reach within [1, 4]): reached: with probability at least 0.999",
+        "goal `park` (reach within [2, 4] and stay): reached",
+        "goal `lane` (reach within [0, 4]): reached",
+        "goal `far` (reach within [0, 4]): NOT SHOWN REACHED",
+    ] {
+        assert!(text(&o).contains(line), "{line}\n{}", text(&o));
+    }
+    let sets = svg(&plots.join("contraction_sets.svg"));
+    // `far` is outside the view (it bounds x only, beyond the sets): not drawn.
+    assert!(
+        sets.contains("goal: home, park, lane"),
+        "the legend names the goals"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/contraction.json")).unwrap())
+            .unwrap();
+    let goals = json["goals"].as_array().unwrap();
+    assert_eq!(goals.len(), 4);
+    assert_eq!(goals[0]["status"], "reached");
+    assert_eq!(goals[3]["why"]["kind"], "not_inside");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

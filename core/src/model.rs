@@ -59,6 +59,8 @@ pub struct ModelInfo {
     pub constant_diffusion: bool,
     /// Unsafe sets.
     pub unsafe_sets: Vec<UnsafeSet>,
+    /// Goal sets (reach-avoid and reach-and-stay questions, method.md 8.13).
+    pub goals: Vec<GoalSet>,
     /// The analyses, with their certified constants.
     pub analyses: Vec<Analysis>,
 }
@@ -140,7 +142,23 @@ pub struct UnsafeSet {
     pub shape: UnsafeShape,
 }
 
-/// Shapes of unsafe sets.
+/// A named goal set (method.md 8.13): the state should enter it at some time in `window`
+/// (and, with `stay`, remain in it until the window's end), avoiding every unsafe set until
+/// then.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GoalSet {
+    /// Its name.
+    pub name: String,
+    /// The goal is the intersection of these regions (each read as the set it describes, as
+    /// for an unsafe set of that shape).
+    pub parts: Vec<UnsafeShape>,
+    /// The times at which entering counts, `[t1, t2]`; `None`: an analysis' whole horizon.
+    pub window: Option<Bounds>,
+    /// Reach and stay: once entered, the state must remain in the goal until the window ends.
+    pub stay: bool,
+}
+
+/// Shapes of unsafe sets (and of the parts of goal sets).
 #[derive(Clone, Debug, PartialEq)]
 pub enum UnsafeShape {
     /// A box over some states (the others unconstrained): `(state, bounds)` pairs.

@@ -11,7 +11,7 @@
 
 use crate::engine::{self, Detail, RunError, Setting};
 use crate::model::Guarantee;
-use crate::prs::{Prs, Validation, Verdict};
+use crate::prs::{GoalMiss, GoalOutcome, GoalVerdict, Prs, Validation, Verdict};
 use crate::reach::Reach;
 
 /// The smallest `delta` tried: below it the bound is reported as `1 - 1e-15`.
@@ -87,7 +87,72 @@ pub enum SafetyLimit {
     },
 }
 
+/// A bisection in `log(delta)` over full runs, for a question each run answers yes or no.
+struct Search {
+    /// The smallest `delta` shown, with its result.
+    best: Option<(f64, Prs)>,
+    /// The largest `delta` not shown, with its result (an error counts as not shown).
+    worst: Option<(f64, Result<Prs, RunError>)>,
+    /// The runs made.
+    runs: usize,
+    /// The validation of the run at the analysis' own `delta`.
+    own_validation: Validation,
+}
+
 impl Reach<'_> {
+    /// The smallest `delta` in `[DELTA_FLOOR, DELTA_CEILING]` whose run is `shown`, to within
+    /// [`RESOLUTION`] of a `delta` that is not: from the analysis' own `delta`, then the floor
+    /// (if shown there) or the ceiling (if not, and `hopeful` of that run), then bisection.
+    /// Errors: the run at the analysis' own `delta` fails.
+    fn bisect(
+        &self,
+        shown: impl Fn(&Prs) -> bool,
+        hopeful: impl Fn(&Prs) -> bool,
+    ) -> Result<Search, RunError> {
+        let spec = self.analysis();
+        let mut runs = 0;
+        let mut run = |delta: f64| {
+            runs += 1;
+            self.run_at(delta)
+        };
+        let own = run(spec.delta)?;
+        let own_validation = own.validation.clone();
+        let mut best: Option<(f64, Prs)> = None;
+        let mut worst: Option<(f64, Result<Prs, RunError>)> = None;
+        if shown(&own) {
+            best = Some((spec.delta, own));
+            match run(DELTA_FLOOR) {
+                Ok(p) if shown(&p) => best = Some((DELTA_FLOOR, p)),
+                other => worst = Some((DELTA_FLOOR, other)),
+            }
+        } else {
+            let try_ceiling = hopeful(&own) && spec.delta < DELTA_CEILING;
+            worst = Some((spec.delta, Ok(own)));
+            if try_ceiling {
+                match run(DELTA_CEILING) {
+                    Ok(p) if shown(&p) => best = Some((DELTA_CEILING, p)),
+                    other => worst = Some((DELTA_CEILING, other)),
+                }
+            }
+        }
+        while let (Some((hi, _)), Some((lo, _))) = (&best, &worst) {
+            if *hi <= *lo * RESOLUTION {
+                break;
+            }
+            let mid = (0.5 * (hi.ln() + lo.ln())).exp();
+            match run(mid) {
+                Ok(p) if shown(&p) => best = Some((mid, p)),
+                other => worst = Some((mid, other)),
+            }
+        }
+        Ok(Search {
+            best,
+            worst,
+            runs,
+            own_validation,
+        })
+    }
+
     /// A certified lower bound of the probability of safety on `[0, T]` for every start in the
     /// spec's initial set and every input in its input box (method.md 8.9): the smallest
     /// `delta` in `[1e-15, 0.5]` whose PRS avoids every unsafe set, found by bisection in
@@ -112,45 +177,16 @@ impl Reach<'_> {
                 "a probability of safety needs unsafe sets (the model has none)",
             )));
         }
-        let mut runs = 0;
-        let mut run = |delta: f64| {
-            runs += 1;
-            self.run_at(delta)
-        };
-        let own = run(spec.delta)?;
-        let own_validation = own.validation.clone();
-        let safe = |p: &Prs| p.verdict == Verdict::Safe;
-        // (delta, its result) of the smallest delta shown safe, and the largest not shown safe
-        // with its result (an error counts as not shown safe).
-        let mut best: Option<(f64, Prs)> = None;
-        let mut worst: Option<(f64, Result<Prs, RunError>)> = None;
-        if safe(&own) {
-            best = Some((spec.delta, own));
-            let at_floor = run(DELTA_FLOOR);
-            match at_floor {
-                Ok(p) if safe(&p) => best = Some((DELTA_FLOOR, p)),
-                other => worst = Some((DELTA_FLOOR, other)),
-            }
-        } else {
-            let limit = engine::deterministic_limit(sets, &own);
-            worst = Some((spec.delta, Ok(own)));
-            if limit.is_none() && spec.delta < DELTA_CEILING {
-                match run(DELTA_CEILING) {
-                    Ok(p) if safe(&p) => best = Some((DELTA_CEILING, p)),
-                    other => worst = Some((DELTA_CEILING, other)),
-                }
-            }
-        }
-        while let (Some((hi, _)), Some((lo, _))) = (&best, &worst) {
-            if *hi <= *lo * RESOLUTION {
-                break;
-            }
-            let mid = (0.5 * (hi.ln() + lo.ln())).exp();
-            match run(mid) {
-                Ok(p) if safe(&p) => best = Some((mid, p)),
-                other => worst = Some((mid, other)),
-            }
-        }
+        let search = self.bisect(
+            |p| p.verdict == Verdict::Safe,
+            |own| engine::deterministic_limit(sets, own).is_none(),
+        )?;
+        let (best, worst, runs, own_validation) = (
+            search.best,
+            search.worst,
+            search.runs,
+            search.own_validation,
+        );
         let limit = match (&best, &worst) {
             (_, Some((delta, Err(e)))) => SafetyLimit::Failed {
                 delta: *delta,
@@ -182,6 +218,121 @@ impl Reach<'_> {
             limit,
             runs,
             validation,
+        })
+    }
+}
+
+/// A certified lower bound of the probability of reaching a goal set (method.md 8.13): of
+/// entering it at some time of its window, having avoided every unsafe set until then (with
+/// `stay`: and of remaining in it, away from the unsafe sets, until the window ends), for
+/// every start in the initial set and every input in the input box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GoalProbability {
+    /// The goal (index into the model's goal sets).
+    pub goal: usize,
+    /// The smallest `delta` tried whose PRS shows the goal reached: `P >= 1 - delta`; `None`
+    /// when no `delta` up to [`DELTA_CEILING`] does.
+    pub delta: Option<f64>,
+    /// The first report time at which the goal is shown reached at `delta`.
+    pub t: Option<f64>,
+    /// The largest `delta` tried whose PRS does not show it, `None` if every one tried does.
+    pub not_shown_at: Option<f64>,
+    /// What stops the bound from being higher.
+    pub limit: GoalLimit,
+    /// The runs made (each a full analysis).
+    pub runs: usize,
+    /// Which parts of the run at `delta` (at the analysis' own `delta` when there is no bound)
+    /// are proved: the bound is proved only if they all are.
+    pub validation: Validation,
+}
+
+impl GoalProbability {
+    /// The lower bound `1 - delta` rounded down to a double (`None` without a bound).
+    pub fn lower_bound(&self) -> Option<f64> {
+        self.delta.map(|d| (1.0 - d).next_down())
+    }
+}
+
+/// What limits a [`GoalProbability`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum GoalLimit {
+    /// The bisection's resolution (see [`SafetyLimit::Resolution`]).
+    Resolution,
+    /// Shown at [`DELTA_FLOOR`], the smallest `delta` tried.
+    Floor,
+    /// Not shown even at the largest `delta` tried (at most [`DELTA_CEILING`]), for this
+    /// reason.
+    NotShown(GoalMiss),
+    /// A run failed at `delta`, the smallest `delta` tried after the last one shown: treated
+    /// as not shown.
+    Failed {
+        /// The `delta` whose run failed.
+        delta: f64,
+        /// Why it failed.
+        why: RunError,
+    },
+}
+
+impl Reach<'_> {
+    /// A certified lower bound of the probability of reaching goal `goal` (an index into the
+    /// model's goal sets) as [`GoalProbability`] says, by the same bisection over `delta` as
+    /// [`Reach::safety_probability`]: each `delta` a full sound run, the smallest whose
+    /// time-uniform PRS shows the goal reached kept.
+    ///
+    /// Errors: a pointwise guarantee, no goal `goal`, or a run at the analysis' own `delta`
+    /// that fails.
+    pub fn goal_probability(&self, goal: usize) -> Result<GoalProbability, RunError> {
+        if self.analysis().guarantee != Guarantee::Uniform {
+            return Err(RunError::Unsupported(
+                Detail::from(
+                    "a probability of reaching a goal needs `guarantee = uniform` (a pointwise \
+                     PRS bounds each time separately, not the path)",
+                )
+                .at_setting(Setting::Guarantee),
+            ));
+        }
+        if goal >= self.model().goals.len() {
+            return Err(RunError::Invalid(
+                format!(
+                    "no goal {goal}: the model has {} goal sets",
+                    self.model().goals.len()
+                )
+                .into(),
+            ));
+        }
+        let reached = |p: &Prs| p.goals.get(goal).is_some_and(GoalVerdict::reached);
+        let search = self.bisect(reached, |_| true)?;
+        let limit = match (&search.best, &search.worst) {
+            (_, Some((delta, Err(e)))) => GoalLimit::Failed {
+                delta: *delta,
+                why: e.clone(),
+            },
+            (Some(_), None) => GoalLimit::Floor,
+            (Some(_), Some(_)) => GoalLimit::Resolution,
+            (None, Some((_, Ok(p)))) => match p.goals.get(goal).map(|g| &g.outcome) {
+                Some(GoalOutcome::NotShown(miss)) => GoalLimit::NotShown(miss.clone()),
+                // (Not reached: a result in `worst` does not show the goal reached.)
+                _ => GoalLimit::Resolution,
+            },
+            (None, None) => unreachable!("the run at the analysis' delta is kept"),
+        };
+        let t = search.best.as_ref().and_then(|(_, p)| {
+            p.goals.get(goal).and_then(|g| match g.outcome {
+                GoalOutcome::Reached { t, .. } => Some(t),
+                _ => None,
+            })
+        });
+        Ok(GoalProbability {
+            goal,
+            delta: search.best.as_ref().map(|(d, _)| *d),
+            t,
+            not_shown_at: search.worst.as_ref().map(|(d, _)| *d),
+            limit,
+            runs: search.runs,
+            validation: match &search.best {
+                Some((_, p)) => p.validation.clone(),
+                None => search.own_validation,
+            },
         })
     }
 }

@@ -75,6 +75,8 @@ pub struct Prs {
     pub steps: Vec<Step>,
     /// Per unsafe set, its verdict over the whole horizon.
     pub unsafe_sets: Vec<UnsafeVerdict>,
+    /// Per goal set of the model, what the result shows (method.md 8.13).
+    pub goals: Vec<GoalVerdict>,
     /// The overall verdict.
     pub verdict: Verdict,
     /// Which parts are proved and which are not.
@@ -455,6 +457,16 @@ pub(crate) enum Prepared<'a> {
     Zonotope(&'a zonotope::ZonotopeTest),
 }
 
+/// `hull` cut by the box `other`, both holding the same set (an intersection's members): an
+/// empty cut cannot happen for sets holding the same nominal state, but stays a valid
+/// (degenerate) box.
+fn cut(hull: &mut [Bounds], other: &[Bounds]) {
+    for (b, o) in hull.iter_mut().zip(other) {
+        let lo = b.lo.max(o.lo);
+        *b = Bounds::new(lo, b.hi.min(o.hi).max(lo));
+    }
+}
+
 /// Whether `|x - c|_P <= r` certainly (interval arithmetic), `p` n x n row-major (both
 /// off-diagonal entries, so a slightly asymmetric `P` is used as given).
 pub(crate) fn within(p: &[f64], x: &[f64], c: &[f64], r: f64) -> bool {
@@ -607,6 +619,82 @@ pub enum Verdict {
         /// Index of the unsafe set in [`Prs::unsafe_sets`].
         set: usize,
     },
+}
+
+/// What a result shows about one goal set of the model (method.md 8.13).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GoalVerdict {
+    /// The goal's name.
+    pub name: String,
+    /// The times at which entering counts: the goal's window, or `[0, T]`.
+    pub window: Bounds,
+    /// Reach and stay (the state must remain in the goal until the window ends).
+    pub stay: bool,
+    /// Per report time, how far the PRS lies inside the goal: the smallest Euclidean gap
+    /// between its bounding box and the goal's boundary (for a half-space or a ball part), or
+    /// per coordinate (for a box part), rounded down; not positive where it is not shown
+    /// inside.
+    pub margins: Vec<f64>,
+    /// What is shown.
+    pub outcome: GoalOutcome,
+}
+
+/// The outcome of a [`GoalVerdict`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum GoalOutcome {
+    /// With probability at least `1 - delta`, for every start and input: the state is in the
+    /// goal at report time `t` (in the window), having avoided every unsafe set on `[0, t]`;
+    /// with `stay`, it also remains in the goal, and away from the unsafe sets, until the
+    /// window ends.
+    Reached {
+        /// The first report time at which this is shown.
+        t: f64,
+        /// The smallest containment margin involved (at `t`, and with `stay` over the report
+        /// intervals to the window's end).
+        margin: f64,
+    },
+    /// Not shown (this does not prove that the goal is missed).
+    NotShown(GoalMiss),
+    /// A pointwise result bounds each time separately, not the path: no reach-avoid verdict.
+    NeedsUniform,
+}
+
+/// Why a goal is not shown reached.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GoalMiss {
+    /// No report time lies in the window.
+    NoReportTime,
+    /// The tube may meet unsafe set `set` (index into [`Prs::unsafe_sets`]) over the report
+    /// interval ending at `t`, before the goal is shown reached (with `stay`: before the
+    /// window ends).
+    Unsafe {
+        /// Report time.
+        t: f64,
+        /// Unsafe set index.
+        set: usize,
+    },
+    /// At no report time in the window is the PRS shown inside the goal: the largest margin,
+    /// and when.
+    NotInside {
+        /// Report time of the largest margin.
+        t: f64,
+        /// That margin (not positive).
+        margin: f64,
+    },
+    /// The PRS is inside the goal at some report time in the window, but (the last such
+    /// time tried) the tube over the report interval ending at `t`, before the window ends, is
+    /// not shown inside.
+    Leaves {
+        /// Report time.
+        t: f64,
+    },
+}
+
+impl GoalVerdict {
+    /// Whether the goal is shown reached.
+    pub fn reached(&self) -> bool {
+        matches!(self.outcome, GoalOutcome::Reached { .. })
+    }
 }
 
 /// Which parts of the result are proved.
@@ -792,6 +880,19 @@ impl Prs {
         )
     }
 
+    /// A rigorous bounding box of the PRS over every time of the report interval ending at
+    /// step `k` (step 0: at `t = 0`): this result's own span box widened by its P-ball, cut by
+    /// its members' (an intersection holds the state in each); a split result's is the union's
+    /// (the box of its pieces' spans). `None` if [`ConstantsUsed::spread`] is missing. Panics
+    /// if `k` is out of range.
+    pub fn span_hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
+        let mut hull = self.own_span_hull_at(k)?;
+        for m in &self.also {
+            cut(&mut hull, &m.own_span_hull_at(k)?);
+        }
+        Some(hull)
+    }
+
     /// [`Prs::span_contains`] for this result's own metric.
     pub(crate) fn own_span_contains(&self, k: usize, x: &[f64]) -> bool {
         let span = &self.steps[k].span;
@@ -926,11 +1027,7 @@ impl Prs {
     pub fn hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
         let mut hull = self.own_hull_at(k)?;
         for m in &self.also {
-            for (b, o) in hull.iter_mut().zip(m.own_hull_at(k)?) {
-                // Both hold the intersection, so theirs does; an empty one cannot happen for
-                // sets holding the same nominal state, but stays a valid (degenerate) box.
-                *b = Bounds::new(b.lo.max(o.lo), b.hi.min(o.hi).max(b.lo.max(o.lo)));
-            }
+            cut(&mut hull, &m.own_hull_at(k)?);
         }
         Some(hull)
     }

@@ -210,7 +210,20 @@ impl<'a> Reach<'a> {
         self.run_spec(&spec, &self.info.initial, Inputs::Box)
     }
 
+    /// The result of `own` from `initial` with its goal verdicts (method.md 8.13), read off
+    /// the finished result (the union of a split, the intersection of members).
     fn run_spec(
+        &self,
+        own: &AnalysisSpec,
+        initial: &InitialSet,
+        inputs: Inputs,
+    ) -> Result<Prs, RunError> {
+        let mut prs = self.run_sets(own, initial, inputs)?;
+        prs.goals = engine::goals::assess(&self.info.goals, &prs);
+        Ok(prs)
+    }
+
+    fn run_sets(
         &self,
         own: &AnalysisSpec,
         initial: &InitialSet,

@@ -160,6 +160,7 @@ fn info(
 ) -> ModelInfo {
     let n = states.len();
     ModelInfo {
+        goals: Vec::new(),
         name: name.into(),
         states: states.iter().map(|s| s.to_string()).collect(),
         inputs: (0..input_box.len()).map(|j| format!("u{j}")).collect(),

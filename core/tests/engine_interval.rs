@@ -90,6 +90,7 @@ fn run_with(
 
 fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
     ModelInfo {
+        goals: Vec::new(),
         name: "lin".into(),
         states: vec!["x".into()],
         inputs: vec!["u".into()],
@@ -115,6 +116,7 @@ fn lin_constants() -> Constants {
 fn pendulum_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
     let th = std::f64::consts::PI / 10.0;
     ModelInfo {
+        goals: Vec::new(),
         name: "pendulum".into(),
         states: vec!["theta".into(), "omega".into()],
         inputs: vec![],

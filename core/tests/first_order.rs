@@ -21,6 +21,7 @@ const HALF: [f64; 2] = [std::f64::consts::PI / 10.0, 0.2];
 /// of `method` with the defaults (validated steps, time-uniform tube, local rates).
 fn setup(method: Method) -> (ModelInfo, Analysis) {
     let info = ModelInfo {
+        goals: Vec::new(),
         name: "pend".into(),
         states: vec!["theta".into(), "omega".into()],
         inputs: vec![],

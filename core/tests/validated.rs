@@ -108,6 +108,7 @@ fn forced_exact(x0: f64, t: f64) -> f64 {
 fn model(name: &str, x0: &[(f64, f64)], c: f64) -> ModelInfo {
     let n = x0.len();
     let mut info = ModelInfo {
+        goals: Vec::new(),
         name: name.into(),
         states: (0..n).map(|i| format!("x{i}")).collect(),
         inputs: vec![],

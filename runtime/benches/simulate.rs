@@ -77,6 +77,7 @@ impl System for Linear {
 /// The `amgf_rule` analysis of specs/linear.sde with the compiler's constants.
 fn info() -> ModelInfo {
     let mut info = ModelInfo {
+        goals: Vec::new(),
         name: "linear".into(),
         states: vec!["x1".into(), "x2".into()],
         inputs: vec![],

@@ -498,9 +498,13 @@ fn run_analyses<S: System + Sync>(
                 continue;
             }
         };
-        // The probability of safety, where it is asked for and defined.
+        // The probability of safety and of reaching each goal, where asked for and defined.
         let probability =
             (opts.probability && !info.unsafe_sets.is_empty()).then(|| reach.safety_probability());
+        let goal_probabilities: Vec<_> = (0..info.goals.len())
+            .filter(|_| opts.probability)
+            .map(|g| reach.goal_probability(g))
+            .collect();
         if !opts.quiet {
             let _ = write!(out, "{}", report::summary(&res));
             match &probability {
@@ -512,9 +516,29 @@ fn run_analyses<S: System + Sync>(
                 }
                 None => {}
             }
+            for (g, p) in goal_probabilities.iter().enumerate() {
+                let _ = match p {
+                    Ok(p) => writeln!(
+                        out,
+                        "  {}",
+                        report::probability::goal_line(
+                            &info.goals,
+                            &info.unsafe_sets,
+                            res.horizon,
+                            p
+                        )
+                    ),
+                    Err(why) => writeln!(
+                        out,
+                        "  probability of reaching `{}`: not computed: {why}",
+                        info.goals[g].name
+                    ),
+                };
+            }
             let _ = writeln!(out);
         }
         let probability = probability.and_then(Result::ok);
+        let goal_probabilities: Vec<_> = goal_probabilities.into_iter().flatten().collect();
         not_safe |= matches!(res.verdict, reachc_core::prs::Verdict::NotShownSafe { .. });
         let mut csv = Vec::new();
         // Writing into memory cannot fail.
@@ -522,7 +546,14 @@ fn run_analyses<S: System + Sync>(
         let dir = &opts.out_dir;
         files.add(
             dir.join(format!("{name}.json")),
-            (report::to_json_with(&res, probability.as_ref()) + "\n").into(),
+            (report::to_json_with(
+                &res,
+                report::probability::Probabilities {
+                    safety: probability.as_ref(),
+                    goals: &goal_probabilities,
+                },
+            ) + "\n")
+                .into(),
         );
         files.add(dir.join(format!("{name}.csv")), csv);
     }

@@ -70,6 +70,7 @@ fn analysis(name: &str, method: Method, constants: bool) -> Analysis {
 
 fn model(analyses: Vec<Analysis>) -> ModelInfo {
     ModelInfo {
+        goals: Vec::new(),
         name: "decay".into(),
         states: vec!["x".into()],
         inputs: vec![],

@@ -98,6 +98,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
         metric[i * n + i] = 1.0;
     }
     let mut info = ModelInfo {
+        goals: Vec::new(),
         name: "linear".into(),
         states: (1..=n).map(|i| format!("x{i}")).collect(),
         inputs: if sys.b != 0.0 {

@@ -72,6 +72,7 @@ fn dual_norm(a: &[f64]) -> f64 {
 
 fn model() -> ModelInfo {
     let mut info = ModelInfo {
+        goals: Vec::new(),
         name: "decay".into(),
         states: vec!["x".into(), "y".into()],
         inputs: vec![],

@@ -70,7 +70,7 @@ pub fn reflection_factor(n: usize, epochs: usize, delta: f64) -> f64 {
 
 /// `Q(z) = P(N(0, 1) > z)` for `z >= 1`: `phi(z) / (z + 1/(z + 2/(z + 3/(z + ...))))`
 /// (Laplace's continued fraction), evaluated backwards from 500 terms.
-fn normal_tail(z: f64) -> f64 {
+pub fn normal_tail(z: f64) -> f64 {
     let cf = (1..500).rev().fold(z, |acc, k| z + f64::from(k) / acc);
     (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt() / cf
 }

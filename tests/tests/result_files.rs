@@ -21,8 +21,8 @@ fn members_over_budget_are_written_as_their_bounding_boxes() {
         prs.also.len() >= 2,
         "the pendulum's contraction run has members"
     );
-    let full_text = to_json_within(&prs, None, usize::MAX);
-    let boxed_text = to_json_within(&prs, None, 0);
+    let full_text = to_json_within(&prs, Default::default(), usize::MAX);
+    let boxed_text = to_json_within(&prs, Default::default(), 0);
     assert!(boxed_text.len() < full_text.len());
     let (full, boxed): (Value, Value) = (
         serde_json::from_str(&full_text).unwrap(),

@@ -198,6 +198,7 @@ struct Doc<'a> {
     unbounded: Vec<UnboundedDoc<'a>>,
     #[serde(rename = "unsafe")]
     unsafe_sets: Vec<Value>,
+    goals: Vec<Value>,
     analyses: Vec<Value>,
 }
 
@@ -299,7 +300,21 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             })
             .collect(),
         unbounded,
-        unsafe_sets: model.unsafe_sets.iter().map(|u| unsafe_json(model, u)).collect(),
+        unsafe_sets: model
+            .unsafe_sets
+            .iter()
+            .map(|u| shape_json(model, &u.name, &u.shape))
+            .collect(),
+        goals: model
+            .goals
+            .iter()
+            .map(|g| {
+                let parts: Vec<Value> =
+                    g.parts.iter().map(|p| shape_json(model, &g.name, p)).collect();
+                json!({"name": g.name, "parts": parts,
+                       "window": g.window.map(|w| [w.lo, w.hi]), "stay": g.stay})
+            })
+            .collect(),
         analyses: model
             .analyses
             .iter()
@@ -315,19 +330,20 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out)
 }
 
-fn unsafe_json(model: &Model, u: &reachc_compiler::model::UnsafeSet) -> Value {
+/// An unsafe set, or a part of goal `set`, in the `inspect --json` document.
+fn shape_json(model: &Model, set: &str, shape: &UnsafeShape) -> Value {
     let name = |i: &usize| model.states[*i].name.clone();
-    match &u.shape {
-        UnsafeShape::Box(sides) => json!({"name": u.name, "kind": "box",
+    match shape {
+        UnsafeShape::Box(sides) => json!({"name": set, "kind": "box",
             "sides": sides.iter().map(|(i, b)| json!({"state": name(i), "range": [b.lo, b.hi]})).collect::<Vec<_>>()}),
         UnsafeShape::Ball {
             states,
             center,
             radius,
-        } => json!({"name": u.name, "kind": "ball",
+        } => json!({"name": set, "kind": "ball",
             "over": states.iter().map(name).collect::<Vec<_>>(), "center": center, "radius": radius}),
         UnsafeShape::HalfSpace { normal, offset } => {
-            json!({"name": u.name, "kind": "halfspace", "normal": normal, "offset": offset})
+            json!({"name": set, "kind": "halfspace", "normal": normal, "offset": offset})
         }
     }
 }

@@ -12,8 +12,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::font::FAMILY;
-use super::geometry::Point;
+use super::geometry::{clip, half_planes, Point};
 use super::output::Draw;
+use super::regions::Region;
 use super::scene::{RadiusScene, RatesScene, SetsScene, WidthsScene};
 use reachc_runtime::report::count;
 
@@ -38,6 +39,8 @@ const PALETTE: [RGBColor; 7] = [
     RGBColor(23, 190, 207),
 ];
 const UNSAFE: RGBColor = RGBColor(214, 39, 40);
+/// Goal sets (olive: not one of the first eight report times' colours).
+const GOAL: RGBColor = RGBColor(188, 189, 34);
 const PATHS: RGBColor = RGBColor(100, 100, 100);
 /// Fill of the union of the PRS over the horizon (opaque, so overlaps do not darken).
 const ENVELOPE: RGBColor = RGBColor(178, 223, 138);
@@ -254,7 +257,12 @@ impl Draw for SetsScene {
         let (i, f) = (|v: i32| v * s as i32, |v: u32| f64::from(v * s));
         let (plot_area, legend_area) = panels(area, s);
         // The view holds the sets, the paths and the bounded unsafe sets.
-        let bounded = self.regions.iter().filter_map(|(_, r)| r.bounds());
+        let bounded = self
+            .regions
+            .iter()
+            .map(|(_, r)| r)
+            .chain(self.goals.iter().flat_map(|(_, parts)| parts))
+            .filter_map(Region::bounds);
         let (vx, vy) = view(
             self.slices
                 .iter()
@@ -278,21 +286,34 @@ impl Draw for SetsScene {
         )?;
         let mut entries = Vec::new();
 
-        // Unsafe sets first: everything else is drawn over them.
-        let unsafe_fill = UNSAFE.mix(0.22);
-        for (name, region) in &self.regions {
-            let poly = region.polygon_in(vx, vy);
+        // Unsafe sets and goals (a goal as the intersection of its parts' projections) first:
+        // everything else is drawn over them.
+        let (unsafe_fill, goal_fill) = (UNSAFE.mix(0.22), GOAL.mix(0.12));
+        let unsafe_sets = self
+            .regions
+            .iter()
+            .map(|(name, r)| (false, name, r.polygon_in(vx, vy)));
+        let goals = self.goals.iter().map(|(name, parts)| {
+            let first = parts[0].polygon_in(vx, vy);
+            let poly = parts[1..].iter().fold(first, |poly, r| {
+                clip(&poly, &half_planes(&r.polygon_in(vx, vy)))
+            });
+            (true, name, poly)
+        });
+        let mut goals_drawn = Vec::new();
+        for (goal, name, poly) in unsafe_sets.chain(goals) {
             if poly.len() < 3 {
                 continue;
             }
+            let (fill, line, label) = match goal {
+                false => (unsafe_fill, UNSAFE.stroke_width(s), RGBColor(150, 20, 20)),
+                true => (goal_fill, GOAL.stroke_width(2 * s), RGBColor(110, 110, 10)),
+            };
             chart
-                .draw_series(std::iter::once(Polygon::new(
-                    closed(&poly),
-                    unsafe_fill.filled(),
-                )))
+                .draw_series(std::iter::once(Polygon::new(closed(&poly), fill.filled())))
                 .map_err(err)?;
             chart
-                .draw_series(LineSeries::new(closed(&poly), UNSAFE.stroke_width(s)))
+                .draw_series(LineSeries::new(closed(&poly), line))
                 .map_err(err)?;
             let n = poly.len() as f64;
             let c = (
@@ -300,17 +321,26 @@ impl Draw for SetsScene {
                 poly.iter().map(|p| p[1]).sum::<f64>() / n,
             );
             let style = TextStyle::from((FAMILY, f(14)).into_font())
-                .color(&RGBColor(150, 20, 20))
+                .color(&label)
                 .pos(Pos::new(HPos::Center, VPos::Center));
             chart
                 .draw_series(std::iter::once(Text::new(name.clone(), c, style)))
                 .map_err(err)?;
+            if goal {
+                goals_drawn.push(name.as_str());
+            }
         }
         if !self.regions.is_empty() {
             let names: Vec<&str> = self.regions.iter().map(|(n, _)| n.as_str()).collect();
             entries.push((
                 Mark::Fill(unsafe_fill),
                 format!("unsafe: {}", names.join(", ")),
+            ));
+        }
+        if !goals_drawn.is_empty() {
+            entries.push((
+                Mark::Fill(goal_fill),
+                format!("goal: {}", goals_drawn.join(", ")),
             ));
         }
 

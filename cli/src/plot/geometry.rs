@@ -237,6 +237,18 @@ fn quad(s: [[f64; 2]; 2], d: Point) -> f64 {
     (s[0][0] * d[0] * d[0] + 2.0 * s[0][1] * d[0] * d[1] + s[1][1] * d[1] * d[1]).max(0.0)
 }
 
+/// The half-planes `(n, c)` (`n . z <= c`) of a convex polygon with counter-clockwise vertices,
+/// one per edge, for [`clip`]: the outward normal of edge `(p, q)` is `q - p` turned right.
+pub fn half_planes(poly: &[Point]) -> Vec<(Point, f64)> {
+    (0..poly.len())
+        .map(|i| {
+            let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+            let n = [q[1] - p[1], p[0] - q[0]];
+            (n, n[0] * p[0] + n[1] * p[1])
+        })
+        .collect()
+}
+
 /// Clips a polygon to the convex region `{z : n . z <= c}` of each `(n, c)` (Sutherland and
 /// Hodgman); the result may be empty.
 pub fn clip(poly: &[Point], planes: &[(Point, f64)]) -> Vec<Point> {

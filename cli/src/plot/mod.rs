@@ -162,6 +162,32 @@ fn unsafe_regions(
     regions
 }
 
+/// The goal sets of `info` in the plane, each as its parts' projections (those that do not
+/// constrain the plane are left out; a goal none of whose parts does is listed in `notes`).
+fn goal_regions(
+    info: &ModelInfo,
+    plane: [usize; 2],
+    notes: &mut Vec<String>,
+) -> Vec<(String, Vec<Region>)> {
+    let mut goals = Vec::new();
+    for g in &info.goals {
+        let parts: Vec<Region> = g
+            .parts
+            .iter()
+            .filter_map(|p| Region::of(p, plane))
+            .collect();
+        if parts.is_empty() {
+            notes.push(format!(
+                "goal `{}` does not constrain the plotted states: not drawn",
+                g.name
+            ));
+        } else {
+            goals.push((g.name.clone(), parts));
+        }
+    }
+    goals
+}
+
 /// Records `choice.paths` sample paths at `times` (with `simulate`'s defaults: random inputs,
 /// Euler steps and input hold times of one report step).
 fn sample(
@@ -235,6 +261,7 @@ pub fn plot_result(
     let plane = Plane::new(states, &result.constants.metric)
         .ok_or("the result's metric is not positive definite")?;
     let mut notes = Vec::new();
+    let goals = model.map_or_else(Vec::new, |m| goal_regions(m.info, states, &mut notes));
     let (regions, paths) = match model {
         Some(m) => (
             unsafe_regions(m.info, states, &mut notes),
@@ -246,6 +273,7 @@ pub fn plot_result(
         }
     };
     let mut sets = scene::sets_scene(result, &plane, &picked, &paths, regions);
+    sets.goals = goals;
     if choice.envelope {
         sets.envelope = scene::envelope(result, &plane);
     }
@@ -319,6 +347,7 @@ pub fn plot_without_result(
     let regions = unsafe_regions(info, states, &mut notes);
     let paths = sample(model, &times, None, choice)?;
     let mut sets = scene::paths_scene(info, analysis, &plane, (&times, &picked), &paths, regions);
+    sets.goals = goal_regions(info, states, &mut sets.notes);
     sets.reference = reference(model, states);
     sets.notes.extend(notes);
     rendered(renderings(&sets, figures::SETS_SIZE, dir, &a.name, "sets"))

@@ -3,7 +3,7 @@
 //! the inputs here, drawn by [`super::figures`], so that the geometry can be tested without
 //! pixels.
 
-use super::geometry::{clip, Plane, Point, Projected};
+use super::geometry::{clip, half_planes, Plane, Point, Projected};
 use super::input::{Guarantee, Method, RateSource, ResultFile, Role, Shape, Step};
 use super::regions::Region;
 use super::Quantile;
@@ -31,6 +31,9 @@ pub struct SetsScene {
     pub paths: Vec<Vec<Point>>,
     /// Unsafe sets by name.
     pub regions: Vec<(String, Region)>,
+    /// Goal sets by name: the projections of their parts (the goal's projection lies in
+    /// their intersection).
+    pub goals: Vec<(String, Vec<Region>)>,
     /// Lines for the legend panel: what is drawn and what is not.
     pub notes: Vec<String>,
 }
@@ -268,15 +271,7 @@ fn intersected(result: &ResultFile, plane: &Plane, k: usize, poly: Vec<Point>) -
         let other = det_set(m, &mp, step)
             .plus_ellipse(mp.shape, step.r_t)
             .polygon();
-        // Counter-clockwise vertices: the outward normal of edge (p, q) is (q - p) turned right.
-        let planes: Vec<(Point, f64)> = (0..other.len())
-            .map(|i| {
-                let (p, q) = (other[i], other[(i + 1) % other.len()]);
-                let n = [q[1] - p[1], p[0] - q[0]];
-                (n, n[0] * p[0] + n[1] * p[1])
-            })
-            .collect();
-        clip(&poly, &planes)
+        clip(&poly, &half_planes(&other))
     })
 }
 
@@ -425,6 +420,7 @@ pub fn sets_scene(
         },
         paths,
         regions,
+        goals: Vec::new(),
         notes,
     }
 }
@@ -468,6 +464,7 @@ pub fn paths_scene(
         nominal_label: String::new(),
         paths,
         regions,
+        goals: Vec::new(),
         notes: vec![format!("no PRS: {why}")],
     }
 }

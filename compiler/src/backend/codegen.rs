@@ -41,9 +41,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
 use reachc_core::model::{
-    Analysis, AutoFit, Ball, Bounds, Constants, Guarantee, Inclusion, InitialSet, InputGain,
-    Integrator, MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Provenance, RadiusRule,
-    Rate, Split, TransformSource, UnsafeSet, UnsafeShape,
+    Analysis, AutoFit, Ball, Bounds, Constants, GoalSet, Guarantee, Inclusion, InitialSet,
+    InputGain, Integrator, MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Provenance,
+    RadiusRule, Rate, Split, TransformSource, UnsafeSet, UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -1488,7 +1488,21 @@ impl InfoWriter {
 
     fn unsafe_set(&mut self, u: &UnsafeSet) -> TokenStream {
         let name = string(&u.name);
-        let shape = match &u.shape {
+        let shape = self.shape(&u.shape);
+        quote!(UnsafeSet { name: #name, shape: #shape })
+    }
+
+    fn goal(&mut self, g: &GoalSet) -> TokenStream {
+        let name = string(&g.name);
+        let parts: Vec<TokenStream> = g.parts.iter().map(|p| self.shape(p)).collect();
+        let parts = list(parts);
+        let window = option(&g.window, |&w| range(w));
+        let stay = g.stay;
+        quote!(GoalSet { name: #name, parts: #parts, window: #window, stay: #stay })
+    }
+
+    fn shape(&mut self, shape: &UnsafeShape) -> TokenStream {
+        match shape {
             UnsafeShape::Box(sides) => {
                 let sides = list(sides.iter().map(|&(i, r)| {
                     let (i, r) = (int(i), range(r));
@@ -1509,8 +1523,7 @@ impl InfoWriter {
                 let (normal, offset) = (self.floats(normal), float(*offset));
                 quote!(UnsafeShape::HalfSpace { normal: #normal, offset: #offset })
             }
-        };
-        quote!(UnsafeSet { name: #name, shape: #shape })
+        }
     }
 
     fn constants(&mut self, c: &Constants, info: &ModelInfo) -> TokenStream {
@@ -1787,6 +1800,8 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
     let constant_diffusion = info.constant_diffusion;
     let unsafe_sets: Vec<TokenStream> = info.unsafe_sets.iter().map(|u| w.unsafe_set(u)).collect();
     let unsafe_sets = list(unsafe_sets);
+    let goals: Vec<TokenStream> = info.goals.iter().map(|g| w.goal(g)).collect();
+    let goals = list(goals);
     let analyses: Vec<TokenStream> = info.analyses.iter().map(|a| w.analysis(a, info)).collect();
     let analyses = list(analyses);
     let mut statics = w.statics;
@@ -1822,6 +1837,7 @@ fn info_fn(info: &ModelInfo) -> TokenStream {
                 affine: #affine,
                 constant_diffusion: #constant_diffusion,
                 unsafe_sets: #unsafe_sets,
+                goals: #goals,
                 analyses: #analyses,
             }
         }

@@ -86,6 +86,7 @@ pub fn prepare(model: &mut Model) -> Prepared {
             .flatten()
             .all(|e| model.pool.vars_of(*e).is_empty()),
         unsafe_sets: model.unsafe_sets.clone(),
+        goals: model.goals.clone(),
         analyses,
     };
     Prepared {

@@ -12,8 +12,9 @@ use reachc_core::engine::Setting;
 // The sets and analyses are the core's data model: the checker lowers straight into it and the
 // backends hand it on unchanged.
 pub use reachc_core::model::{
-    AnalysisSpec, Ball, Bounds, Guarantee, Inclusion, InitialSet, Integrator, Method, MetricChoice,
-    RadiusRule, Rate, Split, Transform, UnsafeSet, UnsafeShape, AUTO_PIECES, MAX_PIECES,
+    AnalysisSpec, Ball, Bounds, GoalSet, Guarantee, Inclusion, InitialSet, Integrator, Method,
+    MetricChoice, RadiusRule, Rate, Split, Transform, UnsafeSet, UnsafeShape, AUTO_PIECES,
+    MAX_PIECES,
 };
 
 /// A checked spec, ready for analysis and code generation.
@@ -47,6 +48,8 @@ pub struct Model {
     pub tables: Vec<Table>,
     /// Unsafe sets.
     pub unsafe_sets: Vec<UnsafeSet>,
+    /// Goal sets (method.md 8.13).
+    pub goals: Vec<GoalSet>,
     /// The analyses to run.
     pub analyses: Vec<Analysis>,
     /// Named constants with their values, in declaration order.

@@ -81,6 +81,20 @@ pub enum Item {
         /// The whole item.
         span: Span,
     },
+    /// `goal NAME KIND { ... } [and KIND { ... }]... [within [T1, T2]] [stay]` (method.md 8.13).
+    Goal {
+        /// The goal's name (used in verdicts).
+        name: Ident,
+        /// The sets whose intersection is the goal: each `box`, `ball` or `halfspace` with its
+        /// block, as for unsafe sets.
+        parts: Vec<(Ident, Block)>,
+        /// `within [T1, T2]`: when entering counts.
+        window: Option<Expr>,
+        /// `stay`: the word, if written.
+        stay: Option<Span>,
+        /// The whole item.
+        span: Span,
+    },
     /// `analysis NAME { key = value ... }`
     Analysis {
         /// The analysis name.

@@ -32,6 +32,7 @@ pub(crate) enum Kw {
     Domain,
     Initial,
     Unsafe,
+    Goal,
     Analysis,
 }
 
@@ -52,6 +53,7 @@ impl Kw {
             "domain" => Kw::Domain,
             "initial" => Kw::Initial,
             "unsafe" => Kw::Unsafe,
+            "goal" => Kw::Goal,
             "analysis" => Kw::Analysis,
             _ => return None,
         })

@@ -475,7 +475,7 @@ impl<'s> Parser<'s> {
                 _ => {
                     let mut help = "items start with a keyword: `model`, `const`, `state`, `input`, \
                                     `noise`, `table`, `let`, `for`, `drift`, `diffusion`, `domain`, \
-                                    `initial`, `unsafe` or `analysis`";
+                                    `initial`, `unsafe`, `goal` or `analysis`";
                     if self.at(&Tok::Ident)
                         && matches!(self.peek(), Tok::Prime | Tok::Colon | Tok::Kw(Kw::In))
                     {
@@ -572,6 +572,7 @@ impl<'s> Parser<'s> {
                 }
             }
             Kw::Unsafe => self.unsafe_item()?,
+            Kw::Goal => self.goal_item()?,
             Kw::Analysis => {
                 self.advance();
                 let help = "an analysis looks like `analysis main { horizon = 4 }`";
@@ -681,8 +682,70 @@ impl<'s> Parser<'s> {
         let start = self.advance().span.start;
         let help = "an unsafe set looks like `unsafe wall halfspace { x + y >= 3 }`";
         let name = self.ident("a set name after `unsafe`", Some(help))?;
+        let (kind, body) = self.set_part("unsafe", help)?;
+        Ok(Item::Unsafe {
+            name,
+            kind,
+            body,
+            span: start..self.prev_end,
+        })
+    }
+
+    /// `goal NAME KIND { ... } [and KIND { ... }]... [within [T1, T2]] [stay]`
+    fn goal_item(&mut self) -> P<Item> {
+        let start = self.advance().span.start;
+        let help = "a goal looks like `goal dock box { x in [0.9, 1.1] } within [2, 4]`";
+        let name = self.ident("a goal name after `goal`", Some(help))?;
+        let mut parts = vec![self.set_part("goal", help)?];
+        while self.at_word("and") {
+            self.advance();
+            parts.push(self.set_part("goal", help)?);
+        }
+        let window = if self.at_word("within") {
+            self.advance();
+            Some(self.expr()?)
+        } else {
+            None
+        };
+        let stay = self.at_word("stay").then(|| self.advance().span);
+        if self.at(&Tok::Ident) && !self.tok.line_start {
+            let expected = match (&window, &stay) {
+                (_, Some(_)) => "a new item after `stay`",
+                (Some(_), None) => "`stay` or a new item",
+                (None, None) => "`and`, `within`, `stay` or a new item",
+            };
+            return Err(self.report_at_tok(
+                Diagnostic::error(
+                    format!("expected {expected}, found {}", self.found()),
+                    self.tok.span.clone(),
+                    "unexpected here",
+                )
+                .with_help(
+                    "after a goal's set come `and KIND { ... }` (an intersection), `within [T1, \
+                     T2]` and `stay`, in that order",
+                ),
+            ));
+        }
+        Ok(Item::Goal {
+            name,
+            parts,
+            window,
+            stay,
+            span: start..self.prev_end,
+        })
+    }
+
+    /// Whether the current token is the identifier `word` (`and`, `within`, `stay`: words of
+    /// a goal, not reserved).
+    fn at_word(&self, word: &str) -> bool {
+        self.at(&Tok::Ident) && self.text(&self.tok.span) == word
+    }
+
+    /// `KIND { ... }` of an unsafe set or a goal (`owner`): `box` (memberships), `ball`
+    /// (fields) or `halfspace` (one constraint).
+    fn set_part(&mut self, owner: &str, help: &str) -> P<(Ident, Block)> {
         let kind = self.ident(
-            "a set kind (`box`, `ball` or `halfspace`) after the unsafe set name",
+            &format!("a set kind (`box`, `ball` or `halfspace`) after the {owner} set name"),
             Some(help),
         )?;
         let ctx = match kind.name.as_str() {
@@ -692,7 +755,7 @@ impl<'s> Parser<'s> {
             other => {
                 self.diags.push(
                     Diagnostic::error(
-                        format!("unknown unsafe set kind `{other}`"),
+                        format!("unknown {owner} set kind `{other}`"),
                         kind.span.clone(),
                         "unknown kind",
                     )
@@ -702,25 +765,22 @@ impl<'s> Parser<'s> {
             }
         };
         let errors_before = self.diags.len() + self.lexer.diags.len();
-        let body = self.block(ctx, "the unsafe set")?;
+        let body = self.block(ctx, &format!("the {owner} set"))?;
         let clean = errors_before == self.diags.len() + self.lexer.diags.len();
         if ctx == Ctx::Halfspace && clean && body.stmts.len() != 1 {
+            let a = if owner == "unsafe" { "an" } else { "a" };
             let msg = if body.stmts.is_empty() {
-                "an unsafe `halfspace` needs a constraint"
+                format!("{a} {owner} `halfspace` needs a constraint")
             } else {
-                "an unsafe `halfspace` has exactly one constraint"
+                format!("{a} {owner} `halfspace` has exactly one constraint")
             };
             self.diags.push(
-                Diagnostic::error(msg, body.span.clone(), "in this block")
-                    .with_help("write one `unsafe NAME halfspace { ... }` per half-space"),
+                Diagnostic::error(msg, body.span.clone(), "in this block").with_help(format!(
+                    "write one `{owner} NAME halfspace {{ ... }}` per half-space"
+                )),
             );
         }
-        Ok(Item::Unsafe {
-            name,
-            kind,
-            body,
-            span: start..self.prev_end,
-        })
+        Ok((kind, body))
     }
 
     // ---- blocks and statements ----------------------------------------------------------

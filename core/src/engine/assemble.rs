@@ -308,6 +308,8 @@ pub(super) fn assemble_with(
         },
         steps,
         unsafe_sets,
+        // (Read off the finished result by `Reach`, after any union or intersection.)
+        goals: Vec::new(),
         verdict,
         validation: Validation {
             rigorous,

@@ -26,6 +26,7 @@ mod embedding;
 mod finite;
 mod first_order;
 mod gaussian;
+pub(crate) mod goals;
 mod hermite;
 mod hints;
 mod intersect;

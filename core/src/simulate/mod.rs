@@ -540,6 +540,7 @@ mod tests {
     fn info_in(b: f64, metric: Vec<f64>) -> ModelInfo {
         let inputs = b != 0.0;
         let mut info = ModelInfo {
+            goals: Vec::new(),
             name: "m".into(),
             states: vec!["x1".into(), "x2".into()],
             inputs: if inputs { vec!["u".into()] } else { vec![] },

@@ -1229,6 +1229,7 @@ mod tests {
     fn pendulum(method: Method) -> ModelInfo {
         let a = std::f64::consts::PI / 10.0;
         let mut info = ModelInfo {
+            goals: Vec::new(),
             name: "pendulum".into(),
             states: vec!["theta".into(), "omega".into()],
             inputs: vec![],

@@ -1255,6 +1255,7 @@ pub(super) mod tests {
     /// (a contraction run's interval box, method.md 8.7), else its own set alone.
     fn result(method: Method, metric: Vec<f64>, members: bool) -> Prs {
         let info = ModelInfo {
+            goals: Vec::new(),
             name: "m".into(),
             states: vec!["x".into(), "y".into()],
             inputs: vec![],

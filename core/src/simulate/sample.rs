@@ -276,6 +276,7 @@ mod tests {
 
     fn info() -> ModelInfo {
         ModelInfo {
+            goals: Vec::new(),
             name: "ou".into(),
             states: vec!["x".into()],
             inputs: vec![],

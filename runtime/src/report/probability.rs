@@ -2,9 +2,9 @@
 //! method.md 8.9).
 
 use super::{count, time};
-use reachc_core::model::UnsafeSet;
-use reachc_core::probability::{SafetyLimit, SafetyProbability};
-use reachc_core::prs::Prs;
+use reachc_core::model::{GoalSet, UnsafeSet};
+use reachc_core::probability::{GoalLimit, GoalProbability, SafetyLimit, SafetyProbability};
+use reachc_core::prs::{GoalMiss, Prs, Validation};
 use serde::Serialize;
 
 /// The `safety_probability` object of the JSON document.
@@ -63,6 +63,152 @@ impl<'a> ProbabilityJson<'a> {
     }
 }
 
+/// The certified probabilities of a run (`reachc run --probability`): of safety, and of
+/// reaching each goal (method.md 8.9, 8.13).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Probabilities<'a> {
+    /// The probability of safety, where computed.
+    pub safety: Option<&'a SafetyProbability>,
+    /// The probability of reaching each goal, where computed.
+    pub goals: &'a [GoalProbability],
+}
+
+/// The `probability` object of a goal in the JSON document.
+#[derive(Serialize)]
+pub(super) struct GoalProbabilityJson<'a> {
+    /// `1 - delta` rounded down; `null` without a bound.
+    lower_bound: Option<f64>,
+    delta: Option<f64>,
+    /// The first report time at which the goal is shown reached at `delta`.
+    t: Option<f64>,
+    not_shown_at: Option<f64>,
+    limit: GoalLimitJson<'a>,
+    runs: usize,
+    proved: bool,
+    conditional_on_domain: bool,
+}
+
+#[derive(Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+enum GoalLimitJson<'a> {
+    Resolution,
+    Floor,
+    NoReportTime,
+    Unsafe { t: f64, set: &'a str },
+    NotInside { t: f64, margin: f64 },
+    Leaves { t: f64 },
+    Failed { delta: f64, why: String },
+}
+
+impl<'a> GoalProbabilityJson<'a> {
+    pub(super) fn of(prs: &'a Prs, p: &'a GoalProbability) -> GoalProbabilityJson<'a> {
+        GoalProbabilityJson {
+            lower_bound: p.lower_bound(),
+            delta: p.delta,
+            t: p.t,
+            not_shown_at: p.not_shown_at,
+            limit: match &p.limit {
+                GoalLimit::Resolution => GoalLimitJson::Resolution,
+                GoalLimit::Floor => GoalLimitJson::Floor,
+                GoalLimit::NotShown(GoalMiss::NoReportTime) => GoalLimitJson::NoReportTime,
+                GoalLimit::NotShown(GoalMiss::Unsafe { t, set }) => GoalLimitJson::Unsafe {
+                    t: *t,
+                    set: prs.unsafe_sets.get(*set).map_or("?", |u| &u.name),
+                },
+                GoalLimit::NotShown(GoalMiss::NotInside { t, margin }) => {
+                    GoalLimitJson::NotInside {
+                        t: *t,
+                        margin: *margin,
+                    }
+                }
+                GoalLimit::NotShown(GoalMiss::Leaves { t }) => GoalLimitJson::Leaves { t: *t },
+                GoalLimit::Failed { delta, why } => GoalLimitJson::Failed {
+                    delta: *delta,
+                    why: why.to_string(),
+                },
+            },
+            runs: p.runs,
+            proved: p.validation.not_validated.is_empty(),
+            conditional_on_domain: p.validation.conditional_on_domain,
+        }
+    }
+}
+
+/// The summary's line for the probability of reaching goal `p.goal` of `goals` (`sets`: the
+/// model's unsafe sets).
+pub fn goal_line(
+    goals: &[GoalSet],
+    sets: &[UnsafeSet],
+    horizon: f64,
+    p: &GoalProbability,
+) -> String {
+    let g = &goals[p.goal];
+    let w = g.window.map_or((0.0, horizon), |w| (w.lo, w.hi));
+    let (lo, hi) = (time(w.0), time(w.1));
+    let event = if g.stay {
+        format!("reach `{}` within [{lo}, {hi}] and stay until {hi}", g.name)
+    } else {
+        format!("reach `{}` within [{lo}, {hi}]", g.name)
+    };
+    let event = if sets.is_empty() {
+        event
+    } else {
+        format!("{event}, avoiding every unsafe set until then")
+    };
+    let s = match p.delta {
+        Some(delta) => format!(
+            "P({event}) >= {} for every start in the initial set and every input",
+            lower_bound_text(delta)
+        ),
+        None => format!("P({event}): no bound"),
+    };
+    let limit = match &p.limit {
+        GoalLimit::Resolution => format!(
+            "to the bisection's resolution: not shown at delta = {:.3e}",
+            p.not_shown_at.unwrap_or(f64::NAN)
+        ),
+        GoalLimit::Floor => "shown at the smallest delta tried".to_string(),
+        GoalLimit::NotShown(miss) => {
+            let at = p.not_shown_at.unwrap_or(f64::NAN);
+            match miss {
+                GoalMiss::NoReportTime => "no report time lies in the window".to_string(),
+                GoalMiss::Unsafe { t, set } => format!(
+                    "the PRS at delta = {at} meets `{}` at t = {} first",
+                    sets.get(*set).map_or("?", |u| &u.name),
+                    time(*t)
+                ),
+                GoalMiss::NotInside { t, margin } => format!(
+                    "the PRS at delta = {at} is not inside the goal in the window (largest \
+                     margin {margin:.3e} at t = {})",
+                    time(*t)
+                ),
+                GoalMiss::Leaves { t } => format!(
+                    "the PRS at delta = {at} is not shown to stay in the goal (the interval \
+                     ending at t = {})",
+                    time(*t)
+                ),
+            }
+        }
+        GoalLimit::Failed { delta, why } => {
+            format!("the run at delta = {delta:.3e} failed: {why}")
+        }
+    };
+    s + &qualifiers(p.runs, &limit, &p.validation)
+}
+
+/// What every bound's line ends with: the runs, what limits it, and whether it is proved and
+/// unconditional.
+fn qualifiers(runs: usize, limit: &str, validation: &Validation) -> String {
+    let mut s = format!(" ({}; {limit})", count(runs as u64, "run"));
+    if !validation.not_validated.is_empty() {
+        s.push_str(" [NOT proved: the runs have \"not validated\" parts]");
+    }
+    if validation.conditional_on_domain {
+        s.push_str(" [while the state stays in the domain]");
+    }
+    s
+}
+
 /// `delta` rounded up to three significant digits, as `(q, e)` with `q 10^e >= delta` and
 /// `q` in `[100, 1000)` (so that `1 - ` it stays a lower bound).
 fn delta_up(delta: f64) -> (u64, i32) {
@@ -95,7 +241,7 @@ pub fn lower_bound_text(delta: f64) -> String {
 /// The summary's line: the bound and what limits it (`sets`: the model's unsafe sets).
 pub fn line(sets: &[UnsafeSet], p: &SafetyProbability) -> String {
     let name = |set: usize| &sets[set].name;
-    let mut s = match p.delta {
+    let s = match p.delta {
         Some(delta) => format!(
             "P(safe on [0, {}]) >= {} for every start in the initial set and every input",
             p.horizon,
@@ -126,14 +272,7 @@ pub fn line(sets: &[UnsafeSet], p: &SafetyProbability) -> String {
             format!("the run at delta = {delta:.3e} failed: {why}")
         }
     };
-    s.push_str(&format!(" ({}; {limit})", count(p.runs as u64, "run")));
-    if !p.validation.not_validated.is_empty() {
-        s.push_str(" [NOT proved: the runs have \"not validated\" parts]");
-    }
-    if p.validation.conditional_on_domain {
-        s.push_str(" [while the state stays in the domain]");
-    }
-    s
+    s + &qualifiers(p.runs, &limit, &p.validation)
 }
 
 #[cfg(test)]

@@ -1,12 +1,11 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
-use super::probability::ProbabilityJson;
+use super::probability::{GoalProbabilityJson, Probabilities, ProbabilityJson};
 use super::{count, csv_field, num, summary_indices, time};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, Split, TransformSource};
-use reachc_core::probability::SafetyProbability;
 use reachc_core::prs::{
-    BallBound, DetSet, Hint, Proved, Prs, R1Method, Role, Step, TransformUsed, UniformBound,
-    Unproved, UnsafeKind, UnsafeVerdict, Verdict,
+    BallBound, DetSet, GoalMiss, GoalOutcome, GoalVerdict, Hint, Proved, Prs, R1Method, Role, Step,
+    TransformUsed, UniformBound, Unproved, UnsafeKind, UnsafeVerdict, Verdict,
 };
 use reachc_core::Interval;
 use serde::Serialize;
@@ -21,27 +20,33 @@ pub const MEMBERS_BUDGET: usize = 32 << 20;
 /// Pretty-printed JSON of a result (arrays of numbers or strings on one line). Non-finite
 /// numbers (e.g. an infinite margin) are `null`.
 pub fn to_json(prs: &Prs) -> String {
-    to_json_with(prs, None)
+    to_json_with(prs, Probabilities::default())
 }
 
-/// [`to_json`] with the analysis' probability of safety (`reachc run --probability`), within
+/// [`to_json`] with the analysis' certified probabilities (`reachc run --probability`), within
 /// [`MEMBERS_BUDGET`] (see [`to_json_within`]).
-pub fn to_json_with(prs: &Prs, probability: Option<&SafetyProbability>) -> String {
-    to_json_within(prs, probability, MEMBERS_BUDGET)
+pub fn to_json_with(prs: &Prs, probabilities: Probabilities<'_>) -> String {
+    to_json_within(prs, probabilities, MEMBERS_BUDGET)
 }
 
 /// [`to_json_with`] for a size budget of `budget` bytes: where the file would be larger with the
-/// members of the intersection written in full (estimated from the count of their numbers) (first-order and linearised zonotopes over
-/// thousands of report times: a 12-state chain at 5000 report times wrote 235 MB), each member
-/// is written as its PRS's bounding box per report time instead (`"boxed": true`; a larger set,
-/// so still a PRS; the result's own sets, boxes, margins and verdicts are unchanged).
-pub fn to_json_within(prs: &Prs, probability: Option<&SafetyProbability>, budget: usize) -> String {
+/// members of the intersection written in full (estimated from the count of their numbers;
+/// first-order and linearised zonotopes over thousands of report times: a 12-state chain at
+/// 5000 report times wrote 235 MB), each member is written as its PRS's bounding box per report
+/// time instead (`"boxed": true`; a larger set, so still a PRS; the result's own sets, boxes,
+/// margins and verdicts are unchanged).
+pub fn to_json_within(prs: &Prs, probabilities: Probabilities<'_>, budget: usize) -> String {
     let write = |boxed: bool| {
         let mut json = Json::of(prs);
         if boxed {
             json.also = prs.also.iter().map(Json::boxed).collect();
         }
-        json.safety_probability = probability.map(|p| ProbabilityJson::of(prs, p));
+        json.safety_probability = probabilities.safety.map(|p| ProbabilityJson::of(prs, p));
+        for p in probabilities.goals {
+            if let Some(g) = json.goals.get_mut(p.goal) {
+                g.probability = Some(GoalProbabilityJson::of(prs, p));
+            }
+        }
         // Plain data with string keys: serialising cannot fail.
         inline_scalar_arrays(&serde_json::to_string_pretty(&json).expect("a result serialises"))
     };
@@ -138,6 +143,9 @@ struct Json<'a> {
     input_center: &'a [f64],
     steps: Vec<StepJson<'a>>,
     unsafe_sets: Vec<UnsafeJson<'a>>,
+    /// Per goal set (absent without goals; method.md 8.13).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    goals: Vec<GoalJson<'a>>,
     verdict: VerdictJson<'a>,
     /// The probability of safety (`reachc run --probability` only).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -369,6 +377,126 @@ struct UnsafeJson<'a> {
     margin_unit: &'static str,
 }
 
+/// One goal's verdict: `reached` with its time and margin, or `why` not.
+#[derive(Serialize)]
+struct GoalJson<'a> {
+    name: &'a str,
+    window: [f64; 2],
+    stay: bool,
+    status: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    t: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    margin: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    why: Option<GoalMissJson<'a>>,
+    /// The certified probability of reaching it (`reachc run --probability`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    probability: Option<GoalProbabilityJson<'a>>,
+    margins: &'a [f64],
+}
+
+#[derive(Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+enum GoalMissJson<'a> {
+    NoReportTime,
+    Unsafe { t: f64, set: &'a str },
+    NotInside { t: f64, margin: f64 },
+    Leaves { t: f64 },
+}
+
+impl<'a> GoalJson<'a> {
+    fn of(prs: &'a Prs, g: &'a GoalVerdict) -> GoalJson<'a> {
+        let (status, t, margin, why) = match &g.outcome {
+            GoalOutcome::Reached { t, margin } => ("reached", Some(*t), Some(*margin), None),
+            GoalOutcome::NeedsUniform => ("needs_uniform", None, None, None),
+            GoalOutcome::NotShown(miss) => (
+                "not_shown",
+                None,
+                None,
+                Some(match *miss {
+                    GoalMiss::NoReportTime => GoalMissJson::NoReportTime,
+                    GoalMiss::Unsafe { t, set } => GoalMissJson::Unsafe {
+                        t,
+                        set: prs.unsafe_sets.get(set).map_or("?", |u| &u.name),
+                    },
+                    GoalMiss::NotInside { t, margin } => GoalMissJson::NotInside { t, margin },
+                    GoalMiss::Leaves { t } => GoalMissJson::Leaves { t },
+                }),
+            ),
+        };
+        GoalJson {
+            name: &g.name,
+            window: [g.window.lo, g.window.hi],
+            stay: g.stay,
+            status,
+            t,
+            margin,
+            why,
+            probability: None,
+            margins: &g.margins,
+        }
+    }
+}
+
+/// The text line of one goal's verdict.
+fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
+    let (lo, hi) = (time(g.window.lo), time(g.window.hi));
+    let what = if g.stay {
+        format!("reach within [{lo}, {hi}] and stay")
+    } else {
+        format!("reach within [{lo}, {hi}]")
+    };
+    let status = match &g.outcome {
+        GoalOutcome::Reached { t, margin } => {
+            let claim = if g.stay {
+                format!(
+                    "the state is in it at t = {} and stays in it until t = {hi}, avoiding every \
+                     unsafe set on [0, {hi}]",
+                    time(*t)
+                )
+            } else {
+                format!(
+                    "the state is in it at t = {}, having avoided every unsafe set on [0, {}]",
+                    time(*t),
+                    time(*t)
+                )
+            };
+            let how = if matches!(prs.rate.rate, Rate::Empirical { .. }) {
+                "by the EMPIRICAL estimate (not a guarantee)".to_string()
+            } else {
+                format!("with probability at least {}", 1.0 - prs.delta)
+            };
+            format!("reached: {how} {claim}; margin {}", num(*margin))
+        }
+        GoalOutcome::NeedsUniform => "not assessed: reaching needs `guarantee = uniform` (a \
+                                      pointwise PRS bounds each time separately, not the path)"
+            .to_string(),
+        GoalOutcome::NotShown(miss) => {
+            let why = match *miss {
+                GoalMiss::NoReportTime => "no report time lies in the window".to_string(),
+                GoalMiss::Unsafe { t, set } => format!(
+                    "the PRS over the interval ending at t = {} meets unsafe set `{}` first",
+                    time(t),
+                    prs.unsafe_sets.get(set).map_or("?", |u| &u.name)
+                ),
+                GoalMiss::NotInside { t, margin } => format!(
+                    "the PRS is not inside it at any report time in the window (largest margin \
+                     {} at t = {})",
+                    num(margin),
+                    time(t)
+                ),
+                GoalMiss::Leaves { t } => format!(
+                    "the PRS over the interval ending at t = {} is not shown inside it",
+                    time(t)
+                ),
+            };
+            format!("NOT SHOWN REACHED: {why} (this does not prove that it is missed)")
+        }
+    };
+    format!("  goal `{}` ({what}): {status}", g.name)
+}
+
 #[derive(Serialize)]
 #[serde(tag = "status", rename_all = "snake_case")]
 enum VerdictJson<'a> {
@@ -470,6 +598,7 @@ impl<'a> Json<'a> {
             input_center: &prs.input_center,
             steps: (0..prs.steps.len()).map(|k| StepJson::of(prs, k)).collect(),
             unsafe_sets: prs.unsafe_sets.iter().map(UnsafeJson::of).collect(),
+            goals: prs.goals.iter().map(|g| GoalJson::of(prs, g)).collect(),
             verdict: VerdictJson::of(prs),
             safety_probability: None,
             validated: ValidationJson {
@@ -1189,6 +1318,9 @@ pub fn summary(prs: &Prs) -> String {
                 time(u.min_margin_t),
             );
         }
+    }
+    for g in &prs.goals {
+        let _ = writeln!(s, "{}", goal_line(prs, g));
     }
     let verdict = match &prs.verdict {
         Verdict::Safe if matches!(prs.rate.rate, Rate::Empirical { .. }) => {

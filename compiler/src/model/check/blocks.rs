@@ -60,6 +60,13 @@ impl<'a> Checker<'a> {
                     body,
                     span,
                 } => self.unsafe_set(name, kind, body, span.clone()),
+                Item::Goal {
+                    name,
+                    parts,
+                    window,
+                    stay,
+                    span,
+                } => self.goal_set(name, parts, window.as_ref(), stay.is_some(), span.clone()),
                 Item::Analysis { name, body, span } => self.analysis(name, body, span.clone()),
                 Item::Const { .. }
                 | Item::State(_)

@@ -18,7 +18,7 @@ use std::path::Path;
 
 use scope::{Scope, Symbol, VarKind};
 
-use super::{Ball, Bounds, InitialSet, Model, UnsafeSet, Variable};
+use super::{Ball, Bounds, GoalSet, InitialSet, Model, UnsafeSet, Variable};
 use crate::diagnostics::{has_errors, Diagnostic, Span};
 use crate::ir::{ExprId, Pool, Table};
 use crate::limits::{MAX_INPUTS, MAX_NOISES, MAX_STATES};
@@ -46,6 +46,7 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         input_box: Vec::new(),
         balls: Vec::new(),
         unsafe_sets: Vec::new(),
+        goals: Vec::new(),
         analyses: Vec::new(),
         auto_transforms: Vec::new(),
         constants: Vec::new(),
@@ -53,6 +54,7 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
     c.declarations(spec);
     c.bodies(spec);
     c.completeness(spec);
+    c.goal_windows();
     if !has_errors(&c.diags) {
         c.auto_transforms();
     }
@@ -98,6 +100,7 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         has_domain: c.has_domain,
         tables: c.tables,
         unsafe_sets: c.unsafe_sets.into_iter().map(|(u, _)| u).collect(),
+        goals: c.goals.into_iter().map(|(g, _, _)| g).collect(),
         analyses: c.analyses,
         constants: c.constants,
     };
@@ -132,6 +135,8 @@ struct Checker<'a> {
     balls: Vec<(Ball, Span)>,
     /// Unsafe sets, with the `unsafe` item of each.
     unsafe_sets: Vec<(UnsafeSet, Span)>,
+    /// Goal sets, with the `goal` item of each and its window's span.
+    goals: Vec<(GoalSet, Span, Option<Span>)>,
     analyses: Vec<super::Analysis>,
     /// Analyses with `transform = auto` (index, span of `auto`), chosen after the checks.
     auto_transforms: Vec<(usize, Span)>,

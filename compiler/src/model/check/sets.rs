@@ -8,8 +8,9 @@ use super::scope::{did_you_mean, VarKind};
 use super::Checker;
 use crate::diagnostics::{Diagnostic, Span};
 use crate::ir::Var;
-use crate::model::{Ball, Bounds, UnsafeSet, UnsafeShape};
+use crate::model::{Ball, Bounds, GoalSet, UnsafeSet, UnsafeShape, Variable};
 use crate::syntax::ast::{Block, CmpOp, Expr, ExprKind, Ident, Stmt, Target};
+use reachc_core::Interval;
 
 /// The fields of a block, by key.
 pub(super) type Fields<'s> = HashMap<&'s str, (&'s Expr, Span)>;
@@ -249,31 +250,7 @@ impl Checker<'_> {
         if self.defined_twice("unsafe set", name, first.map(|(_, span)| span.clone())) {
             return;
         }
-        let shape = match kind.name.as_str() {
-            "box" => self.unsafe_box(body),
-            "ball" => {
-                let f = self.fields(body, &["over", "center", "radius"], "an unsafe ball");
-                self.ball_fields(&f, &span)
-                    .map(|(states, center, radius)| UnsafeShape::Ball {
-                        states,
-                        center,
-                        radius,
-                    })
-            }
-            "halfspace" => self.halfspace(body),
-            other => {
-                let mut d = Diagnostic::error(
-                    format!("unknown unsafe set kind `{other}`"),
-                    kind.span.clone(),
-                    "expected box, ball or halfspace",
-                );
-                if let Some(s) = did_you_mean(other, ["box", "ball", "halfspace"]) {
-                    d = d.with_help(format!("did you mean `{s}`?"));
-                }
-                self.fail(d)
-            }
-        };
-        if let Some(shape) = shape {
+        if let Some(shape) = self.set_shape(kind, body, &span, "unsafe") {
             self.unsafe_sets.push((
                 UnsafeSet {
                     name: name.name.clone(),
@@ -284,15 +261,148 @@ impl Checker<'_> {
         }
     }
 
-    fn unsafe_box(&mut self, body: &Block) -> Option<UnsafeShape> {
+    /// `goal NAME KIND { ... } [and KIND { ... }]... [within [T1, T2]] [stay]` (method.md
+    /// 8.13): the parts as for unsafe sets, refused where they are certainly empty together
+    /// (boxes with no common point, a half-space missing the box of the others); the window
+    /// two constants `0 <= T1 <= T2` (checked against each analysis' horizon by
+    /// [`Checker::goal_windows`]).
+    pub(super) fn goal_set(
+        &mut self,
+        name: &Ident,
+        parts: &[(Ident, Block)],
+        window: Option<&Expr>,
+        stay: bool,
+        span: Span,
+    ) {
+        let first = self.goals.iter().find(|(g, _, _)| g.name == name.name);
+        if self.defined_twice("goal", name, first.map(|(_, span, _)| span.clone())) {
+            return;
+        }
+        let shapes: Vec<Option<UnsafeShape>> = parts
+            .iter()
+            .map(|(kind, body)| self.set_shape(kind, body, &span, "goal"))
+            .collect();
+        let window = match window {
+            None => Some(None),
+            Some(e) => self.goal_window(e).map(|w| Some((w, e.span.clone()))),
+        };
+        let (Some(parts), Some(window)) = (shapes.into_iter().collect::<Option<Vec<_>>>(), window)
+        else {
+            return;
+        };
+        if let Some(why) = empty(&parts, &self.states) {
+            self.diags.push(
+                Diagnostic::error(
+                    format!("goal `{}` is empty: {why}", name.name),
+                    span,
+                    "no state is in every part",
+                )
+                .with_help("a goal is the intersection of its parts: widen or drop one"),
+            );
+            return;
+        }
+        self.goals.push((
+            GoalSet {
+                name: name.name.clone(),
+                parts,
+                window: window.as_ref().map(|(w, _)| *w),
+                stay,
+            },
+            span,
+            window.map(|(_, s)| s),
+        ));
+    }
+
+    /// `within [T1, T2]`: constants with `0 <= T1 <= T2 < inf`.
+    fn goal_window(&mut self, e: &Expr) -> Option<Bounds> {
+        let w = self.interval(e, &[])?;
+        if !(w.lo >= 0.0 && w.hi.is_finite()) {
+            return self.fail(
+                Diagnostic::error(
+                    format!("the window [{}, {}] is not inside [0, inf)", w.lo, w.hi),
+                    e.span.clone(),
+                    "a window of times",
+                )
+                .with_help("write `within [T1, T2]` with 0 <= T1 <= T2"),
+            );
+        }
+        Some(w)
+    }
+
+    /// Every goal's window inside each analysis' `[0, T]` (a window past the horizon asks
+    /// about times the analysis does not cover).
+    pub(super) fn goal_windows(&mut self) {
+        let mut found = Vec::new();
+        for (g, _, span) in &self.goals {
+            let (Some(w), Some(span)) = (g.window, span) else {
+                continue;
+            };
+            for a in &self.analyses {
+                if w.hi > a.spec.horizon {
+                    found.push(
+                        Diagnostic::error(
+                            format!(
+                                "the window of goal `{}` ends at {}, after the horizon {} of \
+                                 analysis `{}`",
+                                g.name, w.hi, a.spec.horizon, a.spec.name
+                            ),
+                            span.clone(),
+                            "outside [0, T]",
+                        )
+                        .with_label(a.name_span.clone(), "this analysis")
+                        .with_help("end the window by the horizon, or lengthen the horizon"),
+                    );
+                }
+            }
+        }
+        self.diags.extend(found);
+    }
+
+    /// `KIND { ... }` of an unsafe set or a goal (`owner`) as a region.
+    fn set_shape(
+        &mut self,
+        kind: &Ident,
+        body: &Block,
+        span: &Span,
+        owner: &str,
+    ) -> Option<UnsafeShape> {
+        let a = if owner == "unsafe" { "an" } else { "a" };
+        match kind.name.as_str() {
+            "box" => self.unsafe_box(body, &format!("{a} {owner} box")),
+            "ball" => {
+                let what = format!("{a} {owner} ball");
+                let f = self.fields(body, &["over", "center", "radius"], &what);
+                self.ball_fields(&f, span)
+                    .map(|(states, center, radius)| UnsafeShape::Ball {
+                        states,
+                        center,
+                        radius,
+                    })
+            }
+            "halfspace" => self.halfspace(body),
+            other => {
+                let mut d = Diagnostic::error(
+                    format!("unknown {owner} set kind `{other}`"),
+                    kind.span.clone(),
+                    "expected box, ball or halfspace",
+                );
+                if let Some(s) = did_you_mean(other, ["box", "ball", "halfspace"]) {
+                    d = d.with_help(format!("did you mean `{s}`?"));
+                }
+                self.fail(d)
+            }
+        }
+    }
+
+    fn unsafe_box(&mut self, body: &Block, what: &str) -> Option<UnsafeShape> {
         let mut sides: Vec<(usize, Bounds)> = Vec::new();
         let mut ok = true;
         for s in &body.stmts {
             let Stmt::Member { target, set, .. } = s else {
                 self.unexpected(
                     s,
-                    "in an unsafe box",
-                    "an unsafe box holds memberships like `px in [1, 2]`",
+                    &format!("in {what}"),
+                    &format!("{what} holds memberships like `px in [1, 2]`"),
                 );
                 ok = false;
                 continue;
@@ -319,7 +429,7 @@ impl Checker<'_> {
         if ok && sides.is_empty() {
             return self.fail(
                 Diagnostic::error(
-                    "an unsafe box needs at least one side",
+                    format!("{what} needs at least one side"),
                     body.span.clone(),
                     "empty",
                 )
@@ -381,4 +491,42 @@ impl Checker<'_> {
         }
         Some(UnsafeShape::HalfSpace { normal, offset })
     }
+}
+
+/// Why the intersection of `parts` is certainly empty, if it is: two boxes with no common point
+/// in a state, or a half-space that misses the box the box parts bound (when they bound every
+/// state it involves).
+fn empty(parts: &[UnsafeShape], states: &[Variable]) -> Option<String> {
+    let mut b = vec![Bounds::ENTIRE; states.len()];
+    for p in parts {
+        if let UnsafeShape::Box(sides) = p {
+            for &(i, side) in sides {
+                let (lo, hi) = (b[i].lo.max(side.lo), b[i].hi.min(side.hi));
+                if lo > hi {
+                    return Some(format!(
+                        "its boxes bound `{}` to ranges with no common point",
+                        states[i].name
+                    ));
+                }
+                b[i] = Bounds::new(lo, hi);
+            }
+        }
+    }
+    for p in parts {
+        if let UnsafeShape::HalfSpace { normal, offset } = p {
+            // The largest `normal . x` over the box, rounded up.
+            let top = normal
+                .iter()
+                .zip(&b)
+                .filter(|(a, _)| **a != 0.0)
+                .fold(Interval::ZERO, |s, (&a, x)| {
+                    s + Interval::point(a) * Interval::new(x.lo, x.hi)
+                })
+                .hi();
+            if top < *offset {
+                return Some("a half-space misses the box its other parts bound".into());
+            }
+        }
+    }
+    None
 }

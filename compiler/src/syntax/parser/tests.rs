@@ -183,6 +183,26 @@ fn sx_item(i: &Item) -> String {
         Item::Unsafe {
             name, kind, body, ..
         } => format!("unsafe {} {} {}", name.name, kind.name, sx_block(body)),
+        Item::Goal {
+            name,
+            parts,
+            window,
+            stay,
+            ..
+        } => {
+            let parts: Vec<String> = parts
+                .iter()
+                .map(|(k, b)| format!("{} {}", k.name, sx_block(b)))
+                .collect();
+            let mut s = format!("goal {} {}", name.name, parts.join(" and "));
+            if let Some(w) = window {
+                s += &format!(" within {}", sx(w));
+            }
+            if stay.is_some() {
+                s += " stay";
+            }
+            s
+        }
         Item::Analysis { name, body, .. } => format!("analysis {} {}", name.name, sx_block(body)),
     }
 }
@@ -1056,4 +1076,26 @@ fn error_flood_is_capped() {
             .message
             .starts_with("too many syntax errors"));
     }
+}
+
+/// Goal sets: one or more parts joined by `and`, an optional window, an optional `stay`; the
+/// words are not reserved (a state may be called `stay`), and a goal ends at the next line's item.
+#[test]
+fn goals() {
+    assert_eq!(
+        items(
+            "goal dock box { x in [0.9, 1.1] } within [2, 4]\n\
+             goal park ball { over = [x, y] center = [0, 0] radius = 0.2 } stay\n\
+             goal lane halfspace { y >= -1 } and halfspace { y <= 1 } and box { x in [4, 5] } \
+             within [0, T] stay\n\
+             state stay in [0, 1]"
+        ),
+        [
+            "goal dock box { x in [0.9, 1.1] } within [2, 4]",
+            "goal park ball { over = [x, y]; center = [0, 0]; radius = 0.2 } stay",
+            "goal lane halfspace { y >= (neg 1) } and halfspace { y <= 1 } and box { x in [4, 5] } \
+             within [0, T] stay",
+            "state stay in [0, 1]",
+        ]
+    );
 }
