@@ -534,7 +534,7 @@ fn goals_are_reported_and_drawn() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
     for line in [
         "goal `home` (reach within [1, 4]): reached: with probability at least 0.999",
-        "goal `park` (reach within [2, 4] and stay): reached",
+        "goal `park` (reach within [2, 4] and stay until 4): reached",
         "goal `lane` (reach within [0, 4]): reached",
         "goal `far` (reach within [0, 4]): NOT SHOWN REACHED",
     ] {

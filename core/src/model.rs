@@ -143,8 +143,7 @@ pub struct UnsafeSet {
 }
 
 /// A named goal set (method.md 8.13): the state should enter it at some time in `window`
-/// (and, with `stay`, remain in it until the window's end), avoiding every unsafe set until
-/// then.
+/// (and, with `stay`, remain in it until the horizon), avoiding every unsafe set until then.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GoalSet {
     /// Its name.
@@ -154,7 +153,7 @@ pub struct GoalSet {
     pub parts: Vec<UnsafeShape>,
     /// The times at which entering counts, `[t1, t2]`; `None`: an analysis' whole horizon.
     pub window: Option<Bounds>,
-    /// Reach and stay: once entered, the state must remain in the goal until the window ends.
+    /// Reach and stay: once entered, the state must remain in the goal until the horizon.
     pub stay: bool,
 }
 

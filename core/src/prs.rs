@@ -628,7 +628,7 @@ pub struct GoalVerdict {
     pub name: String,
     /// The times at which entering counts: the goal's window, or `[0, T]`.
     pub window: Bounds,
-    /// Reach and stay (the state must remain in the goal until the window ends).
+    /// Reach and stay (the state must remain in the goal until the horizon).
     pub stay: bool,
     /// Per report time, how far the PRS lies inside the goal: the smallest Euclidean gap
     /// between its bounding box and the goal's boundary (for a half-space or a ball part), or
@@ -645,12 +645,12 @@ pub enum GoalOutcome {
     /// With probability at least `1 - delta`, for every start and input: the state is in the
     /// goal at report time `t` (in the window), having avoided every unsafe set on `[0, t]`;
     /// with `stay`, it also remains in the goal, and away from the unsafe sets, until the
-    /// window ends.
+    /// horizon.
     Reached {
         /// The first report time at which this is shown.
         t: f64,
         /// The smallest containment margin involved (at `t`, and with `stay` over the report
-        /// intervals to the window's end).
+        /// intervals to the horizon).
         margin: f64,
     },
     /// Not shown (this does not prove that the goal is missed).
@@ -666,7 +666,7 @@ pub enum GoalMiss {
     NoReportTime,
     /// The tube may meet unsafe set `set` (index into [`Prs::unsafe_sets`]) over the report
     /// interval ending at `t`, before the goal is shown reached (with `stay`: before the
-    /// window ends).
+    /// horizon).
     Unsafe {
         /// Report time.
         t: f64,
@@ -682,8 +682,7 @@ pub enum GoalMiss {
         margin: f64,
     },
     /// The PRS is inside the goal at some report time in the window, but (the last such
-    /// time tried) the tube over the report interval ending at `t`, before the window ends, is
-    /// not shown inside.
+    /// time tried) the tube over the report interval ending at `t` is not shown inside.
     Leaves {
         /// Report time.
         t: f64,

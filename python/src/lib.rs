@@ -422,6 +422,7 @@ impl Spec {
             confidence,
             threads,
             safety_bound: None,
+            goal_bounds: Vec::new(),
         };
         let inner = &*self.inner;
         let result = py.detach(|| {

@@ -717,6 +717,22 @@ fn simulate_analyses<S: System + Sync>(
                 }
             }
         }
+        // And of reaching each goal.
+        if let Some(reach) = reach.as_ref().ok().filter(|_| opts.probability) {
+            sim_opts.goal_bounds = (0..info.goals.len())
+                .map(|g| match reach.goal_probability(g) {
+                    Ok(p) => p.lower_bound(),
+                    Err(e) => {
+                        let _ = writeln!(
+                            err,
+                            "note: analysis `{name}`: no probability of reaching `{}`: {e}",
+                            info.goals[g].name
+                        );
+                        None
+                    }
+                })
+                .collect();
+        }
         let result = match reach.and_then(|r| r.run()) {
             Ok(r) => r,
             Err(e @ (RunError::Unsupported(_) | RunError::NoConstants(_))) => {
@@ -849,6 +865,7 @@ mod tests {
                 confidence: 0.99,
                 threads: Some(3),
                 safety_bound: None,
+                goal_bounds: Vec::new(),
             },
         };
         assert_eq!(Command::parse(&sim.to_args()), Ok(Command::Simulate(sim)));

@@ -148,3 +148,45 @@ fn misses_say_why() {
         .iter()
         .all(|g| g.outcome == GoalOutcome::NeedsUniform));
 }
+
+/// `reachc simulate`'s goal check on `x' = 1` from 0 with noise 0.01: every path passes
+/// through `[0.2, 0.8]` within `[0, 1]` (reach), none stays in it to the horizon (stay), none
+/// reaches `[2, 3]` without first entering the wall `x >= 1`; a certified bound above the
+/// paths' Clopper-Pearson upper bound fails, a valid one passes; and shards merge into the
+/// unsharded report exactly, goal counts included.
+#[test]
+fn simulate_counts_goal_events_and_tests_their_bounds() {
+    use reachc_runtime::simulate::{self, merge, run_part, Options, Shard};
+    let src = "model push\nstate x = 0\nnoise w\ndrift { x' = 1 }\ndiffusion { x: 0.01 * w }\n\
+               unsafe wall halfspace { x >= 1 }\n\
+               goal pass box { x in [0.2, 0.8] } within [0, 1]\n\
+               goal keep box { x in [0.2, 0.8] } within [0, 1] stay\n\
+               goal beyond box { x in [2, 3] }\n\
+               goal start box { x in [-0.5, 0.5] } within [0, 0.3] stay\n\
+               analysis a { horizon = 2.5  step = 0.01  delta = 1e-3 }";
+    let (sys, info) = inline(src);
+    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let opts = |bounds: Vec<Option<f64>>| Options {
+        paths: 500,
+        goal_bounds: bounds,
+        ..Options::default()
+    };
+    let run = |o: &Options| simulate::simulate(&sys, &info, &prs, o, &mut |_, _| {}).unwrap();
+    let report = run(&opts(vec![Some(0.99), Some(0.5), None, Some(0.05)]));
+    let counts: Vec<u64> = report.goals.iter().map(|g| g.reached).collect();
+    // `start`: in [-0.5, 0.5] from t = 0, but not to the horizon: no path.
+    assert_eq!(counts, [500, 0, 0, 0], "{:?}", report.goals);
+    let passed: Vec<bool> = report.goals.iter().map(|g| g.passed).collect();
+    assert_eq!(passed, [true, false, true, false]);
+    assert!(!report.passed());
+    // The same paths in three shards, merged.
+    let o = opts(vec![Some(0.99), Some(0.5), None, Some(0.05)]);
+    let parts: Vec<(String, _)> = (0..3)
+        .map(|i| {
+            let shard = Shard::new(i, 3).unwrap();
+            let part = run_part(&sys, &info, &prs, &o, shard, &mut |_, _| {}).unwrap();
+            (format!("part {i}"), part)
+        })
+        .collect();
+    assert_eq!(merge(parts).unwrap(), report);
+}

@@ -143,6 +143,7 @@ impl SimulateArgs {
                 confidence: self.confidence,
                 threads: self.threads,
                 safety_bound: None,
+                goal_bounds: Vec::new(),
             },
         }
     }

@@ -90,7 +90,7 @@ pub enum Item {
         parts: Vec<(Ident, Block)>,
         /// `within [T1, T2]`: when entering counts.
         window: Option<Expr>,
-        /// `stay`: the word, if written.
+        /// `stay` (remain in the goal until the horizon): the word, if written.
         stay: Option<Span>,
         /// The whole item.
         span: Span,

@@ -57,10 +57,8 @@ fn outcome(
             Some(GoalMiss::Unsafe { t: steps[j].t, set })
         })
     };
-    // With stay: the report intervals up to the one holding the window's end.
-    let end = (last_in..steps.len())
-        .find(|&k| steps[k].t >= window.hi)
-        .unwrap_or(steps.len() - 1);
+    // With stay: every report interval to the horizon.
+    let end = steps.len() - 1;
     if goal.stay {
         if let Some(miss) = first_unsafe(end) {
             return GoalOutcome::NotShown(miss);

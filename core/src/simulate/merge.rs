@@ -7,7 +7,7 @@ use super::binomial;
 use super::part::{Part, PartStats, RunInfo};
 use super::part_file::run_bytes;
 use super::report::{
-    Coverage, HorizonReport, InputsReport, SafetyCheck, SimReport, SimStep, StateSpread,
+    Coverage, GoalCheck, HorizonReport, InputsReport, SafetyCheck, SimReport, SimStep, StateSpread,
     TubeReport, UnsafeHits,
 };
 use super::shard::Shard;
@@ -196,6 +196,11 @@ fn difference(a: &RunInfo, b: &RunInfo, a_bytes: &[u8]) -> Option<String> {
             format!("{:?}", a.safety_bound),
             format!("{:?}", b.safety_bound),
         ),
+        (
+            "goal probability bounds",
+            format!("{:?}", a.goals),
+            format!("{:?}", b.goals),
+        ),
     ];
     if let Some((what, x, y)) = named.into_iter().find(|(_, x, y)| x != y) {
         return Some(format!("{what} {y} there, {x} in the first part"));
@@ -337,6 +342,22 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut To
                 passed: run.safety_bound.is_none_or(|b| b <= cp_upper),
             }
         }),
+        goals: run
+            .goals
+            .iter()
+            .zip(&total.goal_reached)
+            .map(|((name, bound), &reached)| {
+                let cp_upper = binomial::upper_bound(reached, n_paths, alpha);
+                GoalCheck {
+                    name: name.clone(),
+                    reached,
+                    fraction: frac(reached),
+                    cp_upper,
+                    certified: *bound,
+                    passed: bound.is_none_or(|b| b <= cp_upper),
+                }
+            })
+            .collect(),
         left_domain: run.has_domain.then_some(total.left_domain),
         diverged: total.diverged,
         verdict: Coverage {

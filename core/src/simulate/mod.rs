@@ -56,14 +56,14 @@ pub use merge::{merge, MergeError, Merger};
 pub use part::{Part, PartStats, RunInfo, StepInfo};
 pub use part_file::{FORMAT_VERSION, MAGIC};
 pub use report::{
-    Coverage, HorizonReport, InitialSampling, InputsReport, NoiseKind, SafetyCheck, SimReport,
-    SimStep, StateSpread, TubeReport, UnsafeHits,
+    Coverage, GoalCheck, HorizonReport, InitialSampling, InputsReport, NoiseKind, SafetyCheck,
+    SimReport, SimStep, StateSpread, TubeReport, UnsafeHits,
 };
 pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
 pub use shard::Shard;
 
 use crate::interval::Interval;
-use crate::model::{Guarantee, ModelInfo};
+use crate::model::{Bounds, Guarantee, ModelInfo};
 use crate::prs::{Prs, UnsafeKind};
 use crate::system::System;
 use crate::workers::Workers;
@@ -106,6 +106,10 @@ pub struct Options {
     /// horizon ([`Reach::safety_probability`](crate::Reach::safety_probability)), tested
     /// against the paths (see [`SafetyCheck`]).
     pub safety_bound: Option<f64>,
+    /// Per goal set of the model, a certified lower bound of the probability of its event
+    /// ([`Reach::goal_probability`](crate::Reach::goal_probability)), tested against the paths
+    /// (see [`GoalCheck`]); empty, or `None` for a goal: nothing tested.
+    pub goal_bounds: Vec<Option<f64>>,
 }
 
 impl Default for Options {
@@ -119,6 +123,7 @@ impl Default for Options {
             confidence: 0.999,
             threads: None,
             safety_bound: None,
+            goal_bounds: Vec::new(),
         }
     }
 }
@@ -211,7 +216,7 @@ pub fn run_part<S: System + Sync + ?Sized>(
     let workers = Workers::new(opts.threads).map_err(SimError::Invalid)?;
     let j = usize::try_from(j).unwrap_or(usize::MAX);
     let (mut topk, mut state_topk) = (topk::TopK::new(steps, j), topk::TopK::new(steps * n, j));
-    let mut total = ChunkStats::new(steps, plan.unsafe_sets.len(), n);
+    let mut total = ChunkStats::new(steps, plan.unsafe_sets.len(), plan.goals.len(), n);
     let range = shard.paths(n_paths);
     let mut done = 0;
     let mine = range.end - range.start;
@@ -289,6 +294,15 @@ fn run_info<S: System + ?Sized>(
             .iter()
             .map(|u| (u.name.clone(), UnsafeKind::of(&u.shape)))
             .collect(),
+        goals: info
+            .goals
+            .iter()
+            .enumerate()
+            .map(|(g, goal)| {
+                let bound = opts.goal_bounds.get(g).copied().flatten();
+                (goal.name.clone(), bound)
+            })
+            .collect(),
         quantile_rank: j,
         steps: result
             .steps
@@ -303,8 +317,8 @@ fn run_info<S: System + ?Sized>(
             .collect(),
         digest: part_file::checksum(
             format!(
-                "{result:?} {:?} {:?} {:?}",
-                info.input_box, info.domain, info.unsafe_sets
+                "{result:?} {:?} {:?} {:?} {:?}",
+                info.input_box, info.domain, info.unsafe_sets, info.goals
             )
             .as_bytes(),
         ),
@@ -351,8 +365,19 @@ fn make_plan<'a, S: System + ?Sized>(
     if !(hold > 0.0 && hold.is_finite()) {
         return usage(format!("the hold time {hold} must be positive and finite"));
     }
-    if let Some(b) = opts.safety_bound.filter(|b| !(0.0..=1.0).contains(b)) {
+    let bounds = opts
+        .safety_bound
+        .iter()
+        .chain(opts.goal_bounds.iter().flatten());
+    if let Some(b) = bounds.copied().find(|b| !(0.0..=1.0).contains(b)) {
         return usage(format!("the probability bound {b} must lie in [0, 1]"));
+    }
+    if !opts.goal_bounds.is_empty() && opts.goal_bounds.len() != info.goals.len() {
+        return usage(format!(
+            "{} goal probability bounds for {} goal sets",
+            opts.goal_bounds.len(),
+            info.goals.len()
+        ));
     }
     if !(opts.confidence > 0.0 && opts.confidence < 1.0) {
         return usage(format!(
@@ -421,6 +446,24 @@ fn make_plan<'a, S: System + ?Sized>(
         Guarantee::Uniform => Some(prs::Tube::new(result, &metric).map_err(SimError::Invalid)?),
         Guarantee::Pointwise => None,
     };
+    let goals = info
+        .goals
+        .iter()
+        .map(|g| {
+            let parts = g
+                .parts
+                .iter()
+                .map(|p| regions::Region::unsafe_set(p, n))
+                .collect::<Result<Vec<_>, _>>()?;
+            let w = g.window.unwrap_or(Bounds::new(0.0, result.horizon));
+            Ok(paths::GoalEvent {
+                parts,
+                window: (w.lo, w.hi),
+                stay: g.stay,
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(SimError::Invalid)?;
     Ok(Plan {
         sys,
         seed: opts.seed,
@@ -435,6 +478,7 @@ fn make_plan<'a, S: System + ?Sized>(
         inputs: inputs::InputSchedule::new(&info.input_box, opts.inputs, hold),
         noise: noise::Noise::new(sys, *times.last().unwrap_or(&0.0), &result.initial_center),
         unsafe_sets,
+        goals,
         domain: info
             .has_domain
             .then(|| regions::Region::domain(&info.domain)),

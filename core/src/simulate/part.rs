@@ -80,6 +80,8 @@ pub struct RunInfo {
     pub has_domain: bool,
     /// The unsafe sets, in order: name and kind.
     pub unsafe_sets: Vec<(String, UnsafeKind)>,
+    /// The goal sets' names, each with the certified lower bound of its probability to test.
+    pub goals: Vec<(String, Option<f64>)>,
     /// `j = floor(delta N (1 + 1e-12)) + 1` (at most `N`), from the whole run's `N`.
     pub quantile_rank: u64,
     /// Per report time, what the analysis computed there.
@@ -121,6 +123,8 @@ pub struct PartStats {
     pub first_hit: Vec<f64>,
     /// Paths that entered some unsafe set.
     pub unsafe_any: u64,
+    /// Per goal set, paths whose event happened.
+    pub goal_reached: Vec<u64>,
     /// Paths that left the domain.
     pub left_domain: u64,
     /// Paths whose state became non-finite.
@@ -138,6 +142,7 @@ impl PartStats {
             unsafe_hits: c.unsafe_hits,
             first_hit: c.first_hit,
             unsafe_any: c.unsafe_any,
+            goal_reached: c.goal_reached,
             left_domain: c.left_domain,
             diverged: c.diverged,
         }
@@ -149,6 +154,7 @@ impl PartStats {
         sum(&mut self.outside, &other.outside);
         sum(&mut self.left_tube, &other.left_tube);
         sum(&mut self.unsafe_hits, &other.unsafe_hits);
+        sum(&mut self.goal_reached, &other.goal_reached);
         for (a, &b) in self.first_hit.iter_mut().zip(&other.first_hit) {
             *a = a.min(b);
         }
@@ -188,6 +194,7 @@ impl Part {
             || run.steps.iter().any(|s| s.hull.len() != n)
             || st.unsafe_hits.len() != sets
             || st.first_hit.len() != sets
+            || st.goal_reached.len() != run.goals.len()
         {
             return Some("its statistics do not match its report times or unsafe sets".into());
         }
@@ -197,7 +204,11 @@ impl Part {
                 run.quantile_rank, run.paths
             ));
         }
-        let counts = st.outside.iter().chain(&st.unsafe_hits);
+        let counts = st
+            .outside
+            .iter()
+            .chain(&st.unsafe_hits)
+            .chain(&st.goal_reached);
         let totals = [
             st.outside_any,
             st.outside_tube,

@@ -20,7 +20,7 @@ use crate::prs::UnsafeKind;
 /// The first bytes of a part file.
 pub const MAGIC: &[u8] = b"reachc simulate part\n";
 /// The version of the layout this reachc writes and reads.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 
 /// FNV-1a, 64 bits.
 pub(crate) fn checksum(bytes: &[u8]) -> u64 {
@@ -166,6 +166,7 @@ impl Part {
         w.u64s(&st.unsafe_hits);
         w.f64s(&st.first_hit);
         w.u64(st.unsafe_any);
+        w.u64s(&st.goal_reached);
         w.u64(st.left_domain);
         w.u64(st.diverged);
         w.u64(self.top.len() as u64);
@@ -220,6 +221,7 @@ impl Part {
             unsafe_hits: r.u64s()?,
             first_hit: r.f64s()?,
             unsafe_any: r.u64()?,
+            goal_reached: r.u64s()?,
             left_domain: r.u64()?,
             diverged: r.u64()?,
         };
@@ -285,6 +287,11 @@ fn write_run(w: &mut Writer, run: &RunInfo) {
         w.str(name);
         w.u8(code_of(&UNSAFE, kind));
     }
+    w.u64(run.goals.len() as u64);
+    for (name, bound) in &run.goals {
+        w.str(name);
+        w.opt_f64(*bound);
+    }
     w.u64(run.quantile_rank);
     w.u64(run.steps.len() as u64);
     for s in &run.steps {
@@ -340,6 +347,9 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
         has_domain: r.bool()?,
         unsafe_sets: (0..r.len(9)?)
             .map(|_| Ok((r.str()?, r.code("unsafe set", &UNSAFE)?)))
+            .collect::<Result<_, String>>()?,
+        goals: (0..r.len(9)?)
+            .map(|_| Ok((r.str()?, r.opt_f64()?)))
             .collect::<Result<_, String>>()?,
         quantile_rank: r.u64()?,
         steps: (0..r.len(32)?)

@@ -97,6 +97,8 @@ pub(crate) struct Plan<'a, S: ?Sized> {
     pub(crate) inputs: InputSchedule,
     pub(crate) noise: Noise,
     pub(crate) unsafe_sets: Vec<Region>,
+    /// The goal sets' events to count (method.md 8.13).
+    pub(crate) goals: Vec<GoalEvent>,
     pub(crate) domain: Option<Region>,
     pub(crate) zig: &'static Ziggurat,
     /// The processor has AVX2, BMI1 and BMI2: the hot loops run in copies compiled for them
@@ -108,6 +110,45 @@ pub(crate) struct Plan<'a, S: ?Sized> {
     /// vector lanes ([`super::avx512`]), which draw the same numbers and do the same IEEE
     /// operations per lane, so the results do not depend on it either.
     pub(crate) avx512: bool,
+}
+
+/// A goal set's event, as the paths are checked against it at every Euler-Maruyama step: in
+/// the goal at a step in the window with no unsafe set entered at a step before (reach), or
+/// in it from a step no later than the window's end to the horizon with no unsafe set entered
+/// at any step (stay).
+#[derive(Clone, Debug)]
+pub(crate) struct GoalEvent {
+    /// The goal is the intersection of these.
+    pub(crate) parts: Vec<Region>,
+    /// The window `[t1, t2]`.
+    pub(crate) window: (f64, f64),
+    /// Reach and stay until the horizon.
+    pub(crate) stay: bool,
+}
+
+/// One path's progress on one goal.
+#[derive(Clone, Copy, Debug)]
+struct GoalPath {
+    /// Reach: the event has happened.
+    reached: bool,
+    /// Stay: the start of the path's current run of steps in the goal (NaN: not in it).
+    since: f64,
+}
+
+impl GoalPath {
+    const START: GoalPath = GoalPath {
+        reached: false,
+        since: f64::NAN,
+    };
+
+    /// Whether the path's event has happened, at the horizon (`clean`: it entered no unsafe
+    /// set).
+    fn happened(self, event: &GoalEvent, clean: bool) -> bool {
+        match event.stay {
+            false => self.reached,
+            true => clean && self.since <= event.window.1,
+        }
+    }
 }
 
 /// Statistics of a chunk of paths.
@@ -135,6 +176,8 @@ pub(crate) struct ChunkStats {
     pub(crate) first_hit: Vec<f64>,
     /// Paths that entered some unsafe set.
     pub(crate) unsafe_any: u64,
+    /// Per goal set, paths whose event happened.
+    pub(crate) goal_reached: Vec<u64>,
     /// Paths that left the domain.
     pub(crate) left_domain: u64,
     /// Paths whose state became non-finite.
@@ -142,7 +185,7 @@ pub(crate) struct ChunkStats {
 }
 
 impl ChunkStats {
-    pub(crate) fn new(steps: usize, sets: usize, states: usize) -> Self {
+    pub(crate) fn new(steps: usize, sets: usize, goals: usize, states: usize) -> Self {
         ChunkStats {
             outside: vec![0; steps],
             candidates: Vec::new(),
@@ -154,6 +197,7 @@ impl ChunkStats {
             unsafe_hits: vec![0; sets],
             first_hit: vec![f64::INFINITY; sets],
             unsafe_any: 0,
+            goal_reached: vec![0; goals],
             left_domain: 0,
             diverged: 0,
         }
@@ -211,6 +255,9 @@ impl ChunkStats {
             *a = a.min(b);
         }
         self.unsafe_any += other.unsafe_any;
+        for (a, b) in self.goal_reached.iter_mut().zip(&other.goal_reached) {
+            *a += b;
+        }
         self.left_domain += other.left_domain;
         self.diverged += other.diverged;
     }
@@ -285,6 +332,8 @@ struct Lanes {
     x: Vec<f64>,
     u: Vec<f64>,
     hit: Vec<bool>,
+    /// One per goal per lane.
+    goal: Vec<GoalPath>,
     paths: [Path; LANES],
     /// Scratch of the general loop: the drift of models larger than [`SMALL`], one path's
     /// normals and `G` (noise that is not constant and diagonal).
@@ -390,7 +439,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         // Lanes are `max(n, 1)` and `max(p, 1)` wide so that chunking by them never panics.
         let (n, p, m) = (dim.get().max(1), self.sys.p().max(1), self.sys.m());
         let sets = self.unsafe_sets.len();
-        let mut st = ChunkStats::new(self.times.len(), sets, dim.get());
+        let mut st = ChunkStats::new(self.times.len(), sets, self.goals.len(), dim.get());
         let quiet = (0..self.times.len())
             .map(|k| Some(thresholds.metric[k].min(self.membership.inside_below(k)?)))
             .collect();
@@ -406,6 +455,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             x: vec![0.0; LANES * n],
             u: vec![0.0; LANES * p],
             hit: vec![false; LANES * sets.max(1)],
+            goal: vec![GoalPath::START; LANES * self.goals.len()],
             paths: [path; LANES],
             f: vec![0.0; n],
             z: vec![0.0; m],
@@ -434,7 +484,9 @@ impl<S: System + ?Sized> Plan<'_, S> {
         st: &mut ChunkStats,
     ) {
         let (n, nn, sets) = (dim.get(), dim.get().max(1), self.unsafe_sets.len().max(1));
+        let goals = self.goals.len();
         l.hit.fill(false);
+        l.goal.fill(GoalPath::START);
         for (a, path) in l.paths.iter_mut().enumerate().take(lanes) {
             path.rng = PathRng::new(self.seed, first + a as u64);
             path.hold = None;
@@ -448,12 +500,14 @@ impl<S: System + ?Sized> Plan<'_, S> {
             st.record_states(0, x, &self.nominal[..n], thresholds.states_at(0, n));
             self.check_tube(0, x, path, st);
             let hit = &mut l.hit[a * sets..][..sets];
-            self.check_sets(0.0, x, hit, &mut path.left_domain, st);
+            let goal = &mut l.goal[a * goals..][..goals];
+            self.check_sets(0.0, x, hit, goal, &mut path.left_domain, st);
         }
         // The common case, in a loop of its own (`additive_lanes`).
         let additive = n <= SMALL
             && self.sys.p() == 0
             && self.unsafe_sets.is_empty()
+            && self.goals.is_empty()
             && self.domain.is_none()
             && self.noise.diagonal().is_some()
             && self.metric.nonneg_diagonal().is_some();
@@ -473,7 +527,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
         // Other small models: eight paths at a time in `lanes_x8`.
         #[cfg(target_arch = "x86_64")]
-        if start == 0 && self.avx512 && self.lanes_take(n) {
+        if start == 0 && self.avx512 && self.lanes_take(n) && self.goals.is_empty() {
             start = lanes / 8 * 8;
             let groups =
                 l.x.chunks_exact_mut(8 * nn)
@@ -536,6 +590,15 @@ impl<S: System + ?Sized> Plan<'_, S> {
             let entered = l.hit.chunks_exact(sets).take(lanes);
             st.unsafe_any += entered.filter(|h| h.contains(&true)).count() as u64;
         }
+        for a in 0..lanes.min(l.goal.len() / goals.max(1)) {
+            // (A path whose state became non-finite stays nowhere.)
+            let clean = !l.hit[a * sets..][..sets].contains(&true);
+            let alive = l.paths[a].alive;
+            for (j, event) in self.goals.iter().enumerate() {
+                let p = l.goal[a * goals + j];
+                st.goal_reached[j] += u64::from(p.happened(event, clean) && (alive || !event.stay));
+            }
+        }
         for path in &l.paths[..lanes] {
             st.outside_any += u64::from(path.outside_any);
             st.outside_tube += u64::from(path.left_tube);
@@ -566,7 +629,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
     ) {
         let (sys, zig, metric) = (self.sys, self.zig, &self.metric);
         let (n, p, sets) = (dim.get(), sys.p(), self.unsafe_sets.len());
-        let check_sets = sets > 0 || self.domain.is_some();
+        let goals = self.goals.len();
+        let check_sets = sets > 0 || goals > 0 || self.domain.is_some();
         let (t, h) = (step.t, step.span.h);
         // Small models: per-step vectors in local arrays, which the compiler keeps in registers
         // (heap scratch could alias the states, and would be reloaded for every lane).
@@ -615,7 +679,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
             path.rng = r;
             if check_sets {
                 let hit = &mut l.hit[a * sets..][..sets];
-                self.check_sets(step.t_end, x, hit, &mut path.left_domain, st);
+                let goal = &mut l.goal[a * goals..][..goals];
+                self.check_sets(step.t_end, x, hit, goal, &mut path.left_domain, st);
             }
             self.check_tube(step.k, x, path, st);
             if let Some(rep) = &step.report {
@@ -1133,13 +1198,14 @@ impl<S: System + ?Sized> Plan<'_, S> {
         path.alive = finite;
     }
 
-    /// Unsafe-set entries and domain exits of a path at time `t`.
+    /// Unsafe-set entries, goal progress and domain exits of a path at time `t`.
     #[inline(always)]
     fn check_sets(
         &self,
         t: f64,
         x: &[f64],
         hit: &mut [bool],
+        goal: &mut [GoalPath],
         left_domain: &mut bool,
         st: &mut ChunkStats,
     ) {
@@ -1148,6 +1214,21 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 hit[j] = true;
                 st.unsafe_hits[j] += 1;
                 st.first_hit[j] = st.first_hit[j].min(t);
+            }
+        }
+        if !goal.is_empty() {
+            let clean = !hit.contains(&true);
+            for (event, path) in self.goals.iter().zip(goal) {
+                let inside = event.parts.iter().all(|r| r.contains(x));
+                if event.stay {
+                    path.since = match inside {
+                        true if path.since.is_nan() => t,
+                        true => path.since,
+                        false => f64::NAN,
+                    };
+                } else if inside && clean && event.window.0 <= t && t <= event.window.1 {
+                    path.reached = true;
+                }
             }
         }
         if let Some(d) = &self.domain {

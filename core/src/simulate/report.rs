@@ -53,6 +53,8 @@ pub struct SimReport {
     pub unsafe_sets: Vec<UnsafeHits>,
     /// With unsafe sets: the paths that entered none, against a certified bound if given.
     pub safety: Option<SafetyCheck>,
+    /// Per goal set, its event's paths against the certified probability, where given.
+    pub goals: Vec<GoalCheck>,
     /// Paths that left the spec's domain at some Euler step (`None` without a domain).
     pub left_domain: Option<u64>,
     /// Paths whose state became non-finite (counted outside from then on).
@@ -204,7 +206,9 @@ impl SimReport {
     /// Whether the coverage check passed, and the probability-of-safety check where there is
     /// one.
     pub fn passed(&self) -> bool {
-        self.verdict.passed && self.safety.as_ref().is_none_or(|s| s.passed)
+        self.verdict.passed
+            && self.safety.as_ref().is_none_or(|s| s.passed)
+            && self.goals.iter().all(|g| g.passed)
     }
 }
 
@@ -224,6 +228,28 @@ pub struct SafetyCheck {
     pub certified: Option<f64>,
     /// The bound is not above `cp_upper` (true without a bound): a valid bound fails with
     /// probability at most `1 - confidence`.
+    pub passed: bool,
+}
+
+/// The paths whose goal event happened (method.md 8.13: in the goal at an Euler-Maruyama step
+/// in the window with no unsafe set entered at a step before; with `stay`, in it at every step
+/// from one no later than the window's end to the horizon, no unsafe set entered at any step),
+/// an estimate of its probability, against a certified lower bound. Between steps a path can
+/// cross an unsafe set or the goal's boundary unseen, in either direction, so the estimate
+/// carries the Euler-Maruyama grid's error (small at the steps `dt` chooses).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GoalCheck {
+    /// The goal's name.
+    pub name: String,
+    /// Paths whose event happened.
+    pub reached: u64,
+    /// `reached / paths`.
+    pub fraction: f64,
+    /// One-sided Clopper-Pearson upper bound of the event's probability at `confidence`.
+    pub cp_upper: f64,
+    /// The certified lower bound tested (`None`: nothing is tested).
+    pub certified: Option<f64>,
+    /// The bound is not above `cp_upper` (true without a bound).
     pub passed: bool,
 }
 

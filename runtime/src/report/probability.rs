@@ -146,7 +146,11 @@ pub fn goal_line(
     let w = g.window.map_or((0.0, horizon), |w| (w.lo, w.hi));
     let (lo, hi) = (time(w.0), time(w.1));
     let event = if g.stay {
-        format!("reach `{}` within [{lo}, {hi}] and stay until {hi}", g.name)
+        format!(
+            "reach `{}` within [{lo}, {hi}] and stay until {}",
+            g.name,
+            time(horizon)
+        )
     } else {
         format!("reach `{}` within [{lo}, {hi}]", g.name)
     };

@@ -443,16 +443,20 @@ impl<'a> GoalJson<'a> {
 fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
     let (lo, hi) = (time(g.window.lo), time(g.window.hi));
     let what = if g.stay {
-        format!("reach within [{lo}, {hi}] and stay")
+        format!(
+            "reach within [{lo}, {hi}] and stay until {}",
+            time(prs.horizon)
+        )
     } else {
         format!("reach within [{lo}, {hi}]")
     };
     let status = match &g.outcome {
         GoalOutcome::Reached { t, margin } => {
             let claim = if g.stay {
+                let end = time(prs.horizon);
                 format!(
-                    "the state is in it at t = {} and stays in it until t = {hi}, avoiding every \
-                     unsafe set on [0, {hi}]",
+                    "the state is in it at t = {} and stays in it until t = {end}, avoiding every \
+                     unsafe set on [0, {end}]",
                     time(*t)
                 )
             } else {

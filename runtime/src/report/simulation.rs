@@ -46,6 +46,9 @@ struct Json<'a> {
     outside_tube: Option<TubeJson>,
     unsafe_sets: Vec<UnsafeJson<'a>>,
     safety: Option<SafetyJson>,
+    /// Per goal set (absent without goals).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    goals: Vec<GoalJson<'a>>,
     left_domain: Option<u64>,
     diverged: u64,
     verdict: CoverageJson,
@@ -133,6 +136,18 @@ struct UnsafeJson<'a> {
 #[derive(Serialize)]
 struct SafetyJson {
     safe: u64,
+    fraction: f64,
+    cp_upper: f64,
+    certified: Option<f64>,
+    /// `pass` or `fail`; `null` without a certified bound.
+    status: Option<&'static str>,
+}
+
+/// The paths whose goal event happened, against its certified probability.
+#[derive(Serialize)]
+struct GoalJson<'a> {
+    name: &'a str,
+    reached: u64,
     fraction: f64,
     cp_upper: f64,
     certified: Option<f64>,
@@ -269,6 +284,18 @@ impl<'a> Json<'a> {
                 certified: c.certified,
                 status: c.certified.map(|_| status(c.passed)),
             }),
+            goals: r
+                .goals
+                .iter()
+                .map(|g| GoalJson {
+                    name: &g.name,
+                    reached: g.reached,
+                    fraction: g.fraction,
+                    cp_upper: g.cp_upper,
+                    certified: g.certified,
+                    status: g.certified.map(|_| status(g.passed)),
+                })
+                .collect(),
             left_domain: r.left_domain,
             diverged: r.diverged,
             verdict: CoverageJson {
@@ -533,28 +560,14 @@ pub fn summary(r: &SimReport) -> String {
         );
     }
     if let Some(c) = &r.safety {
-        let _ = write!(
-            s,
-            "  probability of safety: {} of {} ({:.6}) entered no unsafe set at any \
-             Euler-Maruyama step (Clopper-Pearson upper bound {:.6} at confidence {})",
-            count(c.safe, "path"),
-            r.paths,
-            c.fraction,
-            c.cp_upper,
-            r.confidence
-        );
-        match c.certified {
-            Some(b) if c.passed => {
-                let _ = writeln!(s, "; the certified lower bound {b} is not above it: PASS");
-            }
-            Some(b) => {
-                let _ = writeln!(
-                    s,
-                    "; the certified lower bound {b} is above it: FAIL (the bound is too high)"
-                );
-            }
-            None => s.push('\n'),
-        }
+        let check = (c.safe, c.fraction, c.cp_upper, c.certified, c.passed);
+        let what = "entered no unsafe set at any Euler-Maruyama step";
+        s.push_str(&check_line(r, "probability of safety", what, check));
+    }
+    for g in &r.goals {
+        let check = (g.reached, g.fraction, g.cp_upper, g.certified, g.passed);
+        let what = "reached it as the goal set asks, at the Euler-Maruyama steps";
+        s.push_str(&check_line(r, &format!("goal `{}`", g.name), what, check));
     }
     if let Some(left) = r.left_domain {
         let _ = writeln!(
@@ -604,4 +617,28 @@ pub fn summary(r: &SimReport) -> String {
         }
     }
     s
+}
+
+/// A probability check's line: `label`, the paths that did `what` (`counted`, their
+/// `fraction` and its Clopper-Pearson upper bound), and the certified lower bound against it.
+fn check_line(
+    r: &SimReport,
+    label: &str,
+    what: &str,
+    (counted, fraction, cp_upper, certified, passed): (u64, f64, f64, Option<f64>, bool),
+) -> String {
+    let verdict = match certified {
+        Some(b) if passed => format!("; the certified lower bound {b} is not above it: PASS"),
+        Some(b) => {
+            format!("; the certified lower bound {b} is above it: FAIL (the bound is too high)")
+        }
+        None => String::new(),
+    };
+    format!(
+        "  {label}: {} of {} ({fraction:.6}) {what} (Clopper-Pearson upper bound {cp_upper:.6} at \
+         confidence {}){verdict}\n",
+        count(counted, "path"),
+        r.paths,
+        r.confidence
+    )
 }
