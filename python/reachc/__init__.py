@@ -26,13 +26,14 @@ from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Tuple, Un
 import numpy as np
 
 from . import _native
-from ._native import AnalysisError, Diagnostic, SafetyProbability, SpecError
+from ._native import AnalysisError, Diagnostic, GoalProbability, SafetyProbability, SpecError
 
 __all__ = [
     "AnalysisError",
     "Diagnostic",
     "Reach",
     "Result",
+    "GoalProbability",
     "SafetyProbability",
     "Simulation",
     "Spec",
@@ -275,6 +276,15 @@ class Reach:
         or a model without unsafe sets."""
         return self._native.safety_probability()
 
+    def goal_probability(self, goal: str) -> GoalProbability:
+        """A certified lower bound of the probability of reaching the goal set ``goal`` within
+        its window, avoiding every unsafe set until then (with ``stay``: and staying in it to
+        the horizon), for every start and input: the goal's ``probability`` in ``reachc run
+        --probability`` (``t`` the reach time at that bound; ``limit`` what stops it). About a
+        dozen runs, the GIL released. Raises :class:`ValueError` for an unknown goal and
+        :class:`AnalysisError` for a pointwise guarantee."""
+        return self._native.goal_probability(goal)
+
     def __repr__(self) -> str:
         return repr(self._native)
 
@@ -378,6 +388,14 @@ class Result:
     def verdict(self) -> str:
         """``"safe"``, ``"no unsafe sets"`` or ``"not shown safe"``."""
         return str(self._verdict["verdict"])
+
+    @property
+    def goals(self) -> List[Dict[str, Any]]:
+        """Per goal set of the model, what the result shows (method.md 8.13): ``name``,
+        ``window``, ``stay``, ``status`` (``"reached"`` with the first report time ``t`` and
+        its ``margin``; ``"not_shown"`` with ``why``, ``why_t``, ``why_set``;
+        ``"needs_uniform"``) and ``margins`` per report time."""
+        return self._native.goals
 
     @property
     def verdict_detail(self) -> Dict[str, Any]:

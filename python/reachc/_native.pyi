@@ -103,11 +103,27 @@ class Reach:
     ) -> Result: ...
     def sweep(self, boxes: FloatArray) -> List[Result]: ...
     def safety_probability(self) -> SafetyProbability: ...
+    def goal_probability(self, goal: str) -> GoalProbability: ...
 
 class SafetyProbability:
     horizon: float
     lower_bound: Optional[float]
     delta: Optional[float]
+    not_shown_at: Optional[float]
+    limit: str
+    limit_t: Optional[float]
+    limit_set: Optional[str]
+    limit_why: Optional[str]
+    runs: int
+    proved: bool
+    conditional_on_domain: bool
+    text: str
+
+class GoalProbability:
+    goal: str
+    lower_bound: Optional[float]
+    delta: Optional[float]
+    t: Optional[float]
     not_shown_at: Optional[float]
     limit: str
     limit_t: Optional[float]
@@ -149,6 +165,8 @@ class Result:
     def margins(self) -> FloatArray: ...
     @property
     def unsafe_sets(self) -> List[str]: ...
+    @property
+    def goals(self) -> List[Dict[str, Any]]: ...
     @property
     def metric(self) -> FloatArray: ...
     def verdict(self) -> Dict[str, Any]: ...

@@ -28,8 +28,8 @@ use reachc_compiler::ir::{ExprId, Names};
 use reachc_compiler::model::Model;
 use reachc_runtime::engine::RunError;
 use reachc_runtime::model::{InitialSet, ModelInfo};
-use reachc_runtime::probability::SafetyLimit;
-use reachc_runtime::prs::{DetSet, Verdict};
+use reachc_runtime::probability::{GoalLimit, SafetyLimit};
+use reachc_runtime::prs::{DetSet, GoalMiss, GoalOutcome, Verdict};
 use reachc_runtime::simulate::{self, InputMode, SimError, SimReport};
 use reachc_runtime::{report, Bounds, InputPlan, Prs, Reach};
 
@@ -659,6 +659,52 @@ impl ReachHandle {
         })
     }
 
+    /// A certified lower bound of the probability of reaching the goal set `goal` (its name),
+    /// avoiding the unsafe sets until then (with `stay`: and staying in it to the horizon),
+    /// for every start and input (`reachc run --probability`; about a dozen runs, the GIL
+    /// released).
+    fn goal_probability(&self, py: Python<'_>, goal: &str) -> PyResult<GoalProbabilityPy> {
+        let info = &self.inner.info;
+        let Some(g) = info.goals.iter().position(|x| x.name == goal) else {
+            let names: Vec<&str> = info.goals.iter().map(|x| x.name.as_str()).collect();
+            return Err(PyValueError::new_err(format!(
+                "no goal `{goal}` (the goals: {})",
+                names.join(", ")
+            )));
+        };
+        let p = py
+            .detach(|| self.reach.0.goal_probability(g))
+            .map_err(run_error)?;
+        let sets = &info.unsafe_sets;
+        let (limit, t, set, why) = match &p.limit {
+            GoalLimit::Resolution => ("resolution", None, None, None),
+            GoalLimit::Floor => ("floor", None, None, None),
+            GoalLimit::NotShown(miss) => {
+                let (kind, t, set) = miss_fields(miss);
+                (kind, t, set.map(|s| sets[s].name.clone()), None)
+            }
+            GoalLimit::Failed { delta, why } => {
+                ("failed", Some(*delta), None, Some(why.to_string()))
+            }
+        };
+        let horizon = self.reach.0.analysis().horizon;
+        Ok(GoalProbabilityPy {
+            goal: goal.to_string(),
+            lower_bound: p.lower_bound(),
+            delta: p.delta,
+            t: p.t,
+            not_shown_at: p.not_shown_at,
+            limit: limit.to_string(),
+            limit_t: t,
+            limit_set: set,
+            limit_why: why,
+            runs: p.runs,
+            proved: p.validation.not_validated.is_empty(),
+            conditional_on_domain: p.validation.conditional_on_domain,
+            text: report::probability::goal_line(&info.goals, sets, horizon, &p),
+        })
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Reach({:?} of model {:?})",
@@ -692,6 +738,44 @@ struct SafetyProbabilityPy {
 impl SafetyProbabilityPy {
     fn __repr__(&self) -> String {
         self.text.clone()
+    }
+}
+
+/// A certified lower bound of the probability of reaching a goal (`Reach.goal_probability`):
+/// the fields of the JSON's `goals[].probability`, the limit flattened (`limit` one of
+/// `resolution`, `floor`, `failed`, `no_report_time`, `unsafe`, `not_inside`, `leaves`;
+/// `limit_t` its time, or the `delta` of a `failed` one), and `text` the summary's line.
+#[pyclass(module = "reachc._native", frozen, get_all, name = "GoalProbability")]
+struct GoalProbabilityPy {
+    goal: String,
+    lower_bound: Option<f64>,
+    delta: Option<f64>,
+    t: Option<f64>,
+    not_shown_at: Option<f64>,
+    limit: String,
+    limit_t: Option<f64>,
+    limit_set: Option<String>,
+    limit_why: Option<String>,
+    runs: usize,
+    proved: bool,
+    conditional_on_domain: bool,
+    text: String,
+}
+
+#[pymethods]
+impl GoalProbabilityPy {
+    fn __repr__(&self) -> String {
+        self.text.clone()
+    }
+}
+
+/// A goal miss as `(kind, time, unsafe set index)`, the JSON's names.
+fn miss_fields(miss: &GoalMiss) -> (&'static str, Option<f64>, Option<usize>) {
+    match *miss {
+        GoalMiss::NoReportTime => ("no_report_time", None, None),
+        GoalMiss::Unsafe { t, set } => ("unsafe", Some(t), Some(set)),
+        GoalMiss::NotInside { t, .. } => ("not_inside", Some(t), None),
+        GoalMiss::Leaves { t } => ("leaves", Some(t), None),
     }
 }
 
@@ -850,6 +934,40 @@ impl ReachResult {
             .unsafe_sets
             .iter()
             .map(|u| u.name.clone())
+            .collect()
+    }
+
+    /// Per goal set: `{"name", "window": (t1, t2), "stay", "status": "reached" | "not_shown" |
+    /// "needs_uniform", "t", "margin" (reached), "why", "why_t", "why_set" (not shown),
+    /// "margins"}` (`margins` per report time), as in the JSON's `goals`.
+    #[getter]
+    fn goals<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        self.prs
+            .goals
+            .iter()
+            .map(|g| {
+                let d = PyDict::new(py);
+                d.set_item("name", &g.name)?;
+                d.set_item("window", (g.window.lo, g.window.hi))?;
+                d.set_item("stay", g.stay)?;
+                match &g.outcome {
+                    GoalOutcome::Reached { t, margin } => {
+                        d.set_item("status", "reached")?;
+                        d.set_item("t", t)?;
+                        d.set_item("margin", margin)?;
+                    }
+                    GoalOutcome::NeedsUniform => d.set_item("status", "needs_uniform")?,
+                    GoalOutcome::NotShown(miss) => {
+                        let (kind, t, set) = miss_fields(miss);
+                        d.set_item("status", "not_shown")?;
+                        d.set_item("why", kind)?;
+                        d.set_item("why_t", t)?;
+                        d.set_item("why_set", set.map(|s| &self.prs.unsafe_sets[s].name))?;
+                    }
+                }
+                d.set_item("margins", array1(py, g.margins.clone()))?;
+                Ok(d)
+            })
             .collect()
     }
 
@@ -1153,6 +1271,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ReachHandle>()?;
     m.add_class::<ReachResult>()?;
     m.add_class::<SafetyProbabilityPy>()?;
+    m.add_class::<GoalProbabilityPy>()?;
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;

@@ -307,3 +307,46 @@ def test_safety_probability_needs_a_uniform_guarantee() -> None:
     )
     with pytest.raises(reachc.AnalysisError, match="guarantee = uniform"):
         reachc.loads(text).reach("a").safety_probability()
+
+
+GOALS = (
+    "model ou\nstate x = 0\nnoise w\ndrift { x' = 1 - x }\ndiffusion { x: 0.2 * w }\n"
+    "unsafe low halfspace { x <= -0.6 }\n"
+    "goal up halfspace { x >= 0.3 } within [0.5, 2]\n"
+    "goal far box { x in [5, 6] }\n"
+    "analysis a { method = contraction  delta = 0.05  horizon = 2  step = 0.01 }\n"
+)
+
+
+def test_goals_and_their_probability_equal_the_cli(cli: Path, tmp_path: Path) -> None:
+    spec_path = tmp_path / "ou.sde"
+    spec_path.write_text(GOALS)
+    reach = reachc.load(spec_path).reach("a")
+    goals = reach.run().goals
+    assert [g["name"] for g in goals] == ["up", "far"]
+    assert goals[0]["status"] == "reached" and 0.5 <= goals[0]["t"] <= 2.0
+    assert goals[1]["status"] == "not_shown" and goals[1]["why"] == "not_inside"
+    assert goals[0]["margins"].shape == (201,)
+    p = reach.goal_probability("up")
+    done = run_cli(
+        cli,
+        ["run", str(spec_path), "--backend", "interp", "--probability", "-o", str(tmp_path)],
+    )
+    assert done.returncode == 0, done.stderr
+    written = json.loads((tmp_path / "a.json").read_text())["goals"]
+    assert [g["status"] for g in written] == ["reached", "not_shown"]
+    w = written[0]["probability"]
+    assert (p.lower_bound, p.delta, p.t, p.runs, p.limit) == (
+        w["lower_bound"],
+        w["delta"],
+        w["t"],
+        w["runs"],
+        w["limit"]["kind"],
+    )
+    # The exact P(X_2 >= 0.3) is 0.99997: the certified bound lies below it.
+    assert p.lower_bound is not None and 0.99 < p.lower_bound < 0.99997
+    assert p.text in done.stdout
+    far = reach.goal_probability("far")
+    assert (far.lower_bound, far.limit) == (None, "not_inside")
+    with pytest.raises(ValueError, match="no goal `nowhere`"):
+        reach.goal_probability("nowhere")
