@@ -279,10 +279,16 @@ impl Reach<'_> {
     /// [`Reach::safety_probability`]: each `delta` a full sound run, the smallest whose
     /// time-uniform PRS shows the goal reached kept.
     ///
-    /// Errors: a pointwise guarantee, no goal `goal`, or a run at the analysis' own `delta`
-    /// that fails.
+    /// Errors: a pointwise guarantee (except for reaching alone, without unsafe sets: a question
+    /// about one time), no goal `goal`, or a run at the analysis' own `delta` that fails.
     pub fn goal_probability(&self, goal: usize) -> Result<GoalProbability, RunError> {
-        if self.analysis().guarantee != Guarantee::Uniform {
+        // Reaching alone, with no unsafe set to avoid, is a question about one time.
+        let one_time = self
+            .model()
+            .goals
+            .get(goal)
+            .is_some_and(|g| !g.stay && self.model().unsafe_sets.is_empty());
+        if self.analysis().guarantee != Guarantee::Uniform && !one_time {
             return Err(RunError::Unsupported(
                 Detail::from(
                     "a probability of reaching a goal needs `guarantee = uniform` (a pointwise \

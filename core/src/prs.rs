@@ -633,7 +633,8 @@ pub struct GoalVerdict {
     /// Per report time, how far the PRS lies inside the goal: the smallest Euclidean gap
     /// between its bounding box and the goal's boundary (for a half-space or a ball part), or
     /// per coordinate (for a box part), rounded down; not positive where it is not shown
-    /// inside.
+    /// inside. For reaching alone in a model without unsafe sets, the box is the pointwise one
+    /// ([`Prs::pointwise_hull_at`]).
     pub margins: Vec<f64>,
     /// What is shown.
     pub outcome: GoalOutcome,
@@ -655,7 +656,8 @@ pub enum GoalOutcome {
     },
     /// Not shown (this does not prove that the goal is missed).
     NotShown(GoalMiss),
-    /// A pointwise result bounds each time separately, not the path: no reach-avoid verdict.
+    /// A pointwise result bounds each time separately, not the path: no verdict (except for
+    /// reaching alone without unsafe sets, a question about one time).
     NeedsUniform,
 }
 
@@ -1031,8 +1033,35 @@ impl Prs {
         Some(hull)
     }
 
+    /// A rigorous bounding box of a set holding `X_t` at report step `k` with probability at
+    /// least `1 - delta` at that time alone (not for all times at once): [`Prs::hull_at`] with
+    /// the pointwise radius `r_pointwise` in place of `r_t` in this result's own set (never
+    /// larger; its members keep their sets, which hold at every time); for a split result, the
+    /// hull of its pieces'. `None` as for [`Prs::hull_at`].
+    pub fn pointwise_hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
+        if let Some((first, rest)) = self.pieces.split_first() {
+            let mut hull = first.pointwise_hull_at(k)?;
+            for p in rest {
+                for (b, o) in hull.iter_mut().zip(p.pointwise_hull_at(k)?) {
+                    *b = Bounds::new(b.lo.min(o.lo), b.hi.max(o.hi));
+                }
+            }
+            return Some(hull);
+        }
+        let mut hull = self.own_hull_with(k, Some(self.steps[k].r_pointwise))?;
+        for m in &self.also {
+            cut(&mut hull, &m.own_hull_at(k)?);
+        }
+        Some(hull)
+    }
+
     /// [`Prs::hull_at`] for this result's own metric.
     pub(crate) fn own_hull_at(&self, k: usize) -> Option<Vec<Bounds>> {
+        self.own_hull_with(k, None)
+    }
+
+    /// [`Prs::own_hull_at`] with the stochastic radius `r` in place of `r_t` (`None`: `r_t`).
+    fn own_hull_with(&self, k: usize, r: Option<f64>) -> Option<Vec<Bounds>> {
         let st = &self.steps[k];
         let n = self.n();
         let w = &self.constants.spread;
@@ -1040,12 +1069,19 @@ impl Prs {
             return None;
         }
         let spread = |r: f64, i: usize| Interval::point(r) * Interval::point(w[i]);
+        let (r_t, prs_radius) = match r {
+            None => (st.r_t, st.prs_radius),
+            Some(r) => (
+                r,
+                (Interval::point(st.det.radius()) + Interval::point(r)).hi(),
+            ),
+        };
         Some(match st.det.box_hull() {
             None => {
                 let c = st.det.center();
                 (0..n)
                     .map(|i| {
-                        let d = spread(st.prs_radius, i);
+                        let d = spread(prs_radius, i);
                         let c = Interval::point(c[i]);
                         Bounds::new((c - d).lo(), (c + d).hi())
                     })
@@ -1053,7 +1089,7 @@ impl Prs {
             }
             Some((lo, hi)) => (0..n)
                 .map(|i| {
-                    let r = Interval::point(st.r_t) + Interval::point(st.det.ball_added());
+                    let r = Interval::point(r_t) + Interval::point(st.det.ball_added());
                     let d = spread(r.hi(), i);
                     Bounds::new(
                         (Interval::point(lo[i]) - d).lo(),

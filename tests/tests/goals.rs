@@ -194,3 +194,48 @@ fn simulate_counts_goal_events_and_tests_their_bounds() {
         .collect();
     assert_eq!(merge(parts).unwrap(), report);
 }
+
+/// Reaching alone in a model without unsafe sets asks about one time: the pointwise radius at
+/// the reach time serves (method.md 8.13), for a uniform analysis and a pointwise one alike.
+/// The OU process of the test above, goal `x >= 0.5` within `[0.5, 2]`: the time-uniform tube
+/// gives no bound at any delta; the pointwise sets give one, below the exact `P(X_t* >= 0.5)`.
+#[test]
+fn reaching_alone_uses_the_pointwise_radius() {
+    let src = "model ou\nstate x = 0\nnoise w\ndrift { x' = 1 - x }\ndiffusion { x: 0.2 * w }\n\
+               goal up halfspace { x >= 0.5 } within [0.5, 2]\n\
+               goal hold box { x in [0.3, 1.7] } within [1, 2] stay\n\
+               analysis a { method = contraction  delta = 0.05  horizon = 2  step = 0.01 }\n\
+               analysis p { method = contraction  delta = 0.05  horizon = 2  step = 0.01  \
+               guarantee = pointwise }";
+    let (sys, info) = inline(src);
+    let mean = |t: f64| 1.0 - (-t).exp();
+    let sd = |t: f64| (0.02 * (1.0 - (-2.0 * t).exp())).sqrt();
+    for analysis in ["a", "p"] {
+        let reach = Reach::new(&sys, &info, analysis).unwrap();
+        let prs = reach.run().unwrap();
+        assert!(
+            prs.goals[0].reached(),
+            "{analysis}: {:?}",
+            prs.goals[0].outcome
+        );
+        // Each margin is that of a box holding the pointwise set: inside the uniform one's.
+        for (k, &m) in prs.goals[0].margins.iter().enumerate() {
+            let uniform = prs.hull_at(k).unwrap()[0].lo - 0.5;
+            let pointwise = prs.pointwise_hull_at(k).unwrap()[0].lo - 0.5;
+            assert!(
+                m >= uniform - 1e-12,
+                "{analysis}: step {k}: {m} < {uniform}"
+            );
+            assert!((m - pointwise).abs() <= 1e-12, "{analysis}: step {k}");
+        }
+        let up = reach.goal_probability(0).unwrap();
+        let (p, t) = (up.lower_bound().unwrap(), up.t.unwrap());
+        let exact = 1.0 - normal_tail((mean(t) - 0.5) / sd(t));
+        assert!(
+            p > 0.98 && p <= exact,
+            "{analysis}: {p} vs the exact {exact} at {t}"
+        );
+    }
+    let pointwise = run(src, "p");
+    assert_eq!(pointwise.goals[1].outcome, GoalOutcome::NeedsUniform);
+}

@@ -16,10 +16,16 @@ pub(crate) fn assess(goals: &[GoalSet], prs: &Prs) -> Vec<GoalVerdict> {
 fn assess_one(goal: &GoalSet, prs: &Prs) -> GoalVerdict {
     let window = goal.window.unwrap_or(Bounds::new(0.0, prs.horizon));
     let inside = |b: Option<Vec<Bounds>>| b.map_or(f64::NEG_INFINITY, |b| margin(goal, &b));
+    // Reaching alone (no stay, no unsafe set to avoid on the way) asks about one time: the
+    // pointwise radius at that time serves, whatever the guarantee (method.md 8.13).
+    let at_one_time = !goal.stay && prs.unsafe_sets.is_empty();
     let margins: Vec<f64> = (0..prs.steps.len())
-        .map(|k| inside(prs.hull_at(k)))
+        .map(|k| match at_one_time {
+            true => inside(prs.pointwise_hull_at(k)),
+            false => inside(prs.hull_at(k)),
+        })
         .collect();
-    let outcome = if prs.guarantee != Guarantee::Uniform {
+    let outcome = if prs.guarantee != Guarantee::Uniform && !at_one_time {
         GoalOutcome::NeedsUniform
     } else {
         outcome(goal, prs, window, &margins, |k| inside(prs.span_hull_at(k)))

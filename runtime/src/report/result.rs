@@ -454,11 +454,16 @@ fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
         GoalOutcome::Reached { t, margin } => {
             let claim = if g.stay {
                 let end = time(prs.horizon);
+                let avoiding = match prs.unsafe_sets.is_empty() {
+                    true => String::new(),
+                    false => format!(", avoiding every unsafe set on [0, {end}]"),
+                };
                 format!(
-                    "the state is in it at t = {} and stays in it until t = {end}, avoiding every \
-                     unsafe set on [0, {end}]",
+                    "the state is in it at t = {} and stays in it until t = {end}{avoiding}",
                     time(*t)
                 )
+            } else if prs.unsafe_sets.is_empty() {
+                format!("the state is in it at t = {}", time(*t))
             } else {
                 format!(
                     "the state is in it at t = {}, having avoided every unsafe set on [0, {}]",
