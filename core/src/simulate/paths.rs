@@ -142,11 +142,11 @@ impl GoalPath {
     };
 
     /// Whether the path's event has happened, at the horizon (`clean`: it entered no unsafe
-    /// set).
-    fn happened(self, event: &GoalEvent, clean: bool) -> bool {
+    /// set; `alive`: its state stayed finite, else it stays nowhere).
+    fn happened(self, event: &GoalEvent, clean: bool, alive: bool) -> bool {
         match event.stay {
             false => self.reached,
-            true => clean && self.since <= event.window.1,
+            true => alive && clean && self.since <= event.window.1,
         }
     }
 }
@@ -590,20 +590,16 @@ impl<S: System + ?Sized> Plan<'_, S> {
             let entered = l.hit.chunks_exact(sets).take(lanes);
             st.unsafe_any += entered.filter(|h| h.contains(&true)).count() as u64;
         }
-        for a in 0..lanes.min(l.goal.len() / goals.max(1)) {
-            // (A path whose state became non-finite stays nowhere.)
-            let clean = !l.hit[a * sets..][..sets].contains(&true);
-            let alive = l.paths[a].alive;
-            for (j, event) in self.goals.iter().enumerate() {
-                let p = l.goal[a * goals + j];
-                st.goal_reached[j] += u64::from(p.happened(event, clean) && (alive || !event.stay));
-            }
-        }
-        for path in &l.paths[..lanes] {
+        for (a, path) in l.paths[..lanes].iter().enumerate() {
             st.outside_any += u64::from(path.outside_any);
             st.outside_tube += u64::from(path.left_tube);
             st.left_domain += u64::from(path.left_domain);
             st.diverged += u64::from(!path.alive);
+            let clean = !l.hit[a * sets..][..sets].contains(&true);
+            let events = self.goals.iter().zip(&l.goal[a * goals..][..goals]);
+            for (n, (event, p)) in st.goal_reached.iter_mut().zip(events) {
+                *n += u64::from(p.happened(event, clean, path.alive));
+            }
         }
     }
 

@@ -1,6 +1,7 @@
 //! The probability of safety in words and in the result's JSON (`reachc run --probability`,
 //! method.md 8.9).
 
+use super::result::GoalMissJson;
 use super::{count, time};
 use reachc_core::model::{GoalSet, UnsafeSet};
 use reachc_core::probability::{GoalLimit, GoalProbability, SafetyLimit, SafetyProbability};
@@ -88,15 +89,19 @@ pub(super) struct GoalProbabilityJson<'a> {
     conditional_on_domain: bool,
 }
 
+/// A goal probability's limit: the search's own, or the goal's miss at the largest delta tried.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum GoalLimitJson<'a> {
+    Search(SearchLimitJson),
+    Miss(GoalMissJson<'a>),
+}
+
 #[derive(Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
-enum GoalLimitJson<'a> {
+enum SearchLimitJson {
     Resolution,
     Floor,
-    NoReportTime,
-    Unsafe { t: f64, set: &'a str },
-    NotInside { t: f64, margin: f64 },
-    Leaves { t: f64 },
     Failed { delta: f64, why: String },
 }
 
@@ -108,24 +113,15 @@ impl<'a> GoalProbabilityJson<'a> {
             t: p.t,
             not_shown_at: p.not_shown_at,
             limit: match &p.limit {
-                GoalLimit::Resolution => GoalLimitJson::Resolution,
-                GoalLimit::Floor => GoalLimitJson::Floor,
-                GoalLimit::NotShown(GoalMiss::NoReportTime) => GoalLimitJson::NoReportTime,
-                GoalLimit::NotShown(GoalMiss::Unsafe { t, set }) => GoalLimitJson::Unsafe {
-                    t: *t,
-                    set: prs.unsafe_sets.get(*set).map_or("?", |u| &u.name),
-                },
-                GoalLimit::NotShown(GoalMiss::NotInside { t, margin }) => {
-                    GoalLimitJson::NotInside {
-                        t: *t,
-                        margin: *margin,
-                    }
+                GoalLimit::Resolution => GoalLimitJson::Search(SearchLimitJson::Resolution),
+                GoalLimit::Floor => GoalLimitJson::Search(SearchLimitJson::Floor),
+                GoalLimit::NotShown(miss) => GoalLimitJson::Miss(GoalMissJson::of(prs, miss)),
+                GoalLimit::Failed { delta, why } => {
+                    GoalLimitJson::Search(SearchLimitJson::Failed {
+                        delta: *delta,
+                        why: why.to_string(),
+                    })
                 }
-                GoalLimit::NotShown(GoalMiss::Leaves { t }) => GoalLimitJson::Leaves { t: *t },
-                GoalLimit::Failed { delta, why } => GoalLimitJson::Failed {
-                    delta: *delta,
-                    why: why.to_string(),
-                },
             },
             runs: p.runs,
             proved: p.validation.not_validated.is_empty(),

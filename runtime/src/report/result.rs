@@ -396,13 +396,28 @@ struct GoalJson<'a> {
     margins: &'a [f64],
 }
 
+/// Why a goal is not shown reached (a goal's `why`, and the limit of its probability).
 #[derive(Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
-enum GoalMissJson<'a> {
+pub(super) enum GoalMissJson<'a> {
     NoReportTime,
     Unsafe { t: f64, set: &'a str },
     NotInside { t: f64, margin: f64 },
     Leaves { t: f64 },
+}
+
+impl<'a> GoalMissJson<'a> {
+    pub(super) fn of(prs: &'a Prs, miss: &GoalMiss) -> GoalMissJson<'a> {
+        match *miss {
+            GoalMiss::NoReportTime => GoalMissJson::NoReportTime,
+            GoalMiss::Unsafe { t, set } => GoalMissJson::Unsafe {
+                t,
+                set: prs.unsafe_sets.get(set).map_or("?", |u| &u.name),
+            },
+            GoalMiss::NotInside { t, margin } => GoalMissJson::NotInside { t, margin },
+            GoalMiss::Leaves { t } => GoalMissJson::Leaves { t },
+        }
+    }
 }
 
 impl<'a> GoalJson<'a> {
@@ -410,20 +425,9 @@ impl<'a> GoalJson<'a> {
         let (status, t, margin, why) = match &g.outcome {
             GoalOutcome::Reached { t, margin } => ("reached", Some(*t), Some(*margin), None),
             GoalOutcome::NeedsUniform => ("needs_uniform", None, None, None),
-            GoalOutcome::NotShown(miss) => (
-                "not_shown",
-                None,
-                None,
-                Some(match *miss {
-                    GoalMiss::NoReportTime => GoalMissJson::NoReportTime,
-                    GoalMiss::Unsafe { t, set } => GoalMissJson::Unsafe {
-                        t,
-                        set: prs.unsafe_sets.get(set).map_or("?", |u| &u.name),
-                    },
-                    GoalMiss::NotInside { t, margin } => GoalMissJson::NotInside { t, margin },
-                    GoalMiss::Leaves { t } => GoalMissJson::Leaves { t },
-                }),
-            ),
+            GoalOutcome::NotShown(miss) => {
+                ("not_shown", None, None, Some(GoalMissJson::of(prs, miss)))
+            }
         };
         GoalJson {
             name: &g.name,
