@@ -2,7 +2,7 @@
 //! constants were certified for.
 
 use crate::engine::{
-    self, check_initial, union, Detail, Inputs, Needs, Run, RunError, Setting, Setup,
+    self, check_initial, union, BoxMemo, Detail, Inputs, Needs, Run, RunError, Setting, Setup,
 };
 use crate::interval::Interval;
 use crate::model::{
@@ -38,6 +38,8 @@ pub struct Reach<'a> {
     /// The setups of the metrics run as well, the smallest result kept
     /// ([`Constants::alternatives`](crate::model::Constants::alternatives)).
     alternatives: Vec<Setup<'a>>,
+    /// The embedding's boxes of its runs, kept for those that repeat them.
+    memo: BoxMemo,
 }
 
 impl<'a> Reach<'a> {
@@ -119,6 +121,7 @@ impl<'a> Reach<'a> {
             setup,
             also: setups(|c| &c.also)?,
             alternatives: setups(|c| &c.alternatives)?,
+            memo: BoxMemo::default(),
         })
     }
 
@@ -395,6 +398,7 @@ impl<'a> Reach<'a> {
                 setup,
                 initial,
                 inputs,
+                memo: &self.memo,
                 gaussian,
             })
         };
@@ -451,6 +455,7 @@ impl<'a> Reach<'a> {
                     setup,
                     initial,
                     inputs,
+                    memo: &self.memo,
                     gaussian: Some(own.delta),
                 },
                 &failed,

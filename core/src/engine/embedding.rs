@@ -20,7 +20,7 @@ use crate::model::{Inclusion, Integrator};
 use crate::system::System;
 
 /// How much work the embedding's validated steps may take.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Budget {
     /// The most steps in all.
     pub(crate) steps: usize,

@@ -33,8 +33,8 @@ use super::embedding::{BoxStep, Budget, Embedding};
 use super::intersect::cut_by;
 use super::transform::{self, with_buffer, Frame};
 use super::{
-    contraction, first_order, hints, local, nominal, r1, radius, validate, Detail, Run, RunError,
-    Setting,
+    contraction, first_order, hints, local, memo, nominal, r1, radius, validate, Detail, Run,
+    RunError, Setting,
 };
 use crate::decimal::time;
 use crate::interval::Interval;
@@ -115,21 +115,28 @@ pub(super) fn deterministic(
     let metric = &consts.metric;
     let grid = nominal::time_grid(spec.horizon, spec.step);
     let (inputs, _) = run.nominal_inputs(&grid);
+    let input_boxes = run_inputs(run, &inputs);
+    let key = memo::Key::new(spec, run.initial, &input_boxes, inclusion, budget);
+    let held = run.memo.get_or(key, || {
+        let computed = boxes(
+            run.sys,
+            run.info,
+            spec,
+            run.initial,
+            &grid,
+            &input_boxes,
+            (inclusion, budget),
+        );
+        let size = computed.as_ref().map_or(0, Boxes::size);
+        (computed, size)
+    });
     let Boxes {
         frame,
         start,
         steps,
         x0,
         half0,
-    } = boxes(
-        run.sys,
-        run.info,
-        spec,
-        run.initial,
-        &grid,
-        &run_inputs(run, &inputs),
-        (inclusion, budget),
-    )?;
+    } = Result::clone(&held)?;
     let (r1, r1_bound) = r1::bound(metric, run.initial, &half0);
     let (kappa, radius_rule) = radius::stochastic_factor(n, spec);
     let box_radius = radius::BoxRadius::new(metric, n);
@@ -265,7 +272,8 @@ fn run_inputs(run: &Run, nominal: &[Vec<f64>]) -> Vec<Vec<Interval>> {
 }
 
 /// The embedding system's boxes on its steps (in `y = T x` with a transform).
-struct Boxes {
+#[derive(Clone)]
+pub(crate) struct Boxes {
     /// The transform, if any.
     frame: Option<Frame>,
     /// The initial box `(lo, hi)`.
@@ -275,6 +283,13 @@ struct Boxes {
     /// Centre and half-widths of the initial box in `x`.
     x0: Vec<f64>,
     half0: Vec<f64>,
+}
+
+impl Boxes {
+    /// The numbers it holds (for the memo's capacity).
+    fn size(&self) -> usize {
+        (self.steps.len() + 1) * 6 * self.x0.len()
+    }
 }
 
 /// The boxes of the embedding system with the given inclusion function, inputs in `inputs[k]`

@@ -34,6 +34,7 @@ pub(crate) mod interval;
 pub(crate) mod linalg;
 mod linearised;
 mod local;
+mod memo;
 mod nominal;
 mod r1;
 pub(crate) mod radius;
@@ -249,6 +250,9 @@ pub(crate) fn input_intervals(info: &ModelInfo) -> Vec<Interval> {
         .collect()
 }
 
+/// The embedding's boxes of a `Reach`'s runs (`memo.rs`).
+pub(crate) type BoxMemo = memo::Memo<interval::Boxes>;
+
 /// The inputs of a run.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Inputs<'a> {
@@ -267,6 +271,8 @@ pub(crate) struct Run<'a> {
     pub(crate) setup: &'a Setup<'a>,
     pub(crate) initial: &'a InitialSet,
     pub(crate) inputs: Inputs<'a>,
+    /// The embedding's boxes already computed for the same `Reach` ([`BoxMemo`]).
+    pub(crate) memo: &'a BoxMemo,
     /// The share of delta of the linearised Gaussian sets (method.md 8.10), when the run is
     /// to compute them (the rest of the run then holds at `spec.delta`, the two shares summing
     /// to the analysis' delta).
@@ -363,7 +369,8 @@ pub(crate) fn validate(
             return bad_setting(
                 Setting::Split,
                 format!(
-                    "split = {k:?} must give one count of at least 1 per state ({n}), at most                      {MAX_PIECES} pieces in all"
+                    "split = {k:?} must give one count of at least 1 per state ({n}), at most \
+                     {MAX_PIECES} pieces in all"
                 ),
             );
         }
