@@ -5,7 +5,9 @@
 //! `cargo run --release -p reachc-e2e --example fuzz -- [--check N] [--run N] [--threads N]
 //! [--seed N] [--findings DIR] [--minimise N] [--failures DIR]` (defaults: 10000, 1000, 2, 15,
 //! tests/fuzz/findings, 150 runs per reproducer; with `--failures`, every failing mutant is
-//! also written there, unminimised, as COMMAND-INDEX-CLASS.sde, for triage).
+//! also written there, unminimised, as COMMAND-INDEX-CLASS.sde, for triage, and the
+//! reproducers go there too unless `--findings` says otherwise: a triage run leaves the
+//! repository's findings as they are).
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -31,10 +33,10 @@ fn main() {
         opts.get(key)
             .map_or(default, |v| v.parse().expect("a number"))
     };
-    let findings = opts.get("findings").map_or_else(
-        || reachc_e2e::workspace().join("tests/fuzz/findings"),
-        PathBuf::from,
-    );
+    let findings = match (opts.get("findings"), opts.get("failures")) {
+        (Some(dir), _) | (None, Some(dir)) => PathBuf::from(dir),
+        (None, None) => reachc_e2e::workspace().join("tests/fuzz/findings"),
+    };
     let corpus = Corpus::load();
     let mut records = Vec::new();
     println!("| command | mutants | wall s | mutants/s |");
