@@ -352,6 +352,10 @@ pub struct Step {
     /// The pointwise radius at `t` (what `r_t` would be for this time alone: the price of
     /// uniformity is `r_t / r_pointwise`).
     pub r_pointwise: f64,
+    /// The stochastic radius of the report interval ending here (method.md 8.14): the largest
+    /// over the interval for a uniform guarantee, `r_t` for a pointwise one (0 at `t = 0`, and
+    /// in a split's union, whose pieces hold theirs).
+    pub r_span: f64,
     /// `Psi_t` (upper bound).
     pub psi: f64,
     /// Contraction rate on the step ending here.

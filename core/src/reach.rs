@@ -2,7 +2,8 @@
 //! constants were certified for.
 
 use crate::engine::{
-    self, check_initial, union, BoxMemo, Detail, Inputs, Needs, Run, RunError, Setting, Setup,
+    self, check_initial, union, BoxMemo, Constraint, Detail, Inputs, Needs, Run, RunError, Setting,
+    Setup, TightenError, Tightening,
 };
 use crate::interval::Interval;
 use crate::model::{
@@ -123,6 +124,18 @@ impl<'a> Reach<'a> {
             alternatives: setups(|c| &c.alternatives)?,
             memo: BoxMemo::default(),
         })
+    }
+
+    /// The constraints a nominal plan must meet, per report interval, for the stochastic
+    /// system to meet `constraints` and avoid the model's unsafe sets with probability at least
+    /// `1 - delta` (method.md 8.14), from `prs`, a result of this analysis (from the start the
+    /// plan starts at, or an initial set holding it).
+    pub fn tighten(
+        &self,
+        prs: &Prs,
+        constraints: &[Constraint],
+    ) -> Result<Tightening, TightenError> {
+        engine::tighten(prs, constraints, &self.info.unsafe_sets)
     }
 
     /// The same analysis at another probability level `delta` in `(0, 1)` (the constants do

@@ -5,7 +5,8 @@
 //! [`run`] and [`simulate()`] take typed options ([`RunOptions`], [`SimulateOptions`]); a
 //! generated binary's command line is their textual form, parsed by [`Command::parse`] and
 //! written by `to_args` (by hand, no clap, so the runtime stays light):
-//! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--probability] [--error-lines]`, or
+//! `[--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--probability] [--tighten]
+//! [--error-lines]`, or
 //! `simulate --paths N [options]` (see [`SIMULATE_USAGE`]).
 //!
 //! Exit codes (the CLI's too): [`EXIT_OK`], [`EXIT_FAILED`] (an analysis could not run, its
@@ -32,7 +33,7 @@ pub const DEFAULT_OUT_DIR: &str = "reachc-out";
 
 const USAGE: &str =
     "usage: <model> [--analysis NAME] [-o DIR] [--quiet] [--deny-unsafe] [--probability]
-               [--error-lines]
+               [--tighten] [--error-lines]
        <model> simulate --paths N [options]   (Monte Carlo check; simulate --help)
   --analysis NAME  run only this analysis (default: all)
   -o, --out DIR    output directory for <analysis>.json and <analysis>.csv (default: reachc-out)
@@ -40,6 +41,8 @@ const USAGE: &str =
   --deny-unsafe    exit with status 3 when a verdict is \"not shown safe\"
   --probability    also bound the probability of safety on [0, T] (analyses with unsafe sets
                    and a uniform guarantee; about a dozen runs each)
+  --tighten        also write <analysis>.tightening.csv: the unsafe sets inflated for a
+                   nominal (noise-free) plan, per report interval (MPC set erosion)
   --error-lines    report failed analyses as `reachc-failure` lines (for reachc)
   -h, --help       print this help
   Exit status: 0 ok, 1 an analysis could not run (the others' results are written), 2 usage
@@ -103,6 +106,9 @@ pub struct RunOptions {
     /// Also compute each analysis' probability of safety ([`Reach::safety_probability`]):
     /// printed, and in the JSON.
     pub probability: bool,
+    /// Also write `<analysis>.tightening.csv` ([`Reach::tighten`], method.md 8.14) for the
+    /// analyses of a model with unsafe sets, with a line in the summary.
+    pub tighten: bool,
     /// `out_dir` is a staging directory that the caller moves into place (`reachc run --plot`):
     /// do not print where the files were written.
     pub stage: bool,
@@ -118,6 +124,7 @@ impl Default for RunOptions {
             quiet: false,
             deny_unsafe: false,
             probability: false,
+            tighten: false,
             stage: false,
             error_lines: false,
         }
@@ -239,6 +246,7 @@ fn parse_run(args: &[String]) -> Result<Command, String> {
             "-q" | "--quiet" => opts.quiet = true,
             "--deny-unsafe" => opts.deny_unsafe = true,
             "--probability" => opts.probability = true,
+            "--tighten" => opts.tighten = true,
             "--stage" => opts.stage = true,
             "--error-lines" => opts.error_lines = true,
             "-h" | "--help" => return Ok(Command::Help(USAGE)),
@@ -313,6 +321,7 @@ impl RunOptions {
             (self.quiet, "--quiet"),
             (self.deny_unsafe, "--deny-unsafe"),
             (self.probability, "--probability"),
+            (self.tighten, "--tighten"),
             (self.stage, "--stage"),
             (self.error_lines, "--error-lines"),
         ] {
@@ -505,6 +514,9 @@ fn run_analyses<S: System + Sync>(
             .filter(|_| opts.probability)
             .map(|g| reach.goal_probability(g))
             .collect();
+        // The unsafe sets inflated for a nominal plan, where asked for.
+        let tightening =
+            (opts.tighten && !info.unsafe_sets.is_empty()).then(|| reach.tighten(&res, &[]));
         if !opts.quiet {
             let _ = write!(out, "{}", report::summary(&res));
             match &probability {
@@ -535,6 +547,15 @@ fn run_analyses<S: System + Sync>(
                     ),
                 };
             }
+            match &tightening {
+                Some(Ok(t)) => {
+                    let _ = writeln!(out, "  {}", report::tightening::line(&info.unsafe_sets, t));
+                }
+                Some(Err(why)) => {
+                    let _ = writeln!(out, "  tightening: not computed: {why}");
+                }
+                None => {}
+            }
             let _ = writeln!(out);
         }
         let probability = probability.and_then(Result::ok);
@@ -556,6 +577,11 @@ fn run_analyses<S: System + Sync>(
                 .into(),
         );
         files.add(dir.join(format!("{name}.csv")), csv);
+        if let Some(Ok(t)) = &tightening {
+            let mut csv = Vec::new();
+            let _ = report::tightening::write_csv(t, &info.states, &mut csv);
+            files.add(dir.join(format!("{name}.tightening.csv")), csv);
+        }
     }
     if let Err(code) = commit(files, !opts.quiet && !opts.stage, out, err) {
         return code;
@@ -842,6 +868,7 @@ mod tests {
             quiet: true,
             deny_unsafe: true,
             probability: true,
+            tighten: true,
             stage: true,
             error_lines: true,
         };

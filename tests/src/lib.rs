@@ -55,17 +55,22 @@ pub fn linearised_member(prs: &Prs) -> (&Prs, usize) {
 /// coordinate and epoch, `n K` events sharing `delta`). Computed independently of the crate:
 /// `Q` by its continued fraction, `z` by bisection.
 pub fn reflection_factor(n: usize, epochs: usize, delta: f64) -> f64 {
-    let target = delta / (4.0 * (n * epochs) as f64);
+    upper_quantile(delta / (4.0 * (n * epochs) as f64)).powi(2)
+}
+
+/// `z >= 1` with `Q(z) = q` (`Q` the standard normal upper tail, [`normal_tail`]), by
+/// bisection (to the last bit).
+pub fn upper_quantile(q: f64) -> f64 {
     let (mut lo, mut hi) = (1.0f64, 40.0f64);
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
-        if normal_tail(mid) > target {
+        if normal_tail(mid) > q {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    hi * hi
+    hi
 }
 
 /// `Q(z) = P(N(0, 1) > z)` for `z >= 1`: `phi(z) / (z + 1/(z + 2/(z + 3/(z + ...))))`

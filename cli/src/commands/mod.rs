@@ -86,6 +86,12 @@ pub enum Command {
         /// printed, and `safety_probability` in the JSON.
         #[arg(long)]
         probability: bool,
+        /// Also write ANALYSIS.tightening.csv: the unsafe sets inflated for a nominal
+        /// (noise-free) plan per report interval, so that a plan avoiding them keeps the
+        /// stochastic system out of the unsafe sets with probability 1 - delta (MPC set
+        /// erosion, method.md 8.14).
+        #[arg(long)]
+        tighten: bool,
         /// Do not show cargo's progress (compiled backend).
         #[arg(short, long)]
         quiet: bool,
@@ -137,6 +143,7 @@ fn run(command: Command) -> Result<(), u8> {
             plot,
             deny_unsafe,
             probability,
+            tighten,
             quiet,
         } => run::run_spec(
             &spec,
@@ -147,6 +154,7 @@ fn run(command: Command) -> Result<(), u8> {
             run::Flags {
                 deny_unsafe,
                 probability,
+                tighten,
                 quiet,
             },
         ),

@@ -34,6 +34,8 @@ pub struct Flags {
     pub deny_unsafe: bool,
     /// `--probability`: also bound each analysis' probability of safety.
     pub probability: bool,
+    /// `--tighten`: also write each analysis' tightening for a nominal plan.
+    pub tighten: bool,
     /// `--quiet`: no cargo progress.
     pub quiet: bool,
 }
@@ -52,6 +54,7 @@ pub fn run_spec(
     Flags {
         deny_unsafe,
         probability,
+        tighten,
         quiet,
     }: Flags,
 ) -> Result<(), u8> {
@@ -68,6 +71,7 @@ pub fn run_spec(
         quiet: false,
         deny_unsafe,
         probability,
+        tighten,
         stage: staging.is_some(),
         error_lines: backend == Backend::Compiled,
     };

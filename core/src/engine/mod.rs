@@ -40,6 +40,7 @@ mod r1;
 pub(crate) mod radius;
 mod rates;
 mod safety;
+mod tighten;
 pub(crate) mod transform;
 mod uniform;
 pub(crate) mod union;
@@ -53,6 +54,7 @@ pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
 pub use r1::MAX_BALL_STATES;
 pub use radius::MAX_VERTEX_COORDS;
+pub use tighten::{tighten, Constraint, TightStep, TightenError, Tightening};
 
 use crate::interval::Interval;
 use crate::model::{

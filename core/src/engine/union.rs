@@ -129,6 +129,7 @@ pub(crate) fn union(
                     radius,
                 },
                 r_t: 0.0,
+                r_span: 0.0,
                 prs_radius: radius,
                 span: Span {
                     lo: span.iter().map(|b| b.lo).collect(),

@@ -6,6 +6,7 @@
 pub mod probability;
 pub mod result;
 pub mod simulation;
+pub mod tightening;
 
 pub use reachc_core::decimal::time;
 pub use result::{summary, to_json, to_json_with, to_json_within, write_csv, MEMBERS_BUDGET};
