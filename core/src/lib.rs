@@ -15,6 +15,7 @@ pub mod probability;
 pub mod prs;
 mod reach;
 pub mod simulate;
+pub mod sweep;
 pub mod system;
 pub mod table;
 mod workers;

@@ -138,8 +138,46 @@ pub struct Ball {
 pub struct UnsafeSet {
     /// Its name.
     pub name: String,
-    /// Its shape.
+    /// Its shape (a moving set: at `t = 0`).
     pub shape: UnsafeShape,
+    /// The numbers of the shape that move with time (method.md 8.15; empty: a fixed set).
+    pub moving: Vec<Moving>,
+}
+
+/// A number of a set's shape given by a function of time and tables (a moving set, method.md
+/// 8.15): entry `number` of [`System::set_numbers`](crate::System::set_numbers).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Moving {
+    /// The part of a goal it belongs to (0 for an unsafe set).
+    pub part: usize,
+    /// Which number of that part's shape.
+    pub slot: Slot,
+    /// The entry of `System::set_numbers` that gives it.
+    pub number: usize,
+}
+
+/// A number of an [`UnsafeShape`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// A half-space's offset.
+    Offset,
+    /// The lower end of a box's side `k` (its place in the box's list).
+    Lo(usize),
+    /// The upper end of a box's side `k`.
+    Hi(usize),
+    /// Entry `k` of a ball's centre.
+    Center(usize),
+    /// A ball's radius.
+    Radius,
+}
+
+/// How a moving set is held still over an interval of time (method.md 8.15).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sweep {
+    /// A fixed set holding the set at every time of the interval (for sets to avoid).
+    Union,
+    /// A fixed set inside the set at every time of the interval (for sets to be inside).
+    Common,
 }
 
 /// A named goal set (method.md 8.13): the state should enter it at some time in `window`
@@ -149,8 +187,10 @@ pub struct GoalSet {
     /// Its name.
     pub name: String,
     /// The goal is the intersection of these regions (each read as the set it describes, as
-    /// for an unsafe set of that shape).
+    /// for an unsafe set of that shape; a moving part: at `t = 0`).
     pub parts: Vec<UnsafeShape>,
+    /// The numbers of the parts that move with time (method.md 8.15; empty: a fixed goal).
+    pub moving: Vec<Moving>,
     /// The times at which entering counts, `[t1, t2]`; `None`: an analysis' whole horizon.
     pub window: Option<Bounds>,
     /// Reach and stay: once entered, the state must remain in the goal until the horizon.

@@ -604,6 +604,10 @@ pub struct UnsafeVerdict {
     pub min_margin_t: f64,
     /// First report time at which safety was not shown.
     pub first_not_safe_t: Option<f64>,
+    /// A moving set (method.md 8.15): per report time, the fixed set that held all its
+    /// positions over the report interval ending there (the time itself at `t = 0`), which the
+    /// margins were computed against. Empty for a fixed set.
+    pub swept: Vec<crate::model::UnsafeShape>,
 }
 
 /// The overall verdict. A PRS touching an unsafe set does not prove a violation, hence "not

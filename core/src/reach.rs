@@ -235,7 +235,8 @@ impl<'a> Reach<'a> {
         inputs: Inputs,
     ) -> Result<Prs, RunError> {
         let mut prs = self.run_sets(own, initial, inputs)?;
-        prs.goals = engine::goals::assess(&self.info.goals, &prs);
+        let numbers = |t| crate::sweep::numbers(self.sys, self.info, t);
+        prs.goals = engine::goals::assess(&self.info.goals, &prs, &numbers);
         Ok(prs)
     }
 

@@ -104,4 +104,10 @@ pub trait System: Sync {
         let _ = k;
         None
     }
+    /// Enclosures over the times `t` of the numbers of the model's moving unsafe and goal sets
+    /// (method.md 8.15), one per [`Moving::number`](crate::model::Moving::number), into `out`
+    /// (`ModelInfo::set_numbers` entries). The default writes nothing: no set moves.
+    fn set_numbers(&self, t: Interval, out: &mut [Interval]) {
+        let _ = (t, out);
+    }
 }

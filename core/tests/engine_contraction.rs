@@ -438,6 +438,7 @@ fn half_space_safety() {
                 normal: vec![3.0, 4.0],
                 offset: 100.0,
             },
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "crossing".into(),
@@ -445,6 +446,7 @@ fn half_space_safety() {
                 normal: vec![1.0, 1.0],
                 offset: 0.0,
             },
+            moving: Vec::new(),
         },
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();
@@ -481,6 +483,7 @@ fn safety_against_boxes_and_balls() {
         UnsafeSet {
             name: "box_far".into(),
             shape: UnsafeShape::Box(vec![(0, Bounds::new(5.0, f64::INFINITY))]),
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "ball_far".into(),
@@ -489,10 +492,12 @@ fn safety_against_boxes_and_balls() {
                 center: vec![-4.0],
                 radius: 1.0,
             },
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "box_hit".into(),
             shape: UnsafeShape::Box(vec![(0, Bounds::new(0.9, 1.1))]),
+            moving: Vec::new(),
         },
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();
@@ -531,10 +536,12 @@ fn pendulum_half_space_uses_inverse_metric() {
                 normal: vec![1.0, 0.0],
                 offset: 1.0,
             },
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "omega_box".into(),
             shape: UnsafeShape::Box(vec![(1, Bounds::new(3.0, 4.0))]),
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "ball".into(),
@@ -543,6 +550,7 @@ fn pendulum_half_space_uses_inverse_metric() {
                 center: vec![0.0, 5.0],
                 radius: 0.5,
             },
+            moving: Vec::new(),
         },
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();

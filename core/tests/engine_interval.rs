@@ -290,10 +290,12 @@ fn linear_safety_and_membership() {
                 normal: vec![1.0],
                 offset: 3.0,
             },
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "far_box".into(),
             shape: UnsafeShape::Box(vec![(0, Bounds::new(-5.0, -3.0))]),
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "far_ball".into(),
@@ -302,6 +304,7 @@ fn linear_safety_and_membership() {
                 center: vec![4.0],
                 radius: 1.0,
             },
+            moving: Vec::new(),
         },
         UnsafeSet {
             name: "touching".into(),
@@ -309,6 +312,7 @@ fn linear_safety_and_membership() {
                 normal: vec![-1.0],
                 offset: 0.0,
             },
+            moving: Vec::new(),
         },
     ];
     let a = analysis(2.0, 0.01, Integrator::Rk4, lin_constants());

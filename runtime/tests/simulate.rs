@@ -126,6 +126,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
                 normal: (0..n).map(|i| if i == 0 { 1.0 } else { 0.0 }).collect(),
                 offset: 1.5,
             },
+            moving: Vec::new(),
         }],
         analyses: vec![],
     };

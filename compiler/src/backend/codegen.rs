@@ -42,8 +42,8 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote, ToTokens};
 use reachc_core::model::{
     Analysis, AutoFit, Ball, Bounds, Constants, GoalSet, Guarantee, Inclusion, InitialSet,
-    InputGain, Integrator, MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Provenance,
-    RadiusRule, Rate, Split, TransformSource, UnsafeSet, UnsafeShape,
+    InputGain, Integrator, MatrixBound, Method, MetricChoice, MetricRegion, ModelInfo, Moving,
+    Provenance, RadiusRule, Rate, Slot, Split, TransformSource, UnsafeSet, UnsafeShape,
 };
 
 use super::{mangle, Prepared};
@@ -1394,6 +1394,30 @@ fn range(b: Bounds) -> TokenStream {
     quote!(Bounds::new(#lo, #hi))
 }
 
+/// The moving numbers of a set (method.md 8.15) as a `Vec<Moving>` literal.
+fn moving(ms: &[Moving]) -> TokenStream {
+    list(ms.iter().map(|m| {
+        let (part, number) = (int(m.part), int(m.number));
+        let slot = match m.slot {
+            Slot::Offset => quote!(Slot::Offset),
+            Slot::Lo(k) => {
+                let k = int(k);
+                quote!(Slot::Lo(#k))
+            }
+            Slot::Hi(k) => {
+                let k = int(k);
+                quote!(Slot::Hi(#k))
+            }
+            Slot::Center(k) => {
+                let k = int(k);
+                quote!(Slot::Center(#k))
+            }
+            Slot::Radius => quote!(Slot::Radius),
+        };
+        quote!(Moving { part: #part, slot: #slot, number: #number })
+    }))
+}
+
 fn indices(is: &[usize]) -> TokenStream {
     list(is.iter().map(|&i| int(i).into_token_stream()))
 }
@@ -1489,16 +1513,18 @@ impl InfoWriter {
     fn unsafe_set(&mut self, u: &UnsafeSet) -> TokenStream {
         let name = string(&u.name);
         let shape = self.shape(&u.shape);
-        quote!(UnsafeSet { name: #name, shape: #shape })
+        let moving = moving(&u.moving);
+        quote!(UnsafeSet { name: #name, shape: #shape, moving: #moving })
     }
 
     fn goal(&mut self, g: &GoalSet) -> TokenStream {
         let name = string(&g.name);
         let parts: Vec<TokenStream> = g.parts.iter().map(|p| self.shape(p)).collect();
         let parts = list(parts);
+        let moving = moving(&g.moving);
         let window = option(&g.window, |&w| range(w));
         let stay = g.stay;
-        quote!(GoalSet { name: #name, parts: #parts, window: #window, stay: #stay })
+        quote!(GoalSet { name: #name, parts: #parts, moving: #moving, window: #window, stay: #stay })
     }
 
     fn shape(&mut self, shape: &UnsafeShape) -> TokenStream {

@@ -11,11 +11,13 @@ use super::transform::Frame;
 use super::uniform::{Scale, Tube};
 use super::Run;
 use crate::interval::Interval;
-use crate::model::{Guarantee, Inclusion, Method, ModelInfo, RadiusRule, Rate, Split};
+use crate::model::{Guarantee, Inclusion, Method, ModelInfo, RadiusRule, Rate, Split, UnsafeShape};
 use crate::prs::{
     ConstantsUsed, DetSet, GaussianUsed, Proved, Prs, R1Bound, RateUsed, Role, RuleUsed, Span,
     Step, TransformUsed, UniformBound, Unproved, UnsafeVerdict, Validation, Verdict,
 };
+use crate::sweep;
+use std::borrow::Cow;
 
 /// One internal step `[t0, t1]` of the deterministic part.
 pub(super) struct Piece {
@@ -204,12 +206,26 @@ pub(super) fn assemble_with(
         w: &w,
         frame: det.frame.as_ref(),
     };
-    let margins = |span: &Span| -> Vec<f64> {
-        setup
+    // Moving unsafe sets (method.md 8.15): each report interval's checks against the fixed
+    // sets holding every position of the moving ones over it, which are kept for the result.
+    let mut swept: Vec<Vec<UnsafeShape>> = vec![Vec::new(); setup.checks.len()];
+    let mut checks_over = |t: Interval| -> Cow<'_, [Check]> {
+        if !run.info.unsafe_sets.iter().any(|u| !u.moving.is_empty()) {
+            return Cow::Borrowed(&setup.checks);
+        }
+        let numbers = sweep::numbers(run.sys, run.info, t);
+        let sets = sweep::unsafe_sets(run.info, &numbers);
+        let moved = setup
             .checks
             .iter()
-            .map(|check| check.margin_of_span(span, &context))
-            .collect()
+            .zip(&sets)
+            .map(|(c, s)| c.moved(&s.shape));
+        for ((kept, set), u) in swept.iter_mut().zip(&sets).zip(&run.info.unsafe_sets) {
+            if !u.moving.is_empty() {
+                kept.push(set.shape.clone());
+            }
+        }
+        Cow::Owned(moved.collect())
     };
     let mut steps = Vec::new();
     // t = 0: the initial set, no stochastic part yet.
@@ -217,8 +233,7 @@ pub(super) fn assemble_with(
     steps.push(Step {
         t: 0.0,
         prs_radius: det.start.radius(),
-        margins: setup
-            .checks
+        margins: checks_over(Interval::ZERO)
             .iter()
             .map(|check| check.margin(&det.start, 0.0, &context))
             .collect(),
@@ -252,10 +267,15 @@ pub(super) fn assemble_with(
         let mut span = gathered.take().expect("a report interval has a step");
         span.radius = (Interval::point(span.radius) + Interval::point(r_over)).hi();
         let (c, sigma) = std::mem::replace(&mut rates, (f64::NEG_INFINITY, f64::NEG_INFINITY));
+        let previous = steps.last().map_or(0.0, |st: &Step| st.t);
+        let margins = checks_over(Interval::new(previous, piece.t1))
+            .iter()
+            .map(|check| check.margin_of_span(&span, &context))
+            .collect();
         steps.push(Step {
             t: piece.t1,
             prs_radius: (Interval::point(end.radius()) + Interval::point(r_end)).hi(),
-            margins: margins(&span),
+            margins,
             det: end,
             r_t: r_end,
             r_pointwise,
@@ -266,7 +286,7 @@ pub(super) fn assemble_with(
             span,
         });
     }
-    let (unsafe_sets, verdict) = verdicts(run.info, &setup.checks, &steps);
+    let (unsafe_sets, verdict) = verdicts(run.info, &setup.checks, &steps, swept);
     let mut rigorous = header.rigorous;
     if radii.gaussian.is_some() {
         rigorous.push(Proved::ExactGaussian);
@@ -403,15 +423,19 @@ impl Span {
 }
 
 /// Per-set verdicts and the overall verdict from the per-step margins.
+/// `swept`: per set, where a moving set was held still on each report interval (empty for a
+/// fixed set).
 pub(super) fn verdicts(
     info: &ModelInfo,
     checks: &[Check],
     steps: &[Step],
+    swept: Vec<Vec<UnsafeShape>>,
 ) -> (Vec<UnsafeVerdict>, Verdict) {
     let mut verdicts = Vec::with_capacity(checks.len());
     // (step, set index) of the earliest failure; ties at the same step go to the first set.
     let mut first: Option<(usize, usize)> = None;
-    for (j, (set, check)) in info.unsafe_sets.iter().zip(checks).enumerate() {
+    let sets = info.unsafe_sets.iter().zip(checks).zip(swept);
+    for (j, ((set, check), swept)) in sets.enumerate() {
         let mut min_margin = f64::INFINITY;
         let mut min_t = 0.0;
         let mut first_bad: Option<usize> = None;
@@ -438,6 +462,7 @@ pub(super) fn verdicts(
             min_margin,
             min_margin_t: min_t,
             first_not_safe_t: first_bad.map(|k| steps[k].t),
+            swept,
         });
     }
     let verdict = if checks.is_empty() {

@@ -5,30 +5,55 @@
 //! time. So the verdicts need no further run and no further share of delta.
 
 use crate::interval::Interval;
-use crate::model::{Bounds, GoalSet, Guarantee, UnsafeShape};
+use crate::model::{Bounds, GoalSet, Guarantee, Sweep, UnsafeShape};
 use crate::prs::{GoalMiss, GoalOutcome, GoalVerdict, Prs};
+use crate::sweep;
 
-/// What `prs` (time-uniform, or [`GoalOutcome::NeedsUniform`]) shows about each goal.
-pub(crate) fn assess(goals: &[GoalSet], prs: &Prs) -> Vec<GoalVerdict> {
-    goals.iter().map(|g| assess_one(g, prs)).collect()
+/// What `prs` (time-uniform, or [`GoalOutcome::NeedsUniform`]) shows about each goal;
+/// `numbers` encloses the model's moving set numbers over an interval of time
+/// ([`crate::sweep::numbers`]).
+pub(crate) fn assess(
+    goals: &[GoalSet],
+    prs: &Prs,
+    numbers: &dyn Fn(Interval) -> Vec<Interval>,
+) -> Vec<GoalVerdict> {
+    goals.iter().map(|g| assess_one(g, prs, numbers)).collect()
 }
 
-fn assess_one(goal: &GoalSet, prs: &Prs) -> GoalVerdict {
+fn assess_one(
+    goal: &GoalSet,
+    prs: &Prs,
+    numbers: &dyn Fn(Interval) -> Vec<Interval>,
+) -> GoalVerdict {
     let window = goal.window.unwrap_or(Bounds::new(0.0, prs.horizon));
-    let inside = |b: Option<Vec<Bounds>>| b.map_or(f64::NEG_INFINITY, |b| margin(goal, &b));
+    // A moving goal is held still inside all its positions over the times asked about
+    // (method.md 8.15).
+    let inside = |b: Option<Vec<Bounds>>, t: Interval| {
+        b.map_or(f64::NEG_INFINITY, |b| {
+            if goal.moving.is_empty() {
+                margin(&goal.parts, &b)
+            } else {
+                margin(&sweep::goal_parts(goal, &numbers(t), Sweep::Common), &b)
+            }
+        })
+    };
+    let at = |k: usize| Interval::point(prs.steps[k].t);
+    let over = |k: usize| Interval::new(prs.steps[k.saturating_sub(1)].t, prs.steps[k].t);
     // Reaching alone (no stay, no unsafe set to avoid on the way) asks about one time: the
     // pointwise radius at that time serves, whatever the guarantee (method.md 8.13).
     let at_one_time = !goal.stay && prs.unsafe_sets.is_empty();
     let margins: Vec<f64> = (0..prs.steps.len())
         .map(|k| match at_one_time {
-            true => inside(prs.pointwise_hull_at(k)),
-            false => inside(prs.hull_at(k)),
+            true => inside(prs.pointwise_hull_at(k), at(k)),
+            false => inside(prs.hull_at(k), at(k)),
         })
         .collect();
     let outcome = if prs.guarantee != Guarantee::Uniform && !at_one_time {
         GoalOutcome::NeedsUniform
     } else {
-        outcome(goal, prs, window, &margins, |k| inside(prs.span_hull_at(k)))
+        outcome(goal, prs, window, &margins, |k| {
+            inside(prs.span_hull_at(k), over(k))
+        })
     };
     GoalVerdict {
         name: goal.name.clone(),
@@ -118,10 +143,10 @@ fn positive(m: f64) -> bool {
     m > 0.0
 }
 
-/// How far the box `b` lies inside the goal: the smallest of its parts' margins (see
-/// [`part_margin`]), rounded down.
-pub(crate) fn margin(goal: &GoalSet, b: &[Bounds]) -> f64 {
-    goal.parts
+/// How far the box `b` lies inside the goal of `parts`: the smallest of its parts' margins
+/// (see [`part_margin`]), rounded down.
+pub(crate) fn margin(parts: &[UnsafeShape], b: &[Bounds]) -> f64 {
+    parts
         .iter()
         .map(|p| part_margin(p, b))
         .fold(f64::INFINITY, f64::min)
@@ -205,12 +230,6 @@ mod tests {
         let unbounded = b(&[(0.2, 0.4), (f64::NEG_INFINITY, 1.0)]);
         assert_eq!(part_margin(&half, &unbounded), f64::NEG_INFINITY);
         // An intersection: the smaller margin.
-        let goal = GoalSet {
-            name: "g".into(),
-            parts: vec![goal_box, half],
-            window: None,
-            stay: false,
-        };
-        assert!(close(margin(&goal, &bx), 0.2));
+        assert!(close(margin(&[goal_box, half], &bx), 0.2));
     }
 }

@@ -43,7 +43,8 @@ pub(crate) fn intersect(
     for other in &others {
         absorb(&mut first.validation, &other.validation);
     }
-    let (unsafe_sets, verdict) = verdicts(info, checks, &first.steps);
+    let swept = first.unsafe_sets.iter().map(|v| v.swept.clone()).collect();
+    let (unsafe_sets, verdict) = verdicts(info, checks, &first.steps, swept);
     first.unsafe_sets = unsafe_sets;
     first.verdict = verdict;
     first.delta = delta;

@@ -430,6 +430,21 @@ pub(crate) fn validate(
             info.input_box.len()
         ));
     }
+    let unsafe_parts = info
+        .unsafe_sets
+        .iter()
+        .map(|u| (&u.name, std::slice::from_ref(&u.shape), &u.moving));
+    let goal_parts = info
+        .goals
+        .iter()
+        .map(|g| (&g.name, &g.parts[..], &g.moving));
+    for (name, parts, moving) in unsafe_parts.chain(goal_parts) {
+        if !moving.iter().all(|m| crate::sweep::fits(m, parts)) {
+            return bad(format!(
+                "the moving numbers of set `{name}` do not fit its shape"
+            ));
+        }
+    }
     for (j, b) in info.input_box.iter().enumerate() {
         if Interval::try_new(b.lo, b.hi).is_none_or(|iv| !iv.is_bounded()) {
             return bad(format!(

@@ -114,6 +114,36 @@ impl Check {
         box_margin(self, &span.lo, &span.hi, span.radius, context.w, None)
     }
 
+    /// This check for the same set at another place: the numbers of `shape` (the set's own
+    /// shape with other offsets, sides, centre or radius, as [`crate::sweep`] holds a moving
+    /// set still) in place of its own; the `P^-1` quantities do not depend on them.
+    pub(crate) fn moved(&self, shape: &UnsafeShape) -> Check {
+        let mut c = self.clone();
+        match (&mut c, shape) {
+            (Check::HalfSpace { offset, .. }, UnsafeShape::HalfSpace { offset: o, .. }) => {
+                *offset = *o;
+            }
+            (Check::Box { coords }, UnsafeShape::Box(sides)) => {
+                for ((_, range, _), (_, b)) in coords.iter_mut().zip(sides) {
+                    *range = (b.lo, b.hi);
+                }
+            }
+            (
+                Check::Ball { center, radius, .. },
+                UnsafeShape::Ball {
+                    center: c,
+                    radius: r,
+                    ..
+                },
+            ) => {
+                center.clone_from(c);
+                *radius = *r;
+            }
+            _ => {}
+        }
+        c
+    }
+
     /// Precomputes the checks of every unsafe set (see [`Check::new`]).
     pub(crate) fn all(
         sets: &[UnsafeSet],
@@ -326,12 +356,20 @@ pub(crate) fn deterministic_limit(
         let w: Vec<f64> = diag.iter().map(|d| d.sqrt().hi()).collect();
         checks.push((Check::all(sets, n, &l, &diag).ok()?, w));
     }
+    // A moving set is checked where the result held it still (method.md 8.15).
+    let swept = |j: usize, k: usize| prs.unsafe_sets.get(j).and_then(|v| v.swept.get(k));
     (0..prs.steps.len()).find_map(|k| {
         (0..sets.len()).find_map(|j| {
             let margin = members
                 .iter()
                 .zip(&checks)
-                .map(|(m, (c, w))| c[j].margin(&m.steps[k].det, 0.0, &Context { w, frame: None }))
+                .map(|(m, (c, w))| {
+                    let context = Context { w, frame: None };
+                    match swept(j, k) {
+                        Some(shape) => c[j].moved(shape).margin(&m.steps[k].det, 0.0, &context),
+                        None => c[j].margin(&m.steps[k].det, 0.0, &context),
+                    }
+                })
                 .fold(f64::NEG_INFINITY, f64::max);
             (margin.is_nan() || margin <= 0.0).then_some((k, j))
         })

@@ -105,11 +105,15 @@ pub fn tighten(
     let n = prs.n();
     check(constraints, n)?;
     let amounts = amounts(prs, constraints, unsafe_sets)?;
+    // A moving set is inflated where the result held it still over the interval (method.md
+    // 8.15).
+    let swept = |j: usize, k: usize| prs.unsafe_sets.get(j).and_then(|v| v.swept.get(k));
     let steps = prs
         .steps
         .iter()
         .zip(amounts)
-        .map(|(st, a)| TightStep {
+        .enumerate()
+        .map(|(k, (st, a))| TightStep {
             t: st.t,
             constraints: constraints
                 .iter()
@@ -119,7 +123,8 @@ pub fn tighten(
             unsafe_sets: unsafe_sets
                 .iter()
                 .zip(&a.unsafe_sets)
-                .map(|(u, s)| inflated(u, s))
+                .enumerate()
+                .map(|(j, (u, s))| inflated(u, swept(j, k).unwrap_or(&u.shape), s))
                 .collect(),
         })
         .collect();
@@ -311,9 +316,9 @@ fn tightened(c: &Constraint, s: &[f64]) -> Constraint {
     }
 }
 
-/// `u` moved outwards by the amounts `s`.
-fn inflated(u: &UnsafeSet, s: &[f64]) -> UnsafeSet {
-    let shape = match &u.shape {
+/// `u`, at `shape`, moved outwards by the amounts `s`.
+fn inflated(u: &UnsafeSet, shape: &UnsafeShape, s: &[f64]) -> UnsafeSet {
+    let shape = match shape {
         UnsafeShape::HalfSpace { normal, offset } => UnsafeShape::HalfSpace {
             normal: normal.clone(),
             offset: less(*offset, s[0]),
@@ -346,5 +351,6 @@ fn inflated(u: &UnsafeSet, s: &[f64]) -> UnsafeSet {
     UnsafeSet {
         name: u.name.clone(),
         shape,
+        moving: Vec::new(),
     }
 }

@@ -141,7 +141,8 @@ pub(crate) fn union(
             }
         })
         .collect();
-    let (unsafe_sets, verdict) = verdicts(info, checks, &steps);
+    let swept = u.unsafe_sets.iter().map(|v| v.swept.clone()).collect();
+    let (unsafe_sets, verdict) = verdicts(info, checks, &steps, swept);
     u.steps = steps;
     u.unsafe_sets = unsafe_sets;
     u.verdict = verdict;

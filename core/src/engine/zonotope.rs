@@ -807,6 +807,7 @@ mod tests {
             let set = UnsafeSet {
                 name: "u".into(),
                 shape,
+                moving: Vec::new(),
             };
             Check::new(&set, 2, &l, &diag)
                 .unwrap()

@@ -609,6 +609,7 @@ mod tests {
                         normal: vec![1.0, 0.0],
                         offset: 0.4,
                     },
+                    moving: Vec::new(),
                 }]
             } else {
                 vec![]

@@ -1508,6 +1508,7 @@ mod tests {
             let set = |name: &str, shape| UnsafeSet {
                 name: name.into(),
                 shape,
+                moving: Vec::new(),
             };
             info.unsafe_sets = vec![
                 set("box", UnsafeShape::Box(vec![(1, Bounds::new(0.12, 1.0))])),

@@ -255,6 +255,7 @@ impl Checker<'_> {
                 UnsafeSet {
                     name: name.name.clone(),
                     shape,
+                    moving: Vec::new(),
                 },
                 span,
             ));
@@ -305,6 +306,7 @@ impl Checker<'_> {
             GoalSet {
                 name: name.name.clone(),
                 parts,
+                moving: Vec::new(),
                 window: window.as_ref().map(|(w, _)| *w),
                 stay,
             },
