@@ -644,6 +644,9 @@ pub struct GoalVerdict {
     /// inside. For reaching alone in a model without unsafe sets, the box is the pointwise one
     /// ([`Prs::pointwise_hull_at`]).
     pub margins: Vec<f64>,
+    /// A moving goal (method.md 8.15): per report time, its parts held still inside all their
+    /// positions at that time (the margins' goal). Empty for a fixed goal.
+    pub swept: Vec<Vec<crate::model::UnsafeShape>>,
     /// What is shown.
     pub outcome: GoalOutcome,
 }

@@ -55,11 +55,18 @@ fn assess_one(
             inside(prs.span_hull_at(k), over(k))
         })
     };
+    let swept = match goal.moving.is_empty() {
+        true => Vec::new(),
+        false => (0..prs.steps.len())
+            .map(|k| sweep::goal_parts(goal, &numbers(at(k)), Sweep::Common))
+            .collect(),
+    };
     GoalVerdict {
         name: goal.name.clone(),
         window,
         stay: goal.stay,
         margins,
+        swept,
         outcome,
     }
 }
