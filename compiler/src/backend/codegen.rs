@@ -161,6 +161,32 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
         (&prepared.derivatives, &names),
         (options, lanes),
     );
+    // The moving sets' numbers (method.md 8.15): an inherent method of the model's shape,
+    // which the trait's `set_numbers` calls.
+    let numbers_doc = docs::MethodDoc::set_numbers(&model.pool, &names, &model.set_numbers);
+    let numbers_def = MethodDef {
+        name: "set_numbers_of",
+        kind: Kind::Interval,
+        roots: &model.set_numbers,
+        with_u: false,
+        owner: &name,
+        doc: &numbers_doc,
+    };
+    let (numbers_fn, numbers_helpers, set_numbers) = if model.set_numbers.is_empty() {
+        (TokenStream::new(), TokenStream::new(), TokenStream::new())
+    } else {
+        let (f, h) = method_fn(&model.pool, &mut tables, &numbers_def, options);
+        let call = quote! {
+            fn set_numbers(
+                &self,
+                t: reachc_runtime::Interval,
+                out: &mut [reachc_runtime::Interval],
+            ) {
+                self.set_numbers_of_interval(&[], t, out);
+            }
+        };
+        (f, h, call)
+    };
     let mut frame_items = TokenStream::new();
     let mut frame_arms = TokenStream::new();
     for (k, frame) in prepared.frames.iter().enumerate() {
@@ -234,6 +260,8 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
             pub const P: usize = #p;
             /// Number of noise channels `m`.
             pub const M: usize = #m;
+
+            #numbers_fn
         }
 
         #index_modules
@@ -251,9 +279,12 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
             }
             #bodies
             #frame_fn
+            #set_numbers
         }
 
         #helpers
+
+        #numbers_helpers
 
         #frame_items
 

@@ -40,6 +40,8 @@ pub struct Interpreter {
     jac_x_pattern: Vec<(usize, usize)>,
     jac_u: Plan,
     diffusion: Plan,
+    /// The numbers of the moving sets (method.md 8.15; empty in a transformed system).
+    set_numbers: Plan,
     /// The transformed systems ([`System::frame`]), over the same model (and pool).
     frames: Vec<Interpreter>,
 }
@@ -56,7 +58,9 @@ impl Interpreter {
             .collect();
         let drift = model.drift.clone();
         let diffusion = model.diffusion.clone();
-        Interpreter::of(&model, &drift, &diffusion, &prepared.derivatives, frames)
+        let mut own = Interpreter::of(&model, &drift, &diffusion, &prepared.derivatives, frames);
+        own.set_numbers = Plan::new(&model, model.set_numbers.clone());
+        own
     }
 
     fn of(
@@ -75,6 +79,7 @@ impl Interpreter {
             jac_x: Plan::new(model, flat(&derivatives.jac_x)),
             jac_u: Plan::new(model, flat(&derivatives.jac_u)),
             diffusion: Plan::new(model, flat(diffusion)),
+            set_numbers: Plan::new(model, Vec::new()),
             model: Arc::clone(model),
             frames,
         }
@@ -163,5 +168,11 @@ impl System for Interpreter {
 
     fn frame(&self, k: usize) -> Option<&dyn System> {
         self.frames.get(k).map(|f| f as &dyn System)
+    }
+
+    fn set_numbers(&self, t: Interval, out: &mut [Interval]) {
+        if !self.set_numbers.roots.is_empty() {
+            self.eval_into(&self.set_numbers, &[], &[], t, out);
+        }
     }
 }

@@ -13,8 +13,8 @@ use reachc_core::engine::Setting;
 // backends hand it on unchanged.
 pub use reachc_core::model::{
     AnalysisSpec, Ball, Bounds, GoalSet, Guarantee, Inclusion, InitialSet, Integrator, Method,
-    MetricChoice, RadiusRule, Rate, Split, Transform, UnsafeSet, UnsafeShape, AUTO_PIECES,
-    MAX_PIECES,
+    MetricChoice, Moving, RadiusRule, Rate, Slot, Split, Transform, UnsafeSet, UnsafeShape,
+    AUTO_PIECES, MAX_PIECES,
 };
 
 /// A checked spec, ready for analysis and code generation.
@@ -50,6 +50,9 @@ pub struct Model {
     pub unsafe_sets: Vec<UnsafeSet>,
     /// Goal sets (method.md 8.13).
     pub goals: Vec<GoalSet>,
+    /// The numbers of the moving unsafe and goal sets as expressions of `t` and tables
+    /// (method.md 8.15), indexed by `Moving::number`: `System::set_numbers`.
+    pub set_numbers: Vec<ExprId>,
     /// The analyses to run.
     pub analyses: Vec<Analysis>,
     /// Named constants with their values, in declaration order.

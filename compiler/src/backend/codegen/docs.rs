@@ -117,6 +117,19 @@ impl SystemDocs {
     }
 }
 
+impl MethodDoc {
+    /// The doc of `set_numbers`: the moving sets' numbers (method.md 8.15), printed by
+    /// `names`.
+    pub(super) fn set_numbers(pool: &Pool, names: &Names<'_>, roots: &[ExprId]) -> MethodDoc {
+        let p = Printer { pool, names };
+        MethodDoc {
+            what: "The numbers of the moving unsafe and goal sets, functions of `t` and tables: \
+                   `out[k]` is entry `k` of `ModelInfo`'s `Moving::number`",
+            equations: block(roots.len(), |k| p.equation(format!("number {k}"), roots[k])),
+        }
+    }
+}
+
 /// Prints a system's expressions.
 struct Printer<'a> {
     pool: &'a Pool,

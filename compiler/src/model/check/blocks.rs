@@ -305,6 +305,31 @@ impl<'a> Checker<'a> {
 
     /// An interval `[lo, hi]` of constants with `lo <= hi`.
     pub(super) fn interval(&mut self, e: &Expr, env: &LoopEnv) -> Option<Bounds> {
+        let [lo, hi] = self.interval_ends(e)?;
+        let (lo, hi) = (self.constant(lo, env), self.constant(hi, env));
+        let (lo, hi) = (lo?, hi?);
+        self.ordered(lo, hi, e)
+    }
+
+    /// `Bounds { lo, hi }`, or a diagnostic at `e` when `lo > hi`.
+    pub(super) fn ordered(&mut self, lo: f64, hi: f64, e: &Expr) -> Option<Bounds> {
+        if lo > hi {
+            return self.fail(
+                Diagnostic::error(
+                    format!(
+                        "empty interval: the lower end {lo} is greater than the upper end {hi}"
+                    ),
+                    e.span.clone(),
+                    "empty",
+                )
+                .with_help("swap the ends"),
+            );
+        }
+        Some(Bounds { lo, hi })
+    }
+
+    /// The two ends of an interval `[LO, HI]`.
+    pub(super) fn interval_ends<'e>(&mut self, e: &'e Expr) -> Option<&'e [Expr; 2]> {
         let ExprKind::List(items) = &e.kind else {
             return self.fail(
                 Diagnostic::error("expected an interval", e.span.clone(), "not an interval")
@@ -324,21 +349,7 @@ impl<'a> Checker<'a> {
                 .with_help("write `[LO, HI]`"),
             );
         }
-        let (lo, hi) = (self.constant(&items[0], env), self.constant(&items[1], env));
-        let (lo, hi) = (lo?, hi?);
-        if lo > hi {
-            return self.fail(
-                Diagnostic::error(
-                    format!(
-                        "empty interval: the lower end {lo} is greater than the upper end {hi}"
-                    ),
-                    e.span.clone(),
-                    "empty",
-                )
-                .with_help("swap the ends"),
-            );
-        }
-        Some(Bounds { lo, hi })
+        items.as_slice().try_into().ok()
     }
 
     fn drift_stmt(&mut self, s: &Stmt, env: &LoopEnv) {

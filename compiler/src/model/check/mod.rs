@@ -47,6 +47,7 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         balls: Vec::new(),
         unsafe_sets: Vec::new(),
         goals: Vec::new(),
+        set_numbers: Vec::new(),
         analyses: Vec::new(),
         auto_transforms: Vec::new(),
         constants: Vec::new(),
@@ -101,6 +102,7 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         tables: c.tables,
         unsafe_sets: c.unsafe_sets.into_iter().map(|(u, _)| u).collect(),
         goals: c.goals.into_iter().map(|(g, _, _)| g).collect(),
+        set_numbers: c.set_numbers,
         analyses: c.analyses,
         constants: c.constants,
     };
@@ -137,6 +139,8 @@ struct Checker<'a> {
     unsafe_sets: Vec<(UnsafeSet, Span)>,
     /// Goal sets, with the `goal` item of each and its window's span.
     goals: Vec<(GoalSet, Span, Option<Span>)>,
+    /// The expressions of the moving sets' numbers (`Moving::number` indexes them).
+    set_numbers: Vec<ExprId>,
     analyses: Vec<super::Analysis>,
     /// Analyses with `transform = auto` (index, span of `auto`), chosen after the checks.
     auto_transforms: Vec<(usize, Span)>,

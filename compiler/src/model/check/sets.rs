@@ -7,13 +7,16 @@ use super::matrix;
 use super::scope::{did_you_mean, VarKind};
 use super::Checker;
 use crate::diagnostics::{Diagnostic, Span};
-use crate::ir::Var;
-use crate::model::{Ball, Bounds, GoalSet, UnsafeSet, UnsafeShape, Variable};
+use crate::ir::{ExprId, Var, VarValues};
+use crate::model::{Ball, Bounds, GoalSet, Moving, Slot, UnsafeSet, UnsafeShape, Variable};
 use crate::syntax::ast::{Block, CmpOp, Expr, ExprKind, Ident, Stmt, Target};
 use reachc_core::Interval;
 
 /// The fields of a block, by key.
 pub(super) type Fields<'s> = HashMap<&'s str, (&'s Expr, Span)>;
+
+/// The numbers of a set's shape that move (method.md 8.15), each with its expression.
+type MovingNumbers = Vec<(Slot, ExprId)>;
 
 impl Checker<'_> {
     /// Collects `key = value` fields, reporting unknown keys (with a suggestion), duplicates and
@@ -250,12 +253,13 @@ impl Checker<'_> {
         if self.defined_twice("unsafe set", name, first.map(|(_, span)| span.clone())) {
             return;
         }
-        if let Some(shape) = self.set_shape(kind, body, &span, "unsafe") {
+        if let Some((shape, moving)) = self.set_shape(kind, body, &span, "unsafe") {
+            let moving = self.moving(0, moving);
             self.unsafe_sets.push((
                 UnsafeSet {
                     name: name.name.clone(),
                     shape,
-                    moving: Vec::new(),
+                    moving,
                 },
                 span,
             ));
@@ -279,7 +283,7 @@ impl Checker<'_> {
         if self.defined_twice("goal", name, first.map(|(_, span, _)| span.clone())) {
             return;
         }
-        let shapes: Vec<Option<UnsafeShape>> = parts
+        let shapes: Vec<Option<(UnsafeShape, MovingNumbers)>> = parts
             .iter()
             .map(|(kind, body)| self.set_shape(kind, body, &span, "goal"))
             .collect();
@@ -291,7 +295,18 @@ impl Checker<'_> {
         else {
             return;
         };
-        if let Some(why) = empty(&parts, &self.states) {
+        let (parts, numbers): (Vec<UnsafeShape>, Vec<MovingNumbers>) = parts.into_iter().unzip();
+        let moving: Vec<Moving> = numbers
+            .into_iter()
+            .enumerate()
+            .flat_map(|(j, m)| self.moving(j, m))
+            .collect();
+        // (A moving goal may be empty at some times and not at others: its verdict says so.)
+        let why = moving
+            .is_empty()
+            .then(|| empty(&parts, &self.states))
+            .flatten();
+        if let Some(why) = why {
             self.diags.push(
                 Diagnostic::error(
                     format!("goal `{}` is empty: {why}", name.name),
@@ -306,7 +321,7 @@ impl Checker<'_> {
             GoalSet {
                 name: name.name.clone(),
                 parts,
-                moving: Vec::new(),
+                moving,
                 window: window.as_ref().map(|(w, _)| *w),
                 stay,
             },
@@ -360,26 +375,22 @@ impl Checker<'_> {
         self.diags.extend(found);
     }
 
-    /// `KIND { ... }` of an unsafe set or a goal (`owner`) as a region.
+    /// `KIND { ... }` of an unsafe set or a goal (`owner`) as a region (at `t = 0`), with the
+    /// numbers that move (method.md 8.15).
     fn set_shape(
         &mut self,
         kind: &Ident,
         body: &Block,
         span: &Span,
         owner: &str,
-    ) -> Option<UnsafeShape> {
+    ) -> Option<(UnsafeShape, MovingNumbers)> {
         let a = if owner == "unsafe" { "an" } else { "a" };
         match kind.name.as_str() {
             "box" => self.unsafe_box(body, &format!("{a} {owner} box")),
             "ball" => {
                 let what = format!("{a} {owner} ball");
                 let f = self.fields(body, &["over", "center", "radius"], &what);
-                self.ball_fields(&f, span)
-                    .map(|(states, center, radius)| UnsafeShape::Ball {
-                        states,
-                        center,
-                        radius,
-                    })
+                self.set_ball(&f, span)
             }
             "halfspace" => self.halfspace(body),
             other => {
@@ -396,8 +407,9 @@ impl Checker<'_> {
         }
     }
 
-    fn unsafe_box(&mut self, body: &Block, what: &str) -> Option<UnsafeShape> {
+    fn unsafe_box(&mut self, body: &Block, what: &str) -> Option<(UnsafeShape, MovingNumbers)> {
         let mut sides: Vec<(usize, Bounds)> = Vec::new();
+        let mut moving = Vec::new();
         let mut ok = true;
         for s in &body.stmts {
             let Stmt::Member { target, set, .. } = s else {
@@ -411,9 +423,9 @@ impl Checker<'_> {
             };
             let (i, b) = (
                 self.target(target, VarKind::State, &[]),
-                self.interval(set, &[]),
+                self.set_interval(set),
             );
-            let (Some(i), Some(b)) = (i, b) else {
+            let (Some(i), Some((b, lo, hi))) = (i, b) else {
                 ok = false;
                 continue;
             };
@@ -426,6 +438,9 @@ impl Checker<'_> {
                 ok = false;
                 continue;
             }
+            let k = sides.len();
+            moving.extend(lo.map(|e| (Slot::Lo(k), e)));
+            moving.extend(hi.map(|e| (Slot::Hi(k), e)));
             sides.push((i, b));
         }
         if ok && sides.is_empty() {
@@ -438,10 +453,10 @@ impl Checker<'_> {
                 .with_help("write `px in [1, 2]`"),
             );
         }
-        ok.then_some(UnsafeShape::Box(sides))
+        ok.then_some((UnsafeShape::Box(sides), moving))
     }
 
-    fn halfspace(&mut self, body: &Block) -> Option<UnsafeShape> {
+    fn halfspace(&mut self, body: &Block) -> Option<(UnsafeShape, MovingNumbers)> {
         let [Stmt::Constraint { lhs, op, rhs, span }] = body.stmts.as_slice() else {
             return self.fail(
                 Diagnostic::error(
@@ -472,6 +487,13 @@ impl Checker<'_> {
         };
         let mut normal = vec![0.0; self.states.len()];
         for v in self.pool.vars_of(g) {
+            match v {
+                // A moving half-space: its offset may depend on time (and tables).
+                Var::Time => continue,
+                Var::State(_) => {}
+                // (An input or a noise channel in the offset: refused below, by name.)
+                _ => continue,
+            }
             let Var::State(i) = v else {
                 return not_linear(self);
             };
@@ -481,9 +503,6 @@ impl Checker<'_> {
             };
             normal[i as usize] = a;
         }
-        let zero = self.pool.num(0.0);
-        let at_zero = self.pool.substitute(g, &mut |_| Some(zero));
-        let offset = -self.pool.as_value(at_zero)?;
         if normal.iter().all(|a| *a == 0.0) {
             return self.fail(Diagnostic::error(
                 "the half-space does not depend on any state",
@@ -491,7 +510,146 @@ impl Checker<'_> {
                 "no state here",
             ));
         }
-        Some(UnsafeShape::HalfSpace { normal, offset })
+        // `g(x) = normal . x - offset(t)`: the offset is `-g(0)`.
+        let zero = self.pool.num(0.0);
+        let at_zero = self
+            .pool
+            .substitute(g, &mut |v| matches!(v, Var::State(_)).then_some(zero));
+        let offset = self.pool.neg(at_zero);
+        let moving_span = lhs.span.start..rhs.span.end;
+        let (offset, moving) = match self.set_number(offset, &moving_span)? {
+            (v, None) => (v, Vec::new()),
+            (v, Some(e)) => (v, vec![(Slot::Offset, e)]),
+        };
+        Some((UnsafeShape::HalfSpace { normal, offset }, moving))
+    }
+
+    /// A number of an unsafe or goal set, lowered: its value at `t = 0`, and its expression
+    /// when it moves (depends on `t` or a table, method.md 8.15); states, inputs and noise are
+    /// refused at `span`.
+    fn set_number(&mut self, id: ExprId, span: &Span) -> Option<(f64, Option<ExprId>)> {
+        if let Some(v) = self.pool.as_value(id) {
+            return Some((v, None));
+        }
+        if let Some(v) = self.pool.vars_of(id).into_iter().find(|v| *v != Var::Time) {
+            let what = match v {
+                Var::State(i) => format!("state `{}`", self.states[i as usize].name),
+                Var::Input(i) => format!("input `{}`", self.inputs[i as usize].name),
+                _ => "a noise channel".to_string(),
+            };
+            return self.fail(
+                Diagnostic::error(
+                    format!("a set's bounds, centre and radius may depend on `t` and tables only, not on {what}"),
+                    span.clone(),
+                    "not a function of t and tables",
+                )
+                .with_help("a set that moves is written with `t` or a table column, e.g. `x >= 1 + 0.5 * t` or `x in [lead.x - 1, lead.x + 1]`"),
+            );
+        }
+        let at_zero = VarValues {
+            states: &[],
+            inputs: &[],
+            noises: &[],
+            time: 0.0,
+        };
+        let v = self.pool.eval(&[id], &at_zero, &self.tables)[0];
+        if !v.is_finite() {
+            return self.fail(Diagnostic::error(
+                format!("this number of the set is {v} at t = 0"),
+                span.clone(),
+                "not finite",
+            ));
+        }
+        Some((v, Some(id)))
+    }
+
+    /// A set's number written as the expression `e` (see [`Checker::set_number`]).
+    fn set_number_of(&mut self, e: &Expr) -> Option<(f64, Option<ExprId>)> {
+        let id = self.lower(e, Allow::Model, &[])?;
+        self.set_number(id, &e.span)
+    }
+
+    /// A box side `[LO, HI]` of a set: its bounds at `t = 0` and the ends that move.
+    fn set_interval(&mut self, e: &Expr) -> Option<(Bounds, Option<ExprId>, Option<ExprId>)> {
+        let [lo, hi] = self.interval_ends(e)?;
+        let (lo, hi) = (self.set_number_of(lo), self.set_number_of(hi));
+        let ((lo, lo_moves), (hi, hi_moves)) = (lo?, hi?);
+        // (A moving side may cross later: the set is then empty at those times.)
+        let b = self.ordered(lo, hi, e)?;
+        Some((b, lo_moves, hi_moves))
+    }
+
+    /// `over`, `center` and `radius` of an unsafe or goal ball; `over` defaults to all states.
+    fn set_ball(&mut self, f: &Fields, span: &Span) -> Option<(UnsafeShape, MovingNumbers)> {
+        let states = match f.get("over") {
+            Some((e, _)) => self.state_list(e)?,
+            None => (0..self.states.len()).collect(),
+        };
+        let center_expr = self.required(f, "center", span, "ball")?;
+        let radius_expr = self.required(f, "radius", span, "ball")?;
+        let ExprKind::List(items) = &center_expr.kind else {
+            return self.fail(
+                Diagnostic::error(
+                    "expected a list of numbers",
+                    center_expr.span.clone(),
+                    "not a list",
+                )
+                .with_help("write `[a, b, ...]`"),
+            );
+        };
+        let center: Vec<Option<(f64, Option<ExprId>)>> =
+            items.iter().map(|x| self.set_number_of(x)).collect();
+        let radius = self.set_number_of(radius_expr);
+        let (center, (radius, radius_moves)) =
+            (center.into_iter().collect::<Option<Vec<_>>>()?, radius?);
+        if center.len() != states.len() {
+            return self.fail(Diagnostic::error(
+                format!(
+                    "the centre has {} entries but the ball is over {} states",
+                    center.len(),
+                    states.len()
+                ),
+                center_expr.span.clone(),
+                "wrong length",
+            ));
+        }
+        if radius < 0.0 {
+            return self.fail(Diagnostic::error(
+                format!("the radius {radius} is negative"),
+                radius_expr.span.clone(),
+                "must be >= 0",
+            ));
+        }
+        let mut moving: MovingNumbers = center
+            .iter()
+            .enumerate()
+            .filter_map(|(k, (_, e))| e.map(|e| (Slot::Center(k), e)))
+            .collect();
+        moving.extend(radius_moves.map(|e| (Slot::Radius, e)));
+        let center = center.into_iter().map(|(v, _)| v).collect();
+        Some((
+            UnsafeShape::Ball {
+                states,
+                center,
+                radius,
+            },
+            moving,
+        ))
+    }
+
+    /// The moving numbers of part `part` of a set, registered as the model's set numbers.
+    fn moving(&mut self, part: usize, numbers: MovingNumbers) -> Vec<Moving> {
+        numbers
+            .into_iter()
+            .map(|(slot, e)| {
+                self.set_numbers.push(e);
+                Moving {
+                    part,
+                    slot,
+                    number: self.set_numbers.len() - 1,
+                }
+            })
+            .collect()
     }
 }
 
