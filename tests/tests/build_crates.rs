@@ -494,6 +494,7 @@ fn dump(
     (x, u, t): (&[f64], &[f64], f64),
     (xi, ui, ti): (&[Interval], &[Interval], Interval),
     (lx, lu): (&[X8], &[X8]),
+    sets: usize,
     words: &mut Vec<String>,
 ) {{
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
@@ -510,15 +511,17 @@ fn dump(
     let mut jui = vec![Interval::ZERO; n * p];
     let mut gi = vec![Interval::ZERO; n * m];
     let mut si = vec![Interval::ZERO; sys.jac_x_pattern().len()];
+    let mut ni = vec![Interval::ZERO; sets];
     sys.drift_interval(xi, ui, ti, &mut fi);
     sys.jac_x_interval(xi, ui, ti, &mut jxi);
     sys.jac_u_interval(xi, ui, ti, &mut jui);
     sys.diffusion_interval(xi, ti, &mut gi);
     sys.jac_x_sparse_interval(xi, ui, ti, &mut si);
+    sys.set_numbers(ti, &mut ni);
     for v in f.iter().chain(&jx).chain(&ju).chain(&g) {{
         words.push(format!("{{:016x}}", v.to_bits()));
     }}
-    for v in fi.iter().chain(&jxi).chain(&jui).chain(&gi).chain(&si) {{
+    for v in fi.iter().chain(&jxi).chain(&jui).chain(&gi).chain(&si).chain(&ni) {{
         words.push(format!("{{:016x}}", v.lo().to_bits()));
         words.push(format!("{{:016x}}", v.hi().to_bits()));
     }}
@@ -550,10 +553,10 @@ fn main() {{
         let (lx, lu): (Vec<X8>, Vec<X8>) = ((0..n).map(lane).collect(), (n..n + p).map(lane).collect());
         let lanes = (&lx[..], &lu[..]);
         let mut words: Vec<String> = Vec::new();
-        dump(&sys, (x, u, t), (&xi, &ui, ti), lanes, &mut words);
+        dump(&sys, (x, u, t), (&xi, &ui, ti), lanes, {crate_ident}::info().set_numbers(), &mut words);
         let mut k = 0;
         while let Some(frame) = sys.frame(k) {{
-            dump(frame, (x, u, t), (&xi, &ui, ti), lanes, &mut words);
+            dump(frame, (x, u, t), (&xi, &ui, ti), lanes, 0, &mut words);
             k += 1;
         }}
         writeln!(out, "{{}}", words.join(" ")).expect("stdout");
@@ -565,15 +568,16 @@ fn main() {{
 
 /// What the probe prints for one system at a sample, computed by the interpreter, each entry
 /// with its name: the point values of drift, `D_x f`, `D_u f`, `G`, then the box values of the
-/// same and of the sparse `D_x f`.
+/// same, of the sparse `D_x f` and of the `sets` moving set numbers (method.md 8.15) over the
+/// sample's time box.
 struct Values {
     points: Vec<(String, f64)>,
     boxes: Vec<(String, Interval)>,
 }
 
-fn evaluate(sys: &dyn System, s: &Sample) -> Values {
+fn evaluate(sys: &dyn System, s: &Sample, sets: usize) -> Values {
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
-    let sizes = [n, n * n, n * p, n * m, sys.jac_x_pattern().len()];
+    let sizes = [n, n * n, n * p, n * m, sys.jac_x_pattern().len(), sets];
     let mut points: Vec<Vec<f64>> = sizes[..4].iter().map(|&len| vec![0.0; len]).collect();
     sys.drift(&s.x, &s.u, s.t, &mut points[0]);
     sys.jac_x(&s.x, &s.u, s.t, &mut points[1]);
@@ -586,6 +590,7 @@ fn evaluate(sys: &dyn System, s: &Sample) -> Values {
     sys.jac_u_interval(&s.xi, &s.ui, s.ti, &mut boxes[2]);
     sys.diffusion_interval(&s.xi, s.ti, &mut boxes[3]);
     sys.jac_x_sparse_interval(&s.xi, &s.ui, s.ti, &mut boxes[4]);
+    sys.set_numbers(s.ti, &mut boxes[5]);
     fn named<T: Copy>(parts: &[Vec<T>], names: &[&str]) -> Vec<(String, T)> {
         parts
             .iter()
@@ -604,6 +609,7 @@ fn evaluate(sys: &dyn System, s: &Sample) -> Values {
         "jac_u_interval",
         "diffusion_interval",
         "jac_x_sparse_interval",
+        "set_numbers",
     ];
     Values {
         points: named(&points, &names),
@@ -697,6 +703,7 @@ fn generated_code_agrees_with_the_interpreter() {
         "linear_n",
         "lorenz",
         "msd",
+        "overtake",
         "pendulum",
         "unicycle",
         "unicycle_lookahead",
@@ -815,7 +822,8 @@ fn generated_code_agrees_with_the_interpreter() {
                 } else {
                     format!("{name}: frame {}: sample {k}", j - 1)
                 };
-                let want = evaluate(*sys, s);
+                let sets = if j == 0 { model.set_numbers.len() } else { 0 };
+                let want = evaluate(*sys, s, sets);
                 let (np, nb) = (want.points.len(), want.boxes.len());
                 assert!(words.len() >= at + np + 2 * nb, "{what}: too few values");
                 let points = &words[at..at + np];
