@@ -17,7 +17,7 @@ use reachc_compiler::analysis::{
     bound_matrix, eval_box, split_atoms, time_range, AtomSplit, Derivatives, GradEntry,
 };
 use reachc_compiler::ir::{ExprId, Names};
-use reachc_compiler::model::{Bounds, Model, UnsafeShape, Variable};
+use reachc_compiler::model::{Bounds, Model, Moving, Slot, UnsafeShape, Variable};
 
 /// A dense matrix of expressions with its interval bounds.
 struct Matrix {
@@ -108,6 +108,7 @@ fn report(model: &mut Model) -> Report {
         all.extend(m.atoms.atoms.iter().map(|a| a.expr));
     }
     all.extend(g_exprs);
+    all.extend(&model.set_numbers);
     all.sort_unstable();
     all.dedup();
     let sde_names = Names {
@@ -303,14 +304,22 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
         unsafe_sets: model
             .unsafe_sets
             .iter()
-            .map(|u| shape_json(model, &u.name, &u.shape))
+            .map(|u| moving_json(model, &r, shape_json(model, &u.name, &u.shape), &u.moving))
             .collect(),
         goals: model
             .goals
             .iter()
             .map(|g| {
-                let parts: Vec<Value> =
-                    g.parts.iter().map(|p| shape_json(model, &g.name, p)).collect();
+                let parts: Vec<Value> = g
+                    .parts
+                    .iter()
+                    .enumerate()
+                    .map(|(j, p)| {
+                        let moving: Vec<Moving> =
+                            g.moving.iter().filter(|m| m.part == j).copied().collect();
+                        moving_json(model, &r, shape_json(model, &g.name, p), &moving)
+                    })
+                    .collect();
                 json!({"name": g.name, "parts": parts,
                        "window": g.window.map(|w| [w.lo, w.hi]), "stay": g.stay})
             })
@@ -346,6 +355,39 @@ fn shape_json(model: &Model, set: &str, shape: &UnsafeShape) -> Value {
             json!({"name": set, "kind": "halfspace", "normal": normal, "offset": offset})
         }
     }
+}
+
+/// `shape` (from [`shape_json`]) with, for a moving set (method.md 8.15), `"moving"`: each
+/// moving number's place (`"offset"`, `"lo"`/`"hi"` with the side's state, `"center"` with its
+/// entry, `"radius"`) and its expression of `t` and tables. The shape's own numbers are the
+/// values at `t = 0`.
+fn moving_json(model: &Model, r: &Report, mut shape: Value, moving: &[Moving]) -> Value {
+    if moving.is_empty() {
+        return shape;
+    }
+    let entries: Vec<Value> = moving
+        .iter()
+        .map(|m| {
+            let expression = r.sde(model.set_numbers[m.number]);
+            match m.slot {
+                Slot::Offset => json!({"number": "offset", "expression": expression}),
+                Slot::Lo(k) | Slot::Hi(k) => {
+                    let end = if matches!(m.slot, Slot::Lo(_)) {
+                        "lo"
+                    } else {
+                        "hi"
+                    };
+                    json!({"number": end, "side": k, "expression": expression})
+                }
+                Slot::Center(k) => {
+                    json!({"number": "center", "entry": k, "expression": expression})
+                }
+                Slot::Radius => json!({"number": "radius", "expression": expression}),
+            }
+        })
+        .collect();
+    shape["moving"] = Value::Array(entries);
+    shape
 }
 
 fn fmt_bounds(b: Bounds) -> String {
