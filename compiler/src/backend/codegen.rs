@@ -176,6 +176,13 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
         (TokenStream::new(), TokenStream::new(), TokenStream::new())
     } else {
         let (f, h) = method_fn(&model.pool, &mut tables, &numbers_def, options);
+        let lints = allow_lints();
+        let f = quote! {
+            #lints
+            impl #name {
+                #f
+            }
+        };
         let call = quote! {
             fn set_numbers(
                 &self,
@@ -260,9 +267,9 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
             pub const P: usize = #p;
             /// Number of noise channels `m`.
             pub const M: usize = #m;
-
-            #numbers_fn
         }
+
+        #numbers_fn
 
         #index_modules
 
