@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use reachc_runtime::interval::Interval;
+use reachc_runtime::report::shape::ShapeJson;
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -215,6 +216,7 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             .map(|row| row.iter().map(|&e| r.sde(e)).collect())
             .collect()
     };
+    let states = names(&model.states);
     let mut unbounded = Vec::new();
     for m in &r.matrices {
         for (i, row) in m.bounds.iter().enumerate() {
@@ -303,14 +305,14 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
         unsafe_sets: model
             .unsafe_sets
             .iter()
-            .map(|u| shape_json(model, &u.name, &u.shape))
+            .map(|u| shape_json(&states, &u.name, &u.shape))
             .collect(),
         goals: model
             .goals
             .iter()
             .map(|g| {
                 let parts: Vec<Value> =
-                    g.parts.iter().map(|p| shape_json(model, &g.name, p)).collect();
+                    g.parts.iter().map(|p| shape_json(&states, &g.name, p)).collect();
                 json!({"name": g.name, "parts": parts,
                        "window": g.window.map(|w| [w.lo, w.hi]), "stay": g.stay})
             })
@@ -330,22 +332,13 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out)
 }
 
-/// An unsafe set, or a part of goal `set`, in the `inspect --json` document.
-fn shape_json(model: &Model, set: &str, shape: &UnsafeShape) -> Value {
-    let name = |i: &usize| model.states[*i].name.clone();
-    match shape {
-        UnsafeShape::Box(sides) => json!({"name": set, "kind": "box",
-            "sides": sides.iter().map(|(i, b)| json!({"state": name(i), "range": [b.lo, b.hi]})).collect::<Vec<_>>()}),
-        UnsafeShape::Ball {
-            states,
-            center,
-            radius,
-        } => json!({"name": set, "kind": "ball",
-            "over": states.iter().map(name).collect::<Vec<_>>(), "center": center, "radius": radius}),
-        UnsafeShape::HalfSpace { normal, offset } => {
-            json!({"name": set, "kind": "halfspace", "normal": normal, "offset": offset})
-        }
-    }
+/// An unsafe set, or a part of goal `set`, in the `inspect --json` document: the shape's one
+/// JSON form ([`ShapeJson`]) with the set's name, in the states named `states`.
+fn shape_json(states: &[String], set: &str, shape: &UnsafeShape) -> Value {
+    // Plain data with string keys: converting cannot fail.
+    let mut v = serde_json::to_value(ShapeJson::of(states, shape)).expect("a shape serialises");
+    v["name"] = json!(set);
+    v
 }
 
 fn fmt_bounds(b: Bounds) -> String {
