@@ -7,9 +7,14 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
+use reachc::plot::input::{MovingSet, ResultFile};
+use reachc::plot::regions::Region;
+use reachc::plot::scene::moving_regions;
 use reachc_compiler::backend::interp::Interpreter;
 use reachc_compiler::backend::prepare;
 use reachc_runtime::engine;
+use reachc_runtime::model::{Bounds, UnsafeShape};
+use reachc_runtime::report;
 use reachc_runtime::simulate::{self, Options};
 
 use common::{reachc, spec};
@@ -553,5 +558,184 @@ fn goals_are_reported_and_drawn() {
     assert_eq!(goals.len(), 4);
     assert_eq!(goals[0]["status"], "reached");
     assert_eq!(goals[3]["why"]["kind"], "not_inside");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A model with a fixed and a second unsafe set and a goal, for the moving sets' test below
+/// (whose positions it writes into the result by hand: the compiler gives no moving sets yet).
+const MOVING_SPEC: &str = r#"model drift2
+state x in [1.9, 2.1]
+state y in [-0.1, 0.1]
+noise w1
+noise w2
+drift {
+    x' = -1.5 * x + y
+    y' = -1.5 * y
+}
+diffusion {
+    x: 0.05 * w1
+    y: 0.05 * w2
+}
+unsafe wall halfspace { y >= 0.5 }
+unsafe obs box { x in [-2, -1.5]  y in [-0.5, 0.5] }
+goal home box { x in [-0.5, 0.5]  y in [-0.5, 0.5] } within [1, 4]
+analysis contraction {
+    method = contraction
+    delta = 1e-3
+    horizon = 4
+    step = 0.25
+}
+"#;
+
+/// The points of the SVG polygon drawn last before the label `label` (the filled region the
+/// label names), in pixels.
+fn region_before(svg: &str, label: &str) -> Vec<(i64, i64)> {
+    let at = svg
+        .find(&format!(">\n{label}\n<"))
+        .unwrap_or_else(|| panic!("no label `{label}`"));
+    let start = svg[..at].rfind("<polygon").unwrap();
+    let points = &svg[start..at];
+    let points = &points[points.find("points=\"").unwrap() + 8..];
+    points[..points.find('"').unwrap()]
+        .split_whitespace()
+        .map(|p| {
+            let (x, y) = p.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect()
+}
+
+/// A result with a moving unsafe box and a moving goal (positions written by hand into the
+/// engine's result of a fixed-set model, 0.125 per report step in x and in y): the plot's
+/// reader gives back each step's shapes; `reachc plot` draws each set where it is at the
+/// chosen times (default: t = 0 and the horizon), labelled with the time, the fixed wall as
+/// before; the obstacle's rectangles at t = 1 and t = 3 are the same rectangle moved right.
+#[test]
+fn moving_sets_are_read_and_drawn_where_they_are() {
+    let dir = temp_dir("moving");
+    let spec_path = dir.join("drift2.sde");
+    std::fs::write(&spec_path, MOVING_SPEC).unwrap();
+    let mut loaded = reachc_compiler::driver::load(&spec_path).unwrap();
+    let prepared = prepare(&mut loaded.model);
+    let info = prepared.info.clone();
+    let interp = Interpreter::new(loaded.model, &prepared);
+    let mut prs = engine::run(&interp, &info, info.analysis("contraction").unwrap()).unwrap();
+    let steps = prs.steps.len();
+    assert_eq!(steps, 17);
+    // (Multiples of 1/8: the decimals in the file are exact.)
+    let obs = |k: usize| {
+        let x = k as f64 / 8.0;
+        UnsafeShape::Box(vec![
+            (0, Bounds::new(x - 2.0, x - 1.5)),
+            (1, Bounds::new(-0.5, 0.5)),
+        ])
+    };
+    let home = |k: usize| {
+        let y = k as f64 / 8.0;
+        vec![UnsafeShape::Box(vec![
+            (0, Bounds::new(-0.5, 0.5)),
+            (1, Bounds::new(y - 0.5, y + 0.5)),
+        ])]
+    };
+    assert_eq!(prs.unsafe_sets[1].name, "obs");
+    prs.unsafe_sets[1].swept = (0..steps).map(obs).collect();
+    prs.goals[0].swept = (0..steps).map(home).collect();
+    let path = dir.join("contraction.json");
+    std::fs::write(&path, report::to_json(&prs)).unwrap();
+
+    let read = ResultFile::read(&path).unwrap();
+    let moving = read.moving_sets().unwrap();
+    assert_eq!(
+        moving,
+        [
+            MovingSet {
+                name: "obs".into(),
+                goal: false,
+                at: (0..steps).map(|k| vec![obs(k)]).collect(),
+            },
+            MovingSet {
+                name: "home".into(),
+                goal: true,
+                at: (0..steps).map(home).collect(),
+            },
+        ]
+    );
+    // t = 1 and t = 3 are report steps 4 and 12.
+    let mut notes = Vec::new();
+    let drawn = moving_regions(&read, &moving, [0, 1], &[4, 12], &mut notes);
+    let rect = |x: (f64, f64), y: (f64, f64)| Region::Rect { x, y };
+    assert_eq!(
+        drawn.unsafe_sets,
+        [
+            ("obs at t = 1".to_string(), rect((-1.5, -1.0), (-0.5, 0.5))),
+            ("obs at t = 3".to_string(), rect((-0.5, 0.0), (-0.5, 0.5))),
+        ]
+    );
+    assert_eq!(
+        drawn.goals[1],
+        (
+            "home at t = 3".to_string(),
+            vec![rect((-0.5, 0.5), (1.0, 2.0))]
+        )
+    );
+
+    let spec = spec_path.to_str().unwrap();
+    let pics = dir.join("pics");
+    let o = reachc(&[
+        "plot",
+        path.to_str().unwrap(),
+        "--spec",
+        spec,
+        "--times",
+        "1,3",
+        "--paths",
+        "5",
+        "-o",
+        pics.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let sets = svg(&pics.join("contraction_sets.svg"));
+    for label in [
+        "obs at t = 1",
+        "obs at t = 3",
+        "home at t = 1",
+        "home at t = 3",
+        "unsafe: wall, obs at t = 1, obs at t =",
+        "goal: home at t = 1, home at t = 3",
+        "moving sets drawn at t = 1, 3",
+    ] {
+        assert!(sets.contains(label), "{label}");
+    }
+    assert!(sets.contains(">\nwall\n<"), "the fixed wall as before");
+    let (before, after) = (
+        region_before(&sets, "obs at t = 1"),
+        region_before(&sets, "obs at t = 3"),
+    );
+    assert_eq!(before.len(), after.len());
+    let shift = after[0].0 - before[0].0;
+    assert!(shift > 50, "moved right by {shift} px");
+    for (b, a) in before.iter().zip(&after) {
+        assert!(
+            (a.0 - b.0 - shift).abs() <= 1 && a.1 == b.1,
+            "{before:?} {after:?}"
+        );
+    }
+
+    // Without chosen times: at t = 0 and at the horizon; without the spec: the moving sets
+    // all the same, from the result.
+    let o = reachc(&["plot", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let sets = svg(&dir.join("contraction_sets.svg"));
+    for label in [
+        "obs at t = 0",
+        "obs at t = 4",
+        "home at t = 0",
+        "home at t = 4",
+        "no sample paths or fixed unsafe sets and",
+        "moving sets drawn at t = 0, 4",
+    ] {
+        assert!(sets.contains(label), "{label}");
+    }
+    assert!(!sets.contains(">\nwall\n<"));
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -3,8 +3,8 @@
 use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::interval::Interval;
 use reachc_runtime::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, Transform,
-    TransformSource,
+    Analysis, AnalysisSpec, Bounds, Constants, GoalSet, InitialSet, Method, ModelInfo, Transform,
+    TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_runtime::{report, Reach, System};
 
@@ -253,4 +253,81 @@ fn results_render() {
         s.contains("kappa(n = 1, delta = 0.01)") && s.contains("amgf"),
         "{s}"
     );
+}
+
+/// A moving unsafe set's and a moving goal's positions (method.md 8.15) are written per report
+/// time as `swept`, in the shapes' JSON form of `reachc inspect --json` (an infinite end
+/// `null`); fixed sets have no `swept`. (The positions are filled in by hand: the engine's
+/// sets here are fixed.)
+#[test]
+fn moving_sets_are_written_with_their_positions() {
+    let mut info = model(vec![analysis("ball", Method::Contraction, true)]);
+    let wall = |offset: f64| UnsafeShape::HalfSpace {
+        normal: vec![1.0],
+        offset,
+    };
+    let high = UnsafeShape::Box(vec![(0, Bounds::new(3.0, f64::INFINITY))]);
+    info.unsafe_sets = vec![
+        UnsafeSet {
+            name: "high".into(),
+            shape: high.clone(),
+            moving: vec![],
+        },
+        UnsafeSet {
+            name: "wall".into(),
+            shape: wall(2.0),
+            moving: vec![],
+        },
+    ];
+    let near = |c: f64| vec![UnsafeShape::Box(vec![(0, Bounds::new(c - 0.5, c + 0.5))])];
+    info.goals = vec![GoalSet {
+        name: "near".into(),
+        parts: near(0.0),
+        moving: vec![],
+        window: None,
+        stay: false,
+    }];
+    let mut prs = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
+    let steps = prs.steps.len();
+    assert!(steps > 2);
+    // The wall moves out by 0.25 per report interval, the goal's centre by 0.125.
+    prs.unsafe_sets[1].swept = (0..steps).map(|k| wall(2.0 + 0.25 * k as f64)).collect();
+    prs.goals[0].swept = (0..steps).map(|k| near(0.125 * k as f64)).collect();
+    let v: serde_json::Value = serde_json::from_str(&report::to_json(&prs)).unwrap();
+    let (fixed, moving) = (&v["unsafe_sets"][0], &v["unsafe_sets"][1]);
+    assert_eq!(fixed["name"], "high");
+    assert!(fixed.get("swept").is_none());
+    assert_eq!(moving["name"], "wall");
+    let swept = moving["swept"].as_array().unwrap();
+    assert_eq!(swept.len(), steps);
+    for (k, s) in swept.iter().enumerate() {
+        let offset = 2.0 + 0.25 * k as f64;
+        assert_eq!(
+            *s,
+            serde_json::json!({"kind": "halfspace", "normal": [1.0], "offset": offset})
+        );
+    }
+    let goal = v["goals"][0]["swept"].as_array().unwrap();
+    assert_eq!(goal.len(), steps);
+    for (k, parts) in goal.iter().enumerate() {
+        let c = 0.125 * k as f64;
+        assert_eq!(
+            *parts,
+            serde_json::json!([{"kind": "box", "sides": [{"state": "x", "range": [c - 0.5, c + 0.5]}]}])
+        );
+    }
+    // The same form for an unbounded side as `reachc inspect --json`: `null`.
+    prs.unsafe_sets[0].swept = vec![high; steps];
+    let v: serde_json::Value = serde_json::from_str(&report::to_json(&prs)).unwrap();
+    assert_eq!(
+        v["unsafe_sets"][0]["swept"][steps - 1],
+        serde_json::json!({"kind": "box", "sides": [{"state": "x", "range": [3.0, null]}]})
+    );
+    // Without positions the file is the fixed sets' file, byte for byte.
+    for u in &mut prs.unsafe_sets {
+        u.swept.clear();
+    }
+    prs.goals[0].swept.clear();
+    let fixed = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
+    assert_eq!(report::to_json(&prs), report::to_json(&fixed));
 }

@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use reachc_runtime::interval::Interval;
+use reachc_runtime::report::shape::ShapeJson;
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -216,6 +217,7 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             .map(|row| row.iter().map(|&e| r.sde(e)).collect())
             .collect()
     };
+    let states = names(&model.states);
     let mut unbounded = Vec::new();
     for m in &r.matrices {
         for (i, row) in m.bounds.iter().enumerate() {
@@ -304,7 +306,7 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
         unsafe_sets: model
             .unsafe_sets
             .iter()
-            .map(|u| moving_json(model, &r, shape_json(model, &u.name, &u.shape), &u.moving))
+            .map(|u| moving_json(model, &r, shape_json(&states, &u.name, &u.shape), &u.moving))
             .collect(),
         goals: model
             .goals
@@ -317,7 +319,7 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
                     .map(|(j, p)| {
                         let moving: Vec<Moving> =
                             g.moving.iter().filter(|m| m.part == j).copied().collect();
-                        moving_json(model, &r, shape_json(model, &g.name, p), &moving)
+                        moving_json(model, &r, shape_json(&states, &g.name, p), &moving)
                     })
                     .collect();
                 json!({"name": g.name, "parts": parts,
@@ -339,22 +341,13 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     writeln!(out)
 }
 
-/// An unsafe set, or a part of goal `set`, in the `inspect --json` document.
-fn shape_json(model: &Model, set: &str, shape: &UnsafeShape) -> Value {
-    let name = |i: &usize| model.states[*i].name.clone();
-    match shape {
-        UnsafeShape::Box(sides) => json!({"name": set, "kind": "box",
-            "sides": sides.iter().map(|(i, b)| json!({"state": name(i), "range": [b.lo, b.hi]})).collect::<Vec<_>>()}),
-        UnsafeShape::Ball {
-            states,
-            center,
-            radius,
-        } => json!({"name": set, "kind": "ball",
-            "over": states.iter().map(name).collect::<Vec<_>>(), "center": center, "radius": radius}),
-        UnsafeShape::HalfSpace { normal, offset } => {
-            json!({"name": set, "kind": "halfspace", "normal": normal, "offset": offset})
-        }
-    }
+/// An unsafe set, or a part of goal `set`, in the `inspect --json` document: the shape's one
+/// JSON form ([`ShapeJson`]) with the set's name, in the states named `states`.
+fn shape_json(states: &[String], set: &str, shape: &UnsafeShape) -> Value {
+    // Plain data with string keys: converting cannot fail.
+    let mut v = serde_json::to_value(ShapeJson::of(states, shape)).expect("a shape serialises");
+    v["name"] = json!(set);
+    v
 }
 
 /// `shape` (from [`shape_json`]) with, for a moving set (method.md 8.15), `"moving"`: each

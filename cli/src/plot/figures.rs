@@ -60,7 +60,7 @@ fn err(e: impl std::fmt::Display) -> String {
 }
 
 /// A number for a label: at most 6 decimals, without trailing zeros.
-fn num(v: f64) -> String {
+pub(super) fn num(v: f64) -> String {
     let s = format!("{v:.6}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" {

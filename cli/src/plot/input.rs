@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use reachc_runtime::model::{Bounds, UnsafeShape};
 use serde::Deserialize;
 
 /// The parts of an analysis result the plots use.
@@ -47,6 +48,142 @@ pub struct ResultFile {
     /// A split result's pieces (the PRS is their union; `steps` hold its bounding boxes).
     #[serde(default)]
     pub pieces: Vec<PieceFile>,
+    /// The unsafe sets' verdicts (only their names and where moving ones were are read).
+    #[serde(default)]
+    pub unsafe_sets: Vec<UnsafeEntry>,
+    /// The goals' verdicts (the same).
+    #[serde(default)]
+    pub goals: Vec<GoalEntry>,
+}
+
+/// An unsafe set of a result: its name and, for a moving set (method.md 8.15), per report time
+/// the fixed set that held it over the report interval ending there (empty for a fixed set).
+#[derive(Clone, Debug, Deserialize)]
+pub struct UnsafeEntry {
+    /// Its name.
+    pub name: String,
+    /// Its positions, one per report time.
+    #[serde(default)]
+    pub swept: Vec<ShapeFile>,
+}
+
+/// A goal of a result: its name and, for a moving goal, per report time its parts as they are
+/// then (empty for a fixed goal).
+#[derive(Clone, Debug, Deserialize)]
+pub struct GoalEntry {
+    /// Its name.
+    pub name: String,
+    /// Its parts, one list per report time.
+    #[serde(default)]
+    pub swept: Vec<Vec<ShapeFile>>,
+}
+
+/// A set's shape as result files write it (the form of `reachc inspect --json`: states by
+/// name, an infinite end of a range `null`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ShapeFile {
+    /// A box: the ranges of the states it constrains.
+    Box {
+        /// One range per constrained state.
+        sides: Vec<SideFile>,
+    },
+    /// A ball over some states.
+    Ball {
+        /// Its states, in the order of `center`.
+        over: Vec<String>,
+        /// Its centre.
+        center: Vec<f64>,
+        /// Its radius.
+        radius: f64,
+    },
+    /// `{x : normal . x >= offset}`.
+    #[serde(rename = "halfspace")]
+    HalfSpace {
+        /// One coefficient per state.
+        normal: Vec<f64>,
+        /// The offset.
+        offset: f64,
+    },
+}
+
+/// One side of a box.
+#[derive(Clone, Debug, Deserialize)]
+pub struct SideFile {
+    /// The state's name.
+    pub state: String,
+    /// Its range (`null`: unbounded on that side).
+    pub range: [Option<f64>; 2],
+}
+
+impl ShapeFile {
+    /// The shape with its states as indices into `states`, or why it does not fit them.
+    fn shape(&self, states: &[String]) -> Result<UnsafeShape, String> {
+        let index = |name: &str| {
+            states
+                .iter()
+                .position(|s| s == name)
+                .ok_or_else(|| format!("no state `{name}`"))
+        };
+        Ok(match self {
+            ShapeFile::Box { sides } => UnsafeShape::Box(
+                sides
+                    .iter()
+                    .map(|side| {
+                        let [lo, hi] = side.range;
+                        let range = Bounds::new(
+                            lo.unwrap_or(f64::NEG_INFINITY),
+                            hi.unwrap_or(f64::INFINITY),
+                        );
+                        Ok((index(&side.state)?, range))
+                    })
+                    .collect::<Result<_, String>>()?,
+            ),
+            ShapeFile::Ball {
+                over,
+                center,
+                radius,
+            } => {
+                if over.len() != center.len() {
+                    return Err(format!(
+                        "a ball over {} states with a centre of {}",
+                        over.len(),
+                        center.len()
+                    ));
+                }
+                UnsafeShape::Ball {
+                    states: over.iter().map(|s| index(s)).collect::<Result<_, _>>()?,
+                    center: center.clone(),
+                    radius: *radius,
+                }
+            }
+            ShapeFile::HalfSpace { normal, offset } => {
+                if normal.len() != states.len() {
+                    return Err(format!(
+                        "a half-space normal of {} entries in {} states",
+                        normal.len(),
+                        states.len()
+                    ));
+                }
+                UnsafeShape::HalfSpace {
+                    normal: normal.clone(),
+                    offset: *offset,
+                }
+            }
+        })
+    }
+}
+
+/// A moving unsafe or goal set of a result (method.md 8.15), its shapes in state indices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MovingSet {
+    /// Its name.
+    pub name: String,
+    /// A goal (else an unsafe set).
+    pub goal: bool,
+    /// Per report time its parts (an unsafe set has one): for an unsafe set the fixed set that
+    /// held it over the report interval ending there, for a goal its parts at that time.
+    pub at: Vec<Vec<UnsafeShape>>,
 }
 
 /// One piece of a split, in brief: per report time its PRS's bounding box.
@@ -294,9 +431,11 @@ impl ResultFile {
     }
 
     /// Dimensions, shapes and times agree, every number is finite; and so for the members of
-    /// an intersection and the pieces of a split, on the same report times.
+    /// an intersection and the pieces of a split, on the same report times, and for the
+    /// positions of moving sets.
     fn check(&self) -> Result<(), String> {
         self.check_own()?;
+        self.moving_sets()?;
         for (j, m) in self.also.iter().enumerate() {
             let times = m.steps.len() == self.steps.len()
                 && m.steps.iter().zip(&self.steps).all(|(a, b)| a.t == b.t);
@@ -373,6 +512,53 @@ impl ResultFile {
             return Err("the metric has non-finite entries".into());
         }
         Ok(())
+    }
+
+    /// The moving unsafe sets and goals, in the file's order (unsafe sets first), each with
+    /// one position per report time; or why their positions do not fit the result.
+    pub fn moving_sets(&self) -> Result<Vec<MovingSet>, String> {
+        let unsafe_sets = self
+            .unsafe_sets
+            .iter()
+            .map(|u| (&u.name, false, u.swept.chunks(1).collect::<Vec<_>>()));
+        let goals = self
+            .goals
+            .iter()
+            .map(|g| (&g.name, true, g.swept.iter().map(Vec::as_slice).collect()));
+        let mut moving = Vec::new();
+        for (name, goal, steps) in unsafe_sets.chain(goals) {
+            if steps.is_empty() {
+                continue;
+            }
+            let what = if goal { "goal" } else { "unsafe set" };
+            if steps.len() != self.steps.len() {
+                return Err(format!(
+                    "{what} `{name}`: {} positions for {} report times",
+                    steps.len(),
+                    self.steps.len()
+                ));
+            }
+            let at = steps
+                .iter()
+                .enumerate()
+                .map(|(k, parts)| {
+                    if parts.is_empty() {
+                        return Err(format!("{what} `{name}`: step {k}: no parts"));
+                    }
+                    parts
+                        .iter()
+                        .map(|p| p.shape(&self.states))
+                        .collect::<Result<Vec<_>, _>>()
+                        .map_err(|e| format!("{what} `{name}`: step {k}: {e}"))
+                })
+                .collect::<Result<_, _>>()?;
+            moving.push(MovingSet {
+                name: name.clone(),
+                goal,
+                at,
+            });
+        }
+        Ok(moving)
     }
 
     /// The report times.
@@ -486,5 +672,96 @@ mod tests {
         later["steps"][0]["t"] = json!(1.0);
         let e = check(result(ball, json!([later]))).unwrap_err();
         assert!(e.contains("other states or report times"), "{e}");
+    }
+
+    /// The positions of moving sets are read in state indices (an infinite end written as
+    /// `null`, a goal's parts per report time); a fixed set has none; positions on other
+    /// report times, unknown states and shapes of the wrong dimension are refused, naming the
+    /// set and the step.
+    #[test]
+    fn moving_sets_are_read_and_checked() {
+        let ball = json!({"shape": "p_ball", "center": [1.0, 0.0], "radius": 0.5});
+        let mut r = result(ball, json!([]));
+        r["unsafe_sets"] = json!([
+            {"name": "fixed", "kind": "box"},
+            {"name": "gate", "swept": [{"kind": "box", "sides": [
+                {"state": "y", "range": [0.5, null]}, {"state": "x", "range": [-1.0, 2.0]}]}]},
+        ]);
+        r["goals"] = json!([{"name": "dock", "swept": [[
+            {"kind": "halfspace", "normal": [1.0, -1.0], "offset": 0.25},
+            {"kind": "ball", "over": ["y"], "center": [3.0], "radius": 0.75},
+        ]]}]);
+        let file: ResultFile = serde_json::from_value(r.clone()).unwrap();
+        file.check().unwrap();
+        let moving = file.moving_sets().unwrap();
+        let gate = UnsafeShape::Box(vec![
+            (1, Bounds::new(0.5, f64::INFINITY)),
+            (0, Bounds::new(-1.0, 2.0)),
+        ]);
+        let dock = vec![
+            UnsafeShape::HalfSpace {
+                normal: vec![1.0, -1.0],
+                offset: 0.25,
+            },
+            UnsafeShape::Ball {
+                states: vec![1],
+                center: vec![3.0],
+                radius: 0.75,
+            },
+        ];
+        assert_eq!(
+            moving,
+            [
+                MovingSet {
+                    name: "gate".into(),
+                    goal: false,
+                    at: vec![vec![gate]],
+                },
+                MovingSet {
+                    name: "dock".into(),
+                    goal: true,
+                    at: vec![dock],
+                },
+            ]
+        );
+        let refused = |path: &[&str], value: serde_json::Value, message: &str| {
+            let mut bad = r.clone();
+            let mut at = &mut bad;
+            for key in path {
+                at = match key.parse::<usize>() {
+                    Ok(i) => &mut at[i],
+                    Err(_) => &mut at[*key],
+                };
+            }
+            *at = value;
+            let e = check(bad).unwrap_err();
+            assert!(e.contains(message), "{e}");
+        };
+        let wall = json!({"kind": "halfspace", "normal": [1.0, 0.0], "offset": 0.0});
+        refused(
+            &["unsafe_sets", "1", "swept"],
+            json!([wall, wall]),
+            "unsafe set `gate`: 2 positions for 1 report times",
+        );
+        refused(
+            &["unsafe_sets", "1", "swept", "0", "sides", "0", "state"],
+            json!("z"),
+            "unsafe set `gate`: step 0: no state `z`",
+        );
+        refused(
+            &["goals", "0", "swept", "0", "0", "normal"],
+            json!([1.0]),
+            "goal `dock`: step 0: a half-space normal of 1 entries in 2 states",
+        );
+        refused(
+            &["goals", "0", "swept", "0", "1", "center"],
+            json!([3.0, 1.0]),
+            "goal `dock`: step 0: a ball over 1 states with a centre of 2",
+        );
+        refused(
+            &["goals", "0", "swept", "0"],
+            json!([]),
+            "goal `dock`: step 0: no parts",
+        );
     }
 }

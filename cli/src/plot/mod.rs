@@ -31,7 +31,7 @@ use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::System;
 
 use geometry::{Plane, Point};
-use input::ResultFile;
+use input::{MovingSet, ResultFile};
 use output::Draw;
 use reachc_compiler::ir::Table;
 use regions::Region;
@@ -142,47 +142,57 @@ fn file(dir: &Path, analysis: &str, figure: &str, ext: &str) -> PathBuf {
     dir.join(format!("{analysis}_{figure}.{ext}"))
 }
 
-/// The unsafe sets of `info` in the plane; those that do not constrain it are listed in
-/// `notes`.
+/// The label of a set of the spec: its name, and for a moving set (method.md 8.15, drawn from
+/// the spec where the result does not give its positions) the time of its shape, `t = 0`.
+fn spec_label(name: &str, moving: bool) -> String {
+    if moving {
+        format!("{name} at t = 0")
+    } else {
+        name.to_string()
+    }
+}
+
+/// The unsafe sets of `info` in the plane, except those the result gives the positions of
+/// (`from_result`, drawn by [`scene::moving_regions`]); those that do not constrain it are
+/// listed in `notes`.
 fn unsafe_regions(
     info: &ModelInfo,
     plane: [usize; 2],
+    from_result: &[MovingSet],
     notes: &mut Vec<String>,
 ) -> Vec<(String, Region)> {
     let mut regions = Vec::new();
-    for u in &info.unsafe_sets {
+    let given = |name: &str| from_result.iter().any(|m| !m.goal && m.name == name);
+    for u in info.unsafe_sets.iter().filter(|u| !given(&u.name)) {
         match Region::of(&u.shape, plane) {
-            Some(r) => regions.push((u.name.clone(), r)),
-            None => notes.push(format!(
-                "unsafe set `{}` does not constrain the plotted states: not drawn",
-                u.name
-            )),
+            Some(r) => regions.push((spec_label(&u.name, !u.moving.is_empty()), r)),
+            None => notes.push(scene::not_drawn("unsafe set", &u.name)),
         }
     }
     regions
 }
 
 /// The goal sets of `info` in the plane, each as its parts' projections (those that do not
-/// constrain the plane are left out; a goal none of whose parts does is listed in `notes`).
+/// constrain the plane are left out; a goal none of whose parts does is listed in `notes`),
+/// except those the result gives the positions of (`from_result`).
 fn goal_regions(
     info: &ModelInfo,
     plane: [usize; 2],
+    from_result: &[MovingSet],
     notes: &mut Vec<String>,
 ) -> Vec<(String, Vec<Region>)> {
     let mut goals = Vec::new();
-    for g in &info.goals {
+    let given = |name: &str| from_result.iter().any(|m| m.goal && m.name == name);
+    for g in info.goals.iter().filter(|g| !given(&g.name)) {
         let parts: Vec<Region> = g
             .parts
             .iter()
             .filter_map(|p| Region::of(p, plane))
             .collect();
         if parts.is_empty() {
-            notes.push(format!(
-                "goal `{}` does not constrain the plotted states: not drawn",
-                g.name
-            ));
+            notes.push(scene::not_drawn("goal", &g.name));
         } else {
-            goals.push((g.name.clone(), parts));
+            goals.push((spec_label(&g.name, !g.moving.is_empty()), parts));
         }
     }
     goals
@@ -232,7 +242,7 @@ fn renderings<F: Draw>(
 }
 
 /// Plots a result: `DIR/<analysis>_sets.svg/.png` (the sets at the chosen times, sample paths
-/// and unsafe sets when the model is given), `DIR/<analysis>_radius.svg/.png`, with a Monte
+/// and unsafe sets when the model is given, moving sets where the result says they are), `DIR/<analysis>_radius.svg/.png`, with a Monte
 /// Carlo report's per-state spreads `DIR/<analysis>_widths.svg/.png` (the plotted states'
 /// bounding-box half-widths against the paths') and, when the rates vary in time (local or
 /// empirical), `DIR/<analysis>_rates.svg/.png` (`c_t`). Returns the
@@ -261,17 +271,35 @@ pub fn plot_result(
     let plane = Plane::new(states, &result.constants.metric)
         .ok_or("the result's metric is not positive definite")?;
     let mut notes = Vec::new();
-    let goals = model.map_or_else(Vec::new, |m| goal_regions(m.info, states, &mut notes));
-    let (regions, paths) = match model {
+    let moving = result.moving_sets()?;
+    let mut goals = model.map_or_else(Vec::new, |m| {
+        goal_regions(m.info, states, &moving, &mut notes)
+    });
+    let (mut regions, paths) = match model {
         Some(m) => (
-            unsafe_regions(m.info, states, &mut notes),
+            unsafe_regions(m.info, states, &moving, &mut notes),
             sample(m, &result.times(), Some(&result.initial_center), choice)?,
         ),
         None => {
-            notes.push("no sample paths or unsafe sets: they need the spec (--spec)".into());
+            let sets = match moving.is_empty() {
+                true => "unsafe sets",
+                false => "fixed unsafe sets and goals",
+            };
+            notes.push(format!(
+                "no sample paths or {sets}: they need the spec (--spec)"
+            ));
             (Vec::new(), Vec::new())
         }
     };
+    // Moving sets where they are: at the chosen times, or at the first and last report time.
+    let mut at = match choice.times {
+        Some(_) => picked.clone(),
+        None => vec![0, result.steps.len().saturating_sub(1)],
+    };
+    at.dedup();
+    let drawn = scene::moving_regions(result, &moving, states, &at, &mut notes);
+    regions.extend(drawn.unsafe_sets);
+    goals.extend(drawn.goals);
     let mut sets = scene::sets_scene(result, &plane, &picked, &paths, regions);
     sets.goals = goals;
     if choice.envelope {
@@ -344,11 +372,75 @@ pub fn plot_without_result(
     let picked = select::pick_times(&times, choice.times.as_deref())?;
     let plane = Plane::of_states(states);
     let mut notes = Vec::new();
-    let regions = unsafe_regions(info, states, &mut notes);
+    let regions = unsafe_regions(info, states, &[], &mut notes);
     let paths = sample(model, &times, None, choice)?;
     let mut sets = scene::paths_scene(info, analysis, &plane, (&times, &picked), &paths, regions);
-    sets.goals = goal_regions(info, states, &mut sets.notes);
+    sets.goals = goal_regions(info, states, &[], &mut sets.notes);
     sets.reference = reference(model, states);
     sets.notes.extend(notes);
     rendered(renderings(&sets, figures::SETS_SIZE, dir, &a.name, "sets"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use reachc_runtime::model::{
+        Bounds, GoalSet, InitialSet, Moving, Slot, UnsafeSet, UnsafeShape,
+    };
+
+    /// The spec's sets: fixed ones by name, a moving one the result does not give at its
+    /// shape of `t = 0`, labelled so; those the result gives are left to it.
+    #[test]
+    fn spec_sets_that_move_are_labelled_or_left_to_the_result() {
+        let bar = |lo: f64| UnsafeShape::Box(vec![(0, Bounds::new(lo, lo + 1.0))]);
+        let moves = vec![Moving {
+            part: 0,
+            slot: Slot::Lo(0),
+            number: 0,
+        }];
+        let set = |name: &str, moving: &Vec<Moving>| UnsafeSet {
+            name: name.into(),
+            shape: bar(1.0),
+            moving: moving.clone(),
+        };
+        let info = ModelInfo {
+            name: "m".into(),
+            states: vec!["x".into(), "y".into()],
+            inputs: vec![],
+            noises: vec![],
+            input_box: vec![],
+            initial: InitialSet::from_box(&[Bounds::new(0.0, 0.0); 2]),
+            domain: vec![Bounds::ENTIRE; 2],
+            has_domain: false,
+            affine: false,
+            constant_diffusion: false,
+            unsafe_sets: vec![
+                set("fixed", &vec![]),
+                set("slides", &moves),
+                set("given", &moves),
+            ],
+            goals: vec![GoalSet {
+                name: "dock".into(),
+                parts: vec![bar(3.0)],
+                moving: moves,
+                window: None,
+                stay: false,
+            }],
+            analyses: vec![],
+        };
+        let from_result = [MovingSet {
+            name: "given".into(),
+            goal: false,
+            at: vec![vec![bar(2.0)]],
+        }];
+        let mut notes = Vec::new();
+        let labels: Vec<String> = unsafe_regions(&info, [0, 1], &from_result, &mut notes)
+            .into_iter()
+            .map(|(label, _)| label)
+            .collect();
+        assert_eq!(labels, ["fixed", "slides at t = 0"]);
+        let goals = goal_regions(&info, [0, 1], &from_result, &mut notes);
+        assert_eq!(goals[0].0, "dock at t = 0");
+        assert!(notes.is_empty());
+    }
 }

@@ -98,6 +98,8 @@ impl Region {
                 .iter()
                 .all(|v| v.is_finite())
                 .then_some((x, y)),
+            // (A negative radius: an empty ball, see `polygon_in`.)
+            Region::Disk { radius, .. } if radius < 0.0 => None,
             Region::Disk { center, radius } => Some((
                 (center[0] - radius, center[0] + radius),
                 (center[1] - radius, center[1] + radius),
@@ -126,6 +128,9 @@ impl Region {
                 }
                 vec![[x.0, y.0], [x.1, y.0], [x.1, y.1], [x.0, y.1]]
             }
+            // A goal's ball held inside positions that share no point has a negative radius
+            // (`UnsafeShape::swept`): it holds nothing.
+            Region::Disk { radius, .. } if radius < 0.0 => Vec::new(),
             Region::Disk { center, radius } => {
                 let disk: Vec<Point> = (0..DISK_POINTS)
                     .map(|k| {

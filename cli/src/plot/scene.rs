@@ -3,8 +3,9 @@
 //! the inputs here, drawn by [`super::figures`], so that the geometry can be tested without
 //! pixels.
 
+use super::figures::num;
 use super::geometry::{clip, half_planes, Plane, Point, Projected};
-use super::input::{Guarantee, Method, RateSource, ResultFile, Role, Shape, Step};
+use super::input::{Guarantee, Method, MovingSet, RateSource, ResultFile, Role, Shape, Step};
 use super::regions::Region;
 use super::Quantile;
 use reachc_runtime::model::{Analysis, ModelInfo};
@@ -425,6 +426,78 @@ pub fn sets_scene(
     }
 }
 
+/// The note for a set (`what`: "unsafe set" or "goal") that does not constrain the plotted
+/// states (it projects to the whole plane).
+pub(super) fn not_drawn(what: &str, name: &str) -> String {
+    format!("{what} `{name}` does not constrain the plotted states: not drawn")
+}
+
+/// Moving sets in the plane: unsafe sets as regions, goals as their parts' regions, each
+/// labelled with its name and the time it is drawn at.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MovingRegions {
+    /// Unsafe sets: `(NAME at t = T, region)`.
+    pub unsafe_sets: Vec<(String, Region)>,
+    /// Goals: `(NAME at t = T, the projections of its parts)`.
+    pub goals: Vec<(String, Vec<Region>)>,
+}
+
+/// The `moving` sets of `result` (method.md 8.15) in the plane of states `plane`, each at the
+/// report steps `at`: an unsafe set as the fixed set that held it over the report interval
+/// ending there (its margins' set), a goal as its parts then. A set that does not constrain
+/// the plotted states is listed in `notes` instead, and a note says what is drawn.
+pub fn moving_regions(
+    result: &ResultFile,
+    moving: &[MovingSet],
+    plane: [usize; 2],
+    at: &[usize],
+    notes: &mut Vec<String>,
+) -> MovingRegions {
+    let mut drawn = MovingRegions::default();
+    for set in moving {
+        // A set's shape keeps its kind and states as it moves: it constrains the plane at
+        // every time or at none.
+        let mut constrains = false;
+        for &k in at {
+            let (Some(parts), Some(step)) = (set.at.get(k), result.steps.get(k)) else {
+                continue;
+            };
+            let regions: Vec<Region> = parts.iter().filter_map(|p| Region::of(p, plane)).collect();
+            if regions.is_empty() {
+                continue;
+            }
+            constrains = true;
+            let label = format!("{} at t = {}", set.name, num(step.t));
+            if set.goal {
+                drawn.goals.push((label, regions));
+            } else {
+                // (An unsafe set has one part.)
+                drawn
+                    .unsafe_sets
+                    .extend(regions.into_iter().map(|r| (label.clone(), r)));
+            }
+        }
+        if !constrains {
+            let what = if set.goal { "goal" } else { "unsafe set" };
+            notes.push(not_drawn(what, &set.name));
+        }
+    }
+    if !(drawn.unsafe_sets.is_empty() && drawn.goals.is_empty()) {
+        let times: Vec<String> = at
+            .iter()
+            .filter_map(|&k| result.steps.get(k))
+            .map(|s| num(s.t))
+            .collect();
+        notes.push(format!(
+            "moving sets drawn at t = {}: an unsafe set as the fixed set holding it over the \
+             report interval ending then (its margins are computed against it), a goal as it \
+             is then",
+            times.join(", ")
+        ));
+    }
+    drawn
+}
+
 /// The sets figure of an analysis that has no PRS (its constants could not be bounded): the
 /// sample paths (flat states at the report times `times`) with their states at report steps
 /// `picked`, and the unsafe regions.
@@ -531,6 +604,7 @@ pub fn radius_scene(
 mod tests {
     use super::super::input::{Constants, DetSet, PieceFile, PieceStep};
     use super::*;
+    use reachc_runtime::model::{Bounds, UnsafeShape};
 
     const P: [[f64; 2]; 2] = [[2.0, 0.5], [0.5, 1.0]];
     /// `P^-1`.
@@ -579,6 +653,8 @@ mod tests {
             also,
             role: Role::Own,
             pieces: Vec::new(),
+            unsafe_sets: Vec::new(),
+            goals: Vec::new(),
         }
     }
 
@@ -722,5 +798,91 @@ mod tests {
             "{:?}",
             scene.notes
         );
+    }
+
+    /// Moving sets are drawn at the given report steps where they are then, labelled with the
+    /// time: a box that moved by 2 in x between t = 0 and t = 1 is two rectangles 2 apart, a
+    /// goal's parts move with it; a set over a state off the plane is noted, not drawn.
+    #[test]
+    fn moving_sets_are_drawn_where_they_are_at_each_time() {
+        let mut r = result(Method::Contraction, p_ball(1.0), 0.1, vec![]);
+        r.steps = (0..3)
+            .map(|k| Step {
+                t: 0.5 * f64::from(k),
+                ..r.steps[0].clone()
+            })
+            .collect();
+        let gate = |k: usize| {
+            let x = k as f64;
+            vec![UnsafeShape::Box(vec![
+                (0, Bounds::new(x, x + 1.0)),
+                (1, Bounds::new(0.0, 1.0)),
+            ])]
+        };
+        let dock = |k: usize| {
+            vec![
+                UnsafeShape::HalfSpace {
+                    normal: vec![1.0, 0.0],
+                    offset: 0.5 * k as f64,
+                },
+                UnsafeShape::Box(vec![(1, Bounds::new(-1.0, 1.0))]),
+            ]
+        };
+        let moving = [
+            MovingSet {
+                name: "gate".into(),
+                goal: false,
+                at: (0..3).map(gate).collect(),
+            },
+            MovingSet {
+                name: "far".into(),
+                goal: false,
+                at: (0..3)
+                    .map(|_| vec![UnsafeShape::Box(vec![(2, Bounds::new(0.0, 1.0))])])
+                    .collect(),
+            },
+            MovingSet {
+                name: "dock".into(),
+                goal: true,
+                at: (0..3).map(dock).collect(),
+            },
+        ];
+        let mut notes = Vec::new();
+        let drawn = moving_regions(&r, &moving, [0, 1], &[0, 2], &mut notes);
+        let rect = |x: (f64, f64), y: (f64, f64)| Region::Rect { x, y };
+        assert_eq!(
+            drawn.unsafe_sets,
+            [
+                ("gate at t = 0".to_string(), rect((0.0, 1.0), (0.0, 1.0))),
+                ("gate at t = 1".to_string(), rect((2.0, 3.0), (0.0, 1.0))),
+            ]
+        );
+        let band = rect((f64::NEG_INFINITY, f64::INFINITY), (-1.0, 1.0));
+        let half = |offset: f64| Region::HalfPlane {
+            normal: [1.0, 0.0],
+            offset,
+        };
+        assert_eq!(
+            drawn.goals,
+            [
+                ("dock at t = 0".to_string(), vec![half(0.0), band.clone()]),
+                ("dock at t = 1".to_string(), vec![half(1.0), band]),
+            ]
+        );
+        assert_eq!(
+            notes[0],
+            "unsafe set `far` does not constrain the plotted states: not drawn"
+        );
+        assert!(
+            notes[1].starts_with("moving sets drawn at t = 0, 1: "),
+            "{notes:?}"
+        );
+        // Nothing moves: nothing drawn, nothing said.
+        let mut notes = Vec::new();
+        assert_eq!(
+            moving_regions(&r, &[], [0, 1], &[0, 2], &mut notes),
+            MovingRegions::default()
+        );
+        assert!(notes.is_empty());
     }
 }

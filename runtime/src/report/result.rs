@@ -1,6 +1,7 @@
 //! Renderings of a [`Prs`]: JSON (documented in docs/results.md), CSV and a text summary.
 
 use super::probability::{GoalProbabilityJson, Probabilities, ProbabilityJson};
+use super::shape::ShapeJson;
 use super::{count, csv_field, num, summary_indices, time};
 use reachc_core::model::{AutoFit, Guarantee, Method, Rate, Split, TransformSource};
 use reachc_core::prs::{
@@ -375,6 +376,10 @@ struct UnsafeJson<'a> {
     min_margin_t: f64,
     first_not_safe_t: Option<f64>,
     margin_unit: &'static str,
+    /// A moving set (method.md 8.15): per report time, the fixed set that held it over the
+    /// report interval ending there; absent for a fixed set.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    swept: Vec<ShapeJson<'a>>,
 }
 
 /// One goal's verdict: `reached` with its time and margin, or `why` not.
@@ -394,6 +399,10 @@ struct GoalJson<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     probability: Option<GoalProbabilityJson<'a>>,
     margins: &'a [f64],
+    /// A moving goal (method.md 8.15): per report time, its parts as they are then; absent for a
+    /// fixed goal.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    swept: Vec<Vec<ShapeJson<'a>>>,
 }
 
 /// Why a goal is not shown reached (a goal's `why`, and the limit of its probability).
@@ -439,6 +448,16 @@ impl<'a> GoalJson<'a> {
             why,
             probability: None,
             margins: &g.margins,
+            swept: g
+                .swept
+                .iter()
+                .map(|parts| {
+                    parts
+                        .iter()
+                        .map(|p| ShapeJson::of(&prs.states, p))
+                        .collect()
+                })
+                .collect(),
         }
     }
 }
@@ -610,7 +629,11 @@ impl<'a> Json<'a> {
             initial_center: &prs.initial_center,
             input_center: &prs.input_center,
             steps: (0..prs.steps.len()).map(|k| StepJson::of(prs, k)).collect(),
-            unsafe_sets: prs.unsafe_sets.iter().map(UnsafeJson::of).collect(),
+            unsafe_sets: prs
+                .unsafe_sets
+                .iter()
+                .map(|u| UnsafeJson::of(&prs.states, u))
+                .collect(),
             goals: prs.goals.iter().map(|g| GoalJson::of(prs, g)).collect(),
             verdict: VerdictJson::of(prs),
             safety_probability: None,
@@ -799,7 +822,8 @@ impl<'a> StepJson<'a> {
 }
 
 impl<'a> UnsafeJson<'a> {
-    fn of(u: &'a UnsafeVerdict) -> UnsafeJson<'a> {
+    /// The verdict `u` of a result in the states `states`.
+    fn of(states: &'a [String], u: &'a UnsafeVerdict) -> UnsafeJson<'a> {
         UnsafeJson {
             name: &u.name,
             kind: unsafe_kind(u.kind),
@@ -807,13 +831,17 @@ impl<'a> UnsafeJson<'a> {
             min_margin: u.min_margin,
             min_margin_t: u.min_margin_t,
             first_not_safe_t: u.first_not_safe_t,
-            margin_unit: match u.kind {
-                UnsafeKind::Box => {
-                    "largest per-coordinate gap between the PRS's bounding box and the box"
-                }
-                UnsafeKind::HalfSpace | UnsafeKind::Ball => "Euclidean distance",
-            },
+            margin_unit: margin_unit(u.kind),
+            swept: u.swept.iter().map(|s| ShapeJson::of(states, s)).collect(),
         }
+    }
+}
+
+/// What an unsafe set's margins measure, by its kind.
+fn margin_unit(kind: UnsafeKind) -> &'static str {
+    match kind {
+        UnsafeKind::Box => "largest per-coordinate gap between the PRS's bounding box and the box",
+        UnsafeKind::HalfSpace | UnsafeKind::Ball => "Euclidean distance",
     }
 }
 
@@ -1321,7 +1349,7 @@ pub fn summary(prs: &Prs) -> String {
                     time(u.first_not_safe_t.unwrap_or(f64::NAN))
                 )
             };
-            let unit = UnsafeJson::of(u).margin_unit;
+            let unit = margin_unit(u.kind);
             let _ = writeln!(
                 s,
                 "  unsafe set `{}` ({}): {status}; min margin {} at t = {} ({unit})",
