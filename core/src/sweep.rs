@@ -27,7 +27,7 @@ impl ModelInfo {
 
 /// The moving numbers of `sys`'s sets over the times `t` (enclosures), or nothing for a model
 /// whose sets are all fixed.
-pub fn numbers(sys: &dyn System, info: &ModelInfo, t: Interval) -> Vec<Interval> {
+pub fn numbers<S: System + ?Sized>(sys: &S, info: &ModelInfo, t: Interval) -> Vec<Interval> {
     let mut out = vec![Interval::ZERO; info.set_numbers()];
     if !out.is_empty() {
         sys.set_numbers(t, &mut out);

@@ -133,11 +133,11 @@ fn tail(negative: bool, rng: &mut PathRng) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// Standard normal CDF via erfc (Numerical Recipes' Chebyshev fit, |error| < 1.2e-7).
-    fn phi(x: f64) -> f64 {
+    pub(in crate::simulate) fn phi(x: f64) -> f64 {
         let z = x.abs() / std::f64::consts::SQRT_2;
         let t = 1.0 / (1.0 + 0.5 * z);
         let erfc = t

@@ -10,11 +10,15 @@
 //! no inputs, no unsafe sets or domain, a small model with a non-negative diagonal metric),
 //! with every per-step constant in a register; `additive_x8`, the same eight paths at a time
 //! in AVX-512 lanes where the processor has them; `lanes_x8`, eight paths in lanes for the
-//! other models of at most 4 states, inputs and noise channels (the inputs, normals, drift,
-//! diffusion, update, unsafe sets, domain and the PRS shortcuts in lanes, the rest of the
-//! checks and records in the scalar code); and `step_lanes` for everything else.
-//! All compute the same operations in the same order as [`result_paths`](super::result_paths),
-//! so the paths are the same whichever loop runs them.
+//! other models of at most 4 states, inputs and noise channels and no goal or moving set (the
+//! inputs, normals, drift, diffusion, update, unsafe sets, domain and the PRS shortcuts in
+//! lanes, the rest of the checks and records in the scalar code); and `step_lanes` for
+//! everything else. All compute the same operations in the same order as
+//! [`result_paths`](super::result_paths), so the paths are the same whichever loop runs them.
+//!
+//! Moving unsafe and goal sets (method.md 8.15) are checked in `step_lanes` only: after each
+//! Euler step of a block, against the sets where they are at the step's end, placed once for
+//! all the block's paths ([`SetRegions::place`]).
 //!
 //! For a time-uniform result every loop also checks each path's state after every Euler step
 //! of report interval `k` against the tube over that interval ([`Tube`], the span `k` of the
@@ -30,9 +34,12 @@ use super::inputs::InputSchedule;
 use super::noise::Noise;
 use super::normal::Ziggurat;
 use super::prs::{diag_quad, diag_quad_to_box, lanes, quad_small, Membership, Metric, Tube};
-use super::regions::Region;
+use super::regions::{GoalEvent, SetRegions};
 use super::rng::PathRng;
+use crate::interval::Interval;
 use crate::lanes::X8;
+use crate::model::ModelInfo;
+use crate::sweep;
 use crate::system::System;
 use std::cmp::Ordering;
 use std::ops::Range;
@@ -96,10 +103,14 @@ pub(crate) struct Plan<'a, S: ?Sized> {
     pub(crate) initial: InitialSampler,
     pub(crate) inputs: InputSchedule,
     pub(crate) noise: Noise,
-    pub(crate) unsafe_sets: Vec<Region>,
-    /// The goal sets' events to count (method.md 8.13).
-    pub(crate) goals: Vec<GoalEvent>,
-    pub(crate) domain: Option<Region>,
+    /// The unsafe sets, goal events and domain (a moving set: at `t = 0`, as the model gives
+    /// it).
+    pub(crate) sets: SetRegions,
+    /// The model, if some of its sets move (method.md 8.15): then the paths are checked, after
+    /// each Euler-Maruyama step of a block, against a worker's copy of `sets` with the moving
+    /// ones placed where they are at the step's end ([`SetRegions::place`]). `None`: every set
+    /// is fixed, and `sets` serve at every step.
+    pub(crate) moving: Option<&'a ModelInfo>,
     pub(crate) zig: &'static Ziggurat,
     /// The processor has AVX2, BMI1 and BMI2: the hot loops run in copies compiled for them
     /// (three-operand arithmetic, `mulx`: 11% fewer instructions on the linear example). The
@@ -110,20 +121,6 @@ pub(crate) struct Plan<'a, S: ?Sized> {
     /// vector lanes ([`super::avx512`]), which draw the same numbers and do the same IEEE
     /// operations per lane, so the results do not depend on it either.
     pub(crate) avx512: bool,
-}
-
-/// A goal set's event, as the paths are checked against it at every Euler-Maruyama step: in
-/// the goal at a step in the window with no unsafe set entered at a step before (reach), or
-/// in it from a step no later than the window's end to the horizon with no unsafe set entered
-/// at any step (stay).
-#[derive(Clone, Debug)]
-pub(crate) struct GoalEvent {
-    /// The goal is the intersection of these.
-    pub(crate) parts: Vec<Region>,
-    /// The window `[t1, t2]`.
-    pub(crate) window: (f64, f64),
-    /// Reach and stay until the horizon.
-    pub(crate) stay: bool,
 }
 
 /// One path's progress on one goal.
@@ -438,8 +435,8 @@ impl<S: System + ?Sized> Plan<'_, S> {
     ) -> ChunkStats {
         // Lanes are `max(n, 1)` and `max(p, 1)` wide so that chunking by them never panics.
         let (n, p, m) = (dim.get().max(1), self.sys.p().max(1), self.sys.m());
-        let sets = self.unsafe_sets.len();
-        let mut st = ChunkStats::new(self.times.len(), sets, self.goals.len(), dim.get());
+        let sets = self.sets.unsafe_sets.len();
+        let mut st = ChunkStats::new(self.times.len(), sets, self.sets.goals.len(), dim.get());
         let quiet = (0..self.times.len())
             .map(|k| Some(thresholds.metric[k].min(self.membership.inside_below(k)?)))
             .collect();
@@ -455,7 +452,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             x: vec![0.0; LANES * n],
             u: vec![0.0; LANES * p],
             hit: vec![false; LANES * sets.max(1)],
-            goal: vec![GoalPath::START; LANES * self.goals.len()],
+            goal: vec![GoalPath::START; LANES * self.sets.goals.len()],
             paths: [path; LANES],
             f: vec![0.0; n],
             z: vec![0.0; m],
@@ -464,16 +461,34 @@ impl<S: System + ?Sized> Plan<'_, S> {
             quiet,
             init: vec![0.0; self.initial.scratch_len()],
         };
+        // The worker's copy of the regions, for moving sets.
+        let mut placed = self.moving.map(|_| self.sets.clone());
         let mut first = range.start;
         while first < range.end {
             let lanes = (range.end - first).min(LANES as u64) as usize;
-            self.run_lanes(dim, first, lanes, thresholds, &mut l, &mut st);
+            self.run_lanes(dim, first, lanes, thresholds, &mut l, &mut placed, &mut st);
             first += lanes as u64;
         }
         st
     }
 
-    /// Paths `first .. first + lanes` in lockstep; their records go into `st`.
+    /// The regions to check the states against at time `t`: the plan's when every set is
+    /// fixed; else `placed` (a worker's copy of them, see [`Plan::moving`]) with the moving
+    /// sets placed where they are at `t`.
+    fn sets_at<'s>(&'s self, t: f64, placed: &'s mut Option<SetRegions>) -> &'s SetRegions {
+        match (self.moving, placed) {
+            (Some(info), Some(placed)) => {
+                placed.place(info, &sweep::numbers(self.sys, info, Interval::point(t)));
+                placed
+            }
+            _ => &self.sets,
+        }
+    }
+
+    /// Paths `first .. first + lanes` in lockstep; their records go into `st`. `placed` is the
+    /// worker's copy of the regions for moving sets (`None` for fixed ones), placed at every
+    /// step's end, once for all the block's paths.
+    #[allow(clippy::too_many_arguments)] // the block, its scratch and the chunk's records
     fn run_lanes<D: Dim>(
         &self,
         dim: D,
@@ -481,12 +496,14 @@ impl<S: System + ?Sized> Plan<'_, S> {
         lanes: usize,
         thresholds: &Thresholds,
         l: &mut Lanes,
+        placed: &mut Option<SetRegions>,
         st: &mut ChunkStats,
     ) {
-        let (n, nn, sets) = (dim.get(), dim.get().max(1), self.unsafe_sets.len().max(1));
-        let goals = self.goals.len();
+        let (n, nn) = (dim.get(), dim.get().max(1));
+        let (sets, goals) = (self.sets.unsafe_sets.len().max(1), self.sets.goals.len());
         l.hit.fill(false);
         l.goal.fill(GoalPath::START);
+        let at_start = self.sets_at(0.0, placed);
         for (a, path) in l.paths.iter_mut().enumerate().take(lanes) {
             path.rng = PathRng::new(self.seed, first + a as u64);
             path.hold = None;
@@ -501,14 +518,14 @@ impl<S: System + ?Sized> Plan<'_, S> {
             self.check_tube(0, x, path, st);
             let hit = &mut l.hit[a * sets..][..sets];
             let goal = &mut l.goal[a * goals..][..goals];
-            self.check_sets(0.0, x, hit, goal, &mut path.left_domain, st);
+            at_start.check(0.0, x, hit, goal, &mut path.left_domain, st);
         }
-        // The common case, in a loop of its own (`additive_lanes`).
+        // The common case, in a loop of its own (`additive_lanes`): no sets, so none moving.
         let additive = n <= SMALL
             && self.sys.p() == 0
-            && self.unsafe_sets.is_empty()
-            && self.goals.is_empty()
-            && self.domain.is_none()
+            && self.sets.unsafe_sets.is_empty()
+            && self.sets.goals.is_empty()
+            && self.sets.domain.is_none()
             && self.noise.diagonal().is_some()
             && self.metric.nonneg_diagonal().is_some();
         // With a quiet bound at every report step every step runs `additive_lanes`: then
@@ -525,9 +542,14 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 unsafe { self.additive_x8(dim, x, paths, quiet, thresholds, st) };
             }
         }
-        // Other small models: eight paths at a time in `lanes_x8`.
+        // Other small models: eight paths at a time in `lanes_x8` (fixed unsafe sets only).
         #[cfg(target_arch = "x86_64")]
-        if start == 0 && self.avx512 && self.lanes_take(n) && self.goals.is_empty() {
+        if start == 0
+            && self.avx512
+            && self.lanes_take(n)
+            && self.sets.goals.is_empty()
+            && self.moving.is_none()
+        {
             start = lanes / 8 * 8;
             let groups =
                 l.x.chunks_exact_mut(8 * nn)
@@ -579,14 +601,17 @@ impl<S: System + ?Sized> Plan<'_, S> {
                     } else {
                         self.additive::<D, true, false>(dim, &step, &l.ds, x, paths, st);
                     }
-                } else if self.noise.diagonal().is_some() {
-                    self.general::<D, true>(dim, &step, l, st);
                 } else {
-                    self.general::<D, false>(dim, &step, l, st);
+                    let sets = self.sets_at(t_end, placed);
+                    if self.noise.diagonal().is_some() {
+                        self.general::<D, true>(dim, &step, sets, l, st);
+                    } else {
+                        self.general::<D, false>(dim, &step, sets, l, st);
+                    }
                 }
             }
         }
-        if !self.unsafe_sets.is_empty() {
+        if !self.sets.unsafe_sets.is_empty() {
             let entered = l.hit.chunks_exact(sets).take(lanes);
             st.unsafe_any += entered.filter(|h| h.contains(&true)).count() as u64;
         }
@@ -596,7 +621,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             st.left_domain += u64::from(path.left_domain);
             st.diverged += u64::from(!path.alive);
             let clean = !l.hit[a * sets..][..sets].contains(&true);
-            let events = self.goals.iter().zip(&l.goal[a * goals..][..goals]);
+            let events = self.sets.goals.iter().zip(&l.goal[a * goals..][..goals]);
             for (n, (event, p)) in st.goal_reached.iter_mut().zip(events) {
                 *n += u64::from(p.happened(event, clean, path.alive));
             }
@@ -614,19 +639,30 @@ impl<S: System + ?Sized> Plan<'_, S> {
     /// [`result_paths`](super::result_paths) does). `DIAG`: `G` is constant and diagonal.
     ///
     /// Everything a path does in a step happens in one pass over the lanes, with its state and
-    /// stream in registers.
+    /// stream in registers. The states at the step's end are checked against `regions` (from
+    /// [`sets_at`](Self::sets_at)).
     #[inline(always)]
     fn step_lanes<D: Dim, const DIAG: bool>(
         &self,
         dim: D,
         step: &Step<'_>,
+        regions: &SetRegions,
         l: &mut Lanes,
         st: &mut ChunkStats,
     ) {
         let (sys, zig, metric) = (self.sys, self.zig, &self.metric);
-        let (n, p, sets) = (dim.get(), sys.p(), self.unsafe_sets.len());
-        let goals = self.goals.len();
-        let check_sets = sets > 0 || goals > 0 || self.domain.is_some();
+        // With fixed sets only, `regions` are the plan's: read them from the plan, which the
+        // compiler keeps in registers with the rest of it through the pass (under callgrind,
+        // 1.5% fewer instructions per path-step than through the argument: as before moving
+        // sets).
+        let regions = if self.moving.is_none() {
+            &self.sets
+        } else {
+            regions
+        };
+        let (n, p, sets) = (dim.get(), sys.p(), regions.unsafe_sets.len());
+        let goals = regions.goals.len();
+        let check_sets = sets > 0 || goals > 0 || regions.domain.is_some();
         let (t, h) = (step.t, step.span.h);
         // Small models: per-step vectors in local arrays, which the compiler keeps in registers
         // (heap scratch could alias the states, and would be reloaded for every lane).
@@ -676,7 +712,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
             if check_sets {
                 let hit = &mut l.hit[a * sets..][..sets];
                 let goal = &mut l.goal[a * goals..][..goals];
-                self.check_sets(step.t_end, x, hit, goal, &mut path.left_domain, st);
+                regions.check(step.t_end, x, hit, goal, &mut path.left_domain, st);
             }
             self.check_tube(step.k, x, path, st);
             if let Some(rep) = &step.report {
@@ -911,12 +947,12 @@ impl<S: System + ?Sized> Plan<'_, S> {
     }
 
     /// [`step_lanes`](Self::step_lanes) for eight paths (`group`) of a model with at most
-    /// [`SMALL`] states, inputs and channels, through every span: the inputs, the normals, the
-    /// drift and a state-dependent diffusion (by [`System::drift_x8`] and
-    /// [`System::diffusion_x8`]), the update and the unsafe sets and domain in the lanes of
-    /// AVX-512 registers, with the same draws and IEEE operations per lane as `step_lanes`, so
-    /// the same states and hits; each state then goes through the same scalar tube check and
-    /// record as there. `quiet` is [`Lanes::quiet`].
+    /// [`SMALL`] states, inputs and channels and no goal or moving set, through every span: the
+    /// inputs, the normals, the drift and a state-dependent diffusion (by
+    /// [`System::drift_x8`] and [`System::diffusion_x8`]), the update and the unsafe sets and
+    /// domain in the lanes of AVX-512 registers, with the same draws and IEEE operations per
+    /// lane as `step_lanes`, so the same states and hits; each state then goes through the same
+    /// scalar tube check and record as there. `quiet` is [`Lanes::quiet`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
     fn lanes_x8<D: Dim>(
@@ -928,7 +964,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
         st: &mut ChunkStats,
     ) {
         let (n, m, p) = (dim.get(), self.sys.m(), self.sys.p());
-        let check_sets = !self.unsafe_sets.is_empty() || self.domain.is_some();
+        let check_sets = !self.sets.unsafe_sets.is_empty() || self.sets.domain.is_some();
         // The paths' inputs and their hold interval, the same for all eight (see
         // `InputSchedule::update_x8`).
         let (mut u, mut hold) = ([X8::splat(0.0); SMALL], None);
@@ -966,7 +1002,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 );
                 group.set_states(&xs);
                 if check_sets {
-                    self.check_sets_x8(t_end, &xs[..n], live, hit, paths, st);
+                    self.sets.check_x8(t_end, &xs[..n], live, hit, paths, st);
                 }
                 let report = (i + 1 == span.steps).then(|| Report {
                     k,
@@ -1030,59 +1066,22 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
     }
 
-    /// [`check_sets`](Self::check_sets) of the `live` lanes of eight states `x` (lane `l`:
-    /// path `paths[l]`, its hits `hit[l * sets..]` with `sets` at least 1), the regions decided
-    /// in lanes: the same hits and exits as lane by lane.
-    #[inline(always)]
-    fn check_sets_x8(
-        &self,
-        t: f64,
-        x: &[X8],
-        live: u8,
-        hit: &mut [bool],
-        paths: &mut [Path],
-        st: &mut ChunkStats,
-    ) {
-        let sets = self.unsafe_sets.len().max(1);
-        for (j, set) in self.unsafe_sets.iter().enumerate() {
-            let fresh = live & lanes(|l| !hit[l * sets + j]);
-            if fresh == 0 {
-                continue;
-            }
-            let mut new = fresh & set.contains_x8(x);
-            while new != 0 {
-                let l = new.trailing_zeros() as usize;
-                new &= new - 1;
-                hit[l * sets + j] = true;
-                st.unsafe_hits[j] += 1;
-                st.first_hit[j] = st.first_hit[j].min(t);
-            }
-        }
-        if let Some(d) = &self.domain {
-            let mut out = live & lanes(|l| !paths[l].left_domain) & !d.contains_x8(x);
-            while out != 0 {
-                let l = out.trailing_zeros() as usize;
-                out &= out - 1;
-                paths[l].left_domain = true;
-            }
-        }
-    }
-
     /// [`step_lanes`](Self::step_lanes), compiled for the processor's extensions.
     #[inline(never)]
     fn general<D: Dim, const DIAG: bool>(
         &self,
         dim: D,
         step: &Step<'_>,
+        regions: &SetRegions,
         l: &mut Lanes,
         st: &mut ChunkStats,
     ) {
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` says the processor has the extensions.
-            return unsafe { self.general_avx2::<D, DIAG>(dim, step, l, st) };
+            return unsafe { self.general_avx2::<D, DIAG>(dim, step, regions, l, st) };
         }
-        self.step_lanes::<D, DIAG>(dim, step, l, st);
+        self.step_lanes::<D, DIAG>(dim, step, regions, l, st);
     }
 
     /// [`step_lanes`](Self::step_lanes) with AVX2 and BMI2 instructions.
@@ -1092,10 +1091,11 @@ impl<S: System + ?Sized> Plan<'_, S> {
         &self,
         dim: D,
         step: &Step<'_>,
+        regions: &SetRegions,
         l: &mut Lanes,
         st: &mut ChunkStats,
     ) {
-        self.step_lanes::<D, DIAG>(dim, step, l, st);
+        self.step_lanes::<D, DIAG>(dim, step, regions, l, st);
     }
 
     /// [`additive_lanes`](Self::additive_lanes), compiled for the processor's extensions.
@@ -1193,10 +1193,12 @@ impl<S: System + ?Sized> Plan<'_, S> {
         }
         path.alive = finite;
     }
+}
 
+impl SetRegions {
     /// Unsafe-set entries, goal progress and domain exits of a path at time `t`.
     #[inline(always)]
-    fn check_sets(
+    fn check(
         &self,
         t: f64,
         x: &[f64],
@@ -1230,6 +1232,45 @@ impl<S: System + ?Sized> Plan<'_, S> {
         if let Some(d) = &self.domain {
             if !*left_domain && !d.contains(x) {
                 *left_domain = true;
+            }
+        }
+    }
+
+    /// [`check`](Self::check) of the `live` lanes of eight states `x` (lane `l`: path
+    /// `paths[l]`, its hits `hit[l * sets..]` with `sets` at least 1), the regions decided in
+    /// lanes: the same hits and exits as lane by lane.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn check_x8(
+        &self,
+        t: f64,
+        x: &[X8],
+        live: u8,
+        hit: &mut [bool],
+        paths: &mut [Path],
+        st: &mut ChunkStats,
+    ) {
+        let sets = self.unsafe_sets.len().max(1);
+        for (j, set) in self.unsafe_sets.iter().enumerate() {
+            let fresh = live & lanes(|l| !hit[l * sets + j]);
+            if fresh == 0 {
+                continue;
+            }
+            let mut new = fresh & set.contains_x8(x);
+            while new != 0 {
+                let l = new.trailing_zeros() as usize;
+                new &= new - 1;
+                hit[l * sets + j] = true;
+                st.unsafe_hits[j] += 1;
+                st.first_hit[j] = st.first_hit[j].min(t);
+            }
+        }
+        if let Some(d) = &self.domain {
+            let mut out = live & lanes(|l| !paths[l].left_domain) & !d.contains_x8(x);
+            while out != 0 {
+                let l = out.trailing_zeros() as usize;
+                out &= out - 1;
+                paths[l].left_domain = true;
             }
         }
     }
