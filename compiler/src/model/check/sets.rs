@@ -128,33 +128,62 @@ impl Checker<'_> {
         Some(out)
     }
 
-    /// `over`, `center` and `radius` of a ball; `over` defaults to all states.
+    /// `over`, `center` and `radius` of an initial ball (constants); `over` defaults to all
+    /// states.
     fn ball_fields(&mut self, f: &Fields, span: &Span) -> Option<(Vec<usize>, Vec<f64>, f64)> {
+        let constant = |c: &mut Self, e: &Expr| c.constant(e, &[]).map(|v| (v, None));
+        let (states, center, (radius, _)) = self.ball_numbers(f, span, constant)?;
+        Some((states, center.into_iter().map(|(v, _)| v).collect(), radius))
+    }
+
+    /// `over`, `center` and `radius` of a ball, each number read by `number` (its value, and
+    /// its expression when it moves); `over` defaults to all states.
+    #[allow(clippy::type_complexity)] // (states, centre, radius), each number with its motion
+    fn ball_numbers(
+        &mut self,
+        f: &Fields,
+        span: &Span,
+        mut number: impl FnMut(&mut Self, &Expr) -> Option<(f64, Option<ExprId>)>,
+    ) -> Option<(
+        Vec<usize>,
+        Vec<(f64, Option<ExprId>)>,
+        (f64, Option<ExprId>),
+    )> {
         let states = match f.get("over") {
             Some((e, _)) => self.state_list(e)?,
             None => (0..self.states.len()).collect(),
         };
-        let center = self.required(f, "center", span, "ball")?;
-        let center = self.vector(center)?;
-        let radius = self.required(f, "radius", span, "ball")?;
-        let radius_span = radius.span.clone();
-        let radius = self.constant(radius, &[])?;
+        let center_expr = self.required(f, "center", span, "ball")?;
+        let ExprKind::List(items) = &center_expr.kind else {
+            return self.fail(
+                Diagnostic::error(
+                    "expected a list of numbers",
+                    center_expr.span.clone(),
+                    "not a list",
+                )
+                .with_help("write `[a, b, ...]`"),
+            );
+        };
+        let center: Vec<Option<(f64, Option<ExprId>)>> =
+            items.iter().map(|x| number(self, x)).collect();
+        let center = center.into_iter().collect::<Option<Vec<_>>>()?;
+        let radius_expr = self.required(f, "radius", span, "ball")?;
+        let radius = number(self, radius_expr)?;
         if center.len() != states.len() {
-            let (e, _) = &f["center"];
             return self.fail(Diagnostic::error(
                 format!(
                     "the centre has {} entries but the ball is over {} states",
                     center.len(),
                     states.len()
                 ),
-                e.span.clone(),
+                center_expr.span.clone(),
                 "wrong length",
             ));
         }
-        if radius < 0.0 {
+        if radius.0 < 0.0 {
             return self.fail(Diagnostic::error(
-                format!("the radius {radius} is negative"),
-                radius_span,
+                format!("the radius {} is negative", radius.0),
+                radius_expr.span.clone(),
                 "must be >= 0",
             ));
         }
@@ -581,45 +610,8 @@ impl Checker<'_> {
 
     /// `over`, `center` and `radius` of an unsafe or goal ball; `over` defaults to all states.
     fn set_ball(&mut self, f: &Fields, span: &Span) -> Option<(UnsafeShape, MovingNumbers)> {
-        let states = match f.get("over") {
-            Some((e, _)) => self.state_list(e)?,
-            None => (0..self.states.len()).collect(),
-        };
-        let center_expr = self.required(f, "center", span, "ball")?;
-        let radius_expr = self.required(f, "radius", span, "ball")?;
-        let ExprKind::List(items) = &center_expr.kind else {
-            return self.fail(
-                Diagnostic::error(
-                    "expected a list of numbers",
-                    center_expr.span.clone(),
-                    "not a list",
-                )
-                .with_help("write `[a, b, ...]`"),
-            );
-        };
-        let center: Vec<Option<(f64, Option<ExprId>)>> =
-            items.iter().map(|x| self.set_number_of(x)).collect();
-        let radius = self.set_number_of(radius_expr);
-        let (center, (radius, radius_moves)) =
-            (center.into_iter().collect::<Option<Vec<_>>>()?, radius?);
-        if center.len() != states.len() {
-            return self.fail(Diagnostic::error(
-                format!(
-                    "the centre has {} entries but the ball is over {} states",
-                    center.len(),
-                    states.len()
-                ),
-                center_expr.span.clone(),
-                "wrong length",
-            ));
-        }
-        if radius < 0.0 {
-            return self.fail(Diagnostic::error(
-                format!("the radius {radius} is negative"),
-                radius_expr.span.clone(),
-                "must be >= 0",
-            ));
-        }
+        let (states, center, (radius, radius_moves)) =
+            self.ball_numbers(f, span, Self::set_number_of)?;
         let mut moving: MovingNumbers = center
             .iter()
             .enumerate()
