@@ -833,6 +833,12 @@ impl Prs {
         self.states.len()
     }
 
+    /// Where the result held unsafe set `j` still over the report interval ending at step `k`
+    /// (method.md 8.15); `None` for a fixed set, which is its own shape.
+    pub fn swept_unsafe(&self, j: usize, k: usize) -> Option<&crate::model::UnsafeShape> {
+        self.unsafe_sets.get(j).and_then(|v| v.swept.get(k))
+    }
+
     /// The index of the report time `t` (within `1e-9` relative to the horizon, so grid times
     /// such as `0.3` written as literals are found); `None` between report times (the sets are
     /// only computed at report times).

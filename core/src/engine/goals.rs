@@ -26,40 +26,37 @@ fn assess_one(
     numbers: &dyn Fn(Interval) -> Vec<Interval>,
 ) -> GoalVerdict {
     let window = goal.window.unwrap_or(Bounds::new(0.0, prs.horizon));
-    // A moving goal is held still inside all its positions over the times asked about
-    // (method.md 8.15).
-    let inside = |b: Option<Vec<Bounds>>, t: Interval| {
-        b.map_or(f64::NEG_INFINITY, |b| {
-            if goal.moving.is_empty() {
-                margin(&goal.parts, &b)
-            } else {
-                margin(&sweep::goal_parts(goal, &numbers(t), Sweep::Common), &b)
-            }
-        })
-    };
     let at = |k: usize| Interval::point(prs.steps[k].t);
     let over = |k: usize| Interval::new(prs.steps[k.saturating_sub(1)].t, prs.steps[k].t);
+    // A moving goal is held still inside all its positions over the times asked about
+    // (method.md 8.15); its parts at the report times serve both the margins and the report.
+    let parts_over = |t: Interval| sweep::goal_parts(goal, &numbers(t), Sweep::Common);
+    let swept: Vec<Vec<UnsafeShape>> = match goal.moving.is_empty() {
+        true => Vec::new(),
+        false => (0..prs.steps.len()).map(|k| parts_over(at(k))).collect(),
+    };
+    let parts_at = |k: usize| swept.get(k).map_or(&goal.parts[..], |p| &p[..]);
+    let inside = |b: Option<Vec<Bounds>>, parts: &[UnsafeShape]| {
+        b.map_or(f64::NEG_INFINITY, |b| margin(parts, &b))
+    };
     // Reaching alone (no stay, no unsafe set to avoid on the way) asks about one time: the
     // pointwise radius at that time serves, whatever the guarantee (method.md 8.13).
     let at_one_time = !goal.stay && prs.unsafe_sets.is_empty();
     let margins: Vec<f64> = (0..prs.steps.len())
         .map(|k| match at_one_time {
-            true => inside(prs.pointwise_hull_at(k), at(k)),
-            false => inside(prs.hull_at(k), at(k)),
+            true => inside(prs.pointwise_hull_at(k), parts_at(k)),
+            false => inside(prs.hull_at(k), parts_at(k)),
         })
         .collect();
     let outcome = if prs.guarantee != Guarantee::Uniform && !at_one_time {
         GoalOutcome::NeedsUniform
     } else {
         outcome(goal, prs, window, &margins, |k| {
-            inside(prs.span_hull_at(k), over(k))
+            match goal.moving.is_empty() {
+                true => inside(prs.span_hull_at(k), &goal.parts),
+                false => inside(prs.span_hull_at(k), &parts_over(over(k))),
+            }
         })
-    };
-    let swept = match goal.moving.is_empty() {
-        true => Vec::new(),
-        false => (0..prs.steps.len())
-            .map(|k| sweep::goal_parts(goal, &numbers(at(k)), Sweep::Common))
-            .collect(),
     };
     GoalVerdict {
         name: goal.name.clone(),

@@ -356,8 +356,6 @@ pub(crate) fn deterministic_limit(
         let w: Vec<f64> = diag.iter().map(|d| d.sqrt().hi()).collect();
         checks.push((Check::all(sets, n, &l, &diag).ok()?, w));
     }
-    // A moving set is checked where the result held it still (method.md 8.15).
-    let swept = |j: usize, k: usize| prs.unsafe_sets.get(j).and_then(|v| v.swept.get(k));
     (0..prs.steps.len()).find_map(|k| {
         (0..sets.len()).find_map(|j| {
             let margin = members
@@ -365,7 +363,8 @@ pub(crate) fn deterministic_limit(
                 .zip(&checks)
                 .map(|(m, (c, w))| {
                     let context = Context { w, frame: None };
-                    match swept(j, k) {
+                    // A moving set is checked where the result held it still (8.15).
+                    match prs.swept_unsafe(j, k) {
                         Some(shape) => c[j].moved(shape).margin(&m.steps[k].det, 0.0, &context),
                         None => c[j].margin(&m.steps[k].det, 0.0, &context),
                     }

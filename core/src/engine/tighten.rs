@@ -105,9 +105,6 @@ pub fn tighten(
     let n = prs.n();
     check(constraints, n)?;
     let amounts = amounts(prs, constraints, unsafe_sets)?;
-    // A moving set is inflated where the result held it still over the interval (method.md
-    // 8.15).
-    let swept = |j: usize, k: usize| prs.unsafe_sets.get(j).and_then(|v| v.swept.get(k));
     let steps = prs
         .steps
         .iter()
@@ -124,7 +121,10 @@ pub fn tighten(
                 .iter()
                 .zip(&a.unsafe_sets)
                 .enumerate()
-                .map(|(j, (u, s))| inflated(u, swept(j, k).unwrap_or(&u.shape), s))
+                .map(|(j, (u, s))| {
+                    // A moving set is inflated where the result held it still (8.15).
+                    inflated(u, prs.swept_unsafe(j, k).unwrap_or(&u.shape), s)
+                })
                 .collect(),
         })
         .collect();
@@ -174,27 +174,17 @@ struct Amounts {
 }
 
 impl Amounts {
-    /// Per entry, the larger of the two (for a union's pieces).
-    fn max(mut self, other: &Amounts) -> Amounts {
-        let join = |a: &mut Vec<Vec<f64>>, b: &Vec<Vec<f64>>| {
+    /// Per entry, `f` of the two: `f64::max` for a union's pieces, `f64::min` for the metrics
+    /// of one event.
+    fn join(mut self, other: &Amounts, f: fn(f64, f64) -> f64) -> Amounts {
+        for (a, b) in [
+            (&mut self.constraints, &other.constraints),
+            (&mut self.unsafe_sets, &other.unsafe_sets),
+        ] {
             for (x, y) in a.iter_mut().flatten().zip(b.iter().flatten()) {
-                *x = x.max(*y);
+                *x = f(*x, *y);
             }
-        };
-        join(&mut self.constraints, &other.constraints);
-        join(&mut self.unsafe_sets, &other.unsafe_sets);
-        self
-    }
-
-    /// Per entry, the smaller of the two (for the metrics of one event).
-    fn min(mut self, other: &Amounts) -> Amounts {
-        let join = |a: &mut Vec<Vec<f64>>, b: &Vec<Vec<f64>>| {
-            for (x, y) in a.iter_mut().flatten().zip(b.iter().flatten()) {
-                *x = x.min(*y);
-            }
-        };
-        join(&mut self.constraints, &other.constraints);
-        join(&mut self.unsafe_sets, &other.unsafe_sets);
+        }
         self
     }
 }
@@ -213,7 +203,11 @@ fn amounts(
             .map_or(Ok(Vec::new()), |p| amounts(p, constraints, unsafe_sets))?;
         return pieces.try_fold(first, |acc, p| {
             let next = amounts(p, constraints, unsafe_sets)?;
-            Ok(acc.into_iter().zip(&next).map(|(a, b)| a.max(b)).collect())
+            Ok(acc
+                .into_iter()
+                .zip(&next)
+                .map(|(a, b)| a.join(b, f64::max))
+                .collect())
         });
     }
     if prs.role != Role::Own {
@@ -225,7 +219,11 @@ fn amounts(
         .filter(|m| m.role == Role::Metric)
         .try_fold(own, |acc, m| {
             let next = of_metric(m, constraints, unsafe_sets)?;
-            Ok(acc.into_iter().zip(&next).map(|(a, b)| a.min(b)).collect())
+            Ok(acc
+                .into_iter()
+                .zip(&next)
+                .map(|(a, b)| a.join(b, f64::min))
+                .collect())
         })
 }
 

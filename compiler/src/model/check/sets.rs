@@ -516,15 +516,10 @@ impl Checker<'_> {
         };
         let mut normal = vec![0.0; self.states.len()];
         for v in self.pool.vars_of(g) {
-            match v {
-                // A moving half-space: its offset may depend on time (and tables).
-                Var::Time => continue,
-                Var::State(_) => {}
-                // (An input or a noise channel in the offset: refused below, by name.)
-                _ => continue,
-            }
+            // Only states make the normal. Time (and tables) may move the offset; an input or
+            // a noise channel in the offset is refused below, by name.
             let Var::State(i) = v else {
-                return not_linear(self);
+                continue;
             };
             let d = self.pool.diff(g, v);
             let Some(a) = self.pool.as_value(d) else {
