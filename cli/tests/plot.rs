@@ -443,8 +443,8 @@ fn sample_paths_are_the_monte_carlo_paths() {
     let report = simulate::simulate(&interp, &info, &result, &opts, &mut |_, _| {}).unwrap();
     let paths = simulate::result_paths(&interp, &info, &result, &opts).unwrap();
     assert_eq!(paths.len(), 64);
-    let p = &result.constants.metric;
-    for (k, step) in result.steps.iter().enumerate() {
+    let p = &result.constants().metric;
+    for (k, step) in result.steps().iter().enumerate() {
         let max = paths
             .iter()
             .map(|x| {
@@ -620,7 +620,7 @@ fn moving_sets_are_read_and_drawn_where_they_are() {
     let info = prepared.info.clone();
     let interp = Interpreter::new(loaded.model, &prepared);
     let mut prs = engine::run(&interp, &info, info.analysis("contraction").unwrap()).unwrap();
-    let steps = prs.steps.len();
+    let steps = prs.steps().len();
     assert_eq!(steps, 17);
     // (Multiples of 1/8: the decimals in the file are exact.)
     let obs = |k: usize| {
@@ -637,9 +637,9 @@ fn moving_sets_are_read_and_drawn_where_they_are() {
             (1, Bounds::new(y - 0.5, y + 0.5)),
         ])]
     };
-    assert_eq!(prs.unsafe_sets[1].name, "obs");
-    prs.unsafe_sets[1].swept = (0..steps).map(obs).collect();
-    prs.goals[0].swept = (0..steps).map(home).collect();
+    assert_eq!(prs.unsafe_sets()[1].name, "obs");
+    prs.unsafe_sets_mut()[1].swept = (0..steps).map(obs).collect();
+    prs.goals_mut()[0].swept = (0..steps).map(home).collect();
     let path = dir.join("contraction.json");
     std::fs::write(&path, report::to_json(&prs)).unwrap();
 

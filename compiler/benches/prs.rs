@@ -34,7 +34,7 @@ fn contraction_prs_interpreted(bencher: divan::Bencher) {
     bencher.bench(|| {
         reachc_runtime::engine::run(&interp, &info, analysis)
             .unwrap()
-            .steps
+            .steps()
             .len()
     });
 }
@@ -59,7 +59,7 @@ fn interval_prs(bencher: divan::Bencher, name: &str, inclusion: &str) {
     bencher.bench(|| {
         reachc_runtime::engine::run(&interp, &info, &analysis)
             .unwrap()
-            .steps
+            .steps()
             .len()
     });
 }

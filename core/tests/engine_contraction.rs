@@ -222,11 +222,11 @@ fn pendulum_setup() -> (Pend, ModelInfo, Analysis) {
 
 /// A result and the results it is intersected with.
 fn members(res: &Prs) -> impl Iterator<Item = &Prs> {
-    std::iter::once(res).chain(&res.also)
+    std::iter::once(res).chain(res.also())
 }
 
 fn step_at(res: &Prs, t: f64) -> usize {
-    res.steps
+    res.steps()
         .iter()
         .position(|s| (s.t - t).abs() < 1e-9)
         .unwrap_or_else(|| panic!("no report time {t}"))
@@ -241,14 +241,14 @@ fn linear_psi_matches_closed_form_and_r_uses_kappa() {
     let delta = 1e-3;
     let (sys, inf, an) = linear_setup(delta, 4.0, 0.01);
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.steps.len(), 401);
-    assert_eq!(res.steps.last().unwrap().t, 4.0);
+    assert_eq!(res.steps().len(), 401);
+    assert_eq!(res.steps().last().unwrap().t, 4.0);
     let k = kappa(2, delta, RadiusRule::Amgf);
-    assert_eq!(res.kappa, k);
-    assert_eq!(res.r1, 0.0);
+    assert_eq!(res.kappa(), k);
+    assert_eq!(res.r1(), 0.0);
     let (c, s2) = (-0.4f64, 2.0f64);
     let mut worst = 0.0f64;
-    for st in &res.steps[1..] {
+    for st in &res.steps()[1..] {
         let closed = s2 * (2.0 * c * st.t).exp_m1() / (2.0 * c);
         let rel = (st.psi - closed) / closed;
         worst = worst.max(rel.abs());
@@ -274,11 +274,11 @@ fn linear_psi_matches_closed_form_and_r_uses_kappa() {
         assert_eq!(st.nominal(), [0.0, 0.0]);
         assert!(st.prs_radius >= st.r_t);
     }
-    assert_eq!(res.steps[0].psi, 0.0);
-    assert_eq!(res.steps[0].prs_radius, 0.0);
+    assert_eq!(res.steps()[0].psi, 0.0);
+    assert_eq!(res.steps()[0].prs_radius, 0.0);
     eprintln!("max relative deviation of Psi from the closed form: {worst:e}");
-    assert_eq!(res.verdict, Verdict::NoUnsafeSets);
-    assert!(!res.validation.conditional_on_domain);
+    assert_eq!(res.verdict(), Verdict::NoUnsafeSets);
+    assert!(!res.validation().conditional_on_domain);
 }
 
 #[test]
@@ -286,13 +286,13 @@ fn paper_rules_report_eps() {
     let (sys, inf, mut an) = linear_setup(1e-3, 1.0, 0.1);
     an.spec.radius = RadiusRule::Paper(1.0 / 16.0);
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.radius_rule.rule, RadiusRule::Paper(1.0 / 16.0));
-    assert_eq!(res.radius_rule.eps, Some(1.0 / 16.0));
-    assert_eq!(res.kappa, kappa(2, 1e-3, RadiusRule::Paper(1.0 / 16.0)));
+    assert_eq!(res.radius_rule().rule, RadiusRule::Paper(1.0 / 16.0));
+    assert_eq!(res.radius_rule().eps, Some(1.0 / 16.0));
+    assert_eq!(res.kappa(), kappa(2, 1e-3, RadiusRule::Paper(1.0 / 16.0)));
     an.spec.radius = RadiusRule::PaperOptimal;
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.radius_rule.rule, RadiusRule::PaperOptimal);
-    let eps = res.radius_rule.eps.unwrap();
+    assert_eq!(res.radius_rule().rule, RadiusRule::PaperOptimal);
+    let eps = res.radius_rule().eps.unwrap();
     assert!(eps > 0.0 && eps < 1.0);
 }
 
@@ -304,13 +304,13 @@ fn paper_rules_report_eps() {
 fn input_deterministic_radius() {
     let (sys, inf, an) = input_setup();
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.r1, 0.5);
-    assert_eq!(res.r2, 1.0);
-    assert_eq!(res.constants.rho, 1.0);
-    assert_eq!(res.initial_center, vec![1.0]);
-    assert_eq!(res.input_center, vec![0.0]);
+    assert_eq!(res.r1(), 0.5);
+    assert_eq!(res.r2(), 1.0);
+    assert_eq!(res.constants().rho, 1.0);
+    assert_eq!(res.initial_center(), vec![1.0]);
+    assert_eq!(res.input_center(), vec![0.0]);
     for t in [1.0f64, 2.0] {
-        let st = &res.steps[step_at(&res, t)];
+        let st = &res.steps()[step_at(&res, t)];
         let expect = (-t).exp() * 0.5 + (1.0 - (-t).exp());
         assert!(st.det.radius() >= expect);
         assert!(
@@ -323,7 +323,7 @@ fn input_deterministic_radius() {
         assert!((st.prs_radius - (st.det.radius() + st.r_t)).abs() <= 1e-15);
     }
     // R_0 = r1.
-    assert_eq!(res.steps[0].det.radius(), 0.5);
+    assert_eq!(res.steps()[0].det.radius(), 0.5);
 }
 
 #[test]
@@ -331,7 +331,7 @@ fn membership() {
     let (sys, inf, an) = input_setup();
     let res = engine::run(&sys, &inf, &an).unwrap();
     let k = step_at(&res, 1.0);
-    let st = &res.steps[k];
+    let st = &res.steps()[k];
     let (c, r) = (st.nominal()[0], st.prs_radius);
     assert!(res.contains_at(k, &[c]));
     assert!(res.contains_at(k, &[c + 0.999 * r]));
@@ -343,7 +343,7 @@ fn membership() {
     let (sys, inf, an) = pendulum_setup();
     let res = engine::run(&sys, &inf, &an).unwrap();
     let k = step_at(&res, 2.0);
-    let st = &res.steps[k];
+    let st = &res.steps()[k];
     let d = [1.0, -0.5];
     let norm = (PENDULUM_P[0] * d[0] * d[0]
         + 2.0 * PENDULUM_P[1] * d[0] * d[1]
@@ -391,7 +391,7 @@ fn monte_carlo_probability_level() {
     let (sys, inf, an) = linear_setup(delta, t_end, 0.01);
     let res = engine::run(&sys, &inf, &an).unwrap();
     let k = step_at(&res, t_end);
-    let r_t = res.steps[k].r_t;
+    let r_t = res.steps()[k].r_t;
 
     let paths = 20_000;
     let dt = 0.001;
@@ -451,22 +451,22 @@ fn half_space_safety() {
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();
     // P = I: max of a.x over the ball is |a| R, margin = (100 - 5 R) / 5 = 20 - R.
-    let far = &res.unsafe_sets[0];
+    let far = &res.unsafe_sets()[0];
     assert!(far.safe);
     assert_eq!(far.kind, UnsafeKind::HalfSpace);
-    let last = res.steps.last().unwrap();
+    let last = res.steps().last().unwrap();
     let expect = 20.0 - last.prs_radius;
     assert!(far.min_margin <= expect && expect - far.min_margin < 1e-12);
     assert_eq!(far.min_margin_t, 2.0);
-    for st in &res.steps {
+    for st in res.steps() {
         let e = 20.0 - st.prs_radius;
         assert!(st.margins[0] <= e && e - st.margins[0] < 1e-12);
     }
-    let crossing = &res.unsafe_sets[1];
+    let crossing = &res.unsafe_sets()[1];
     assert!(!crossing.safe);
     assert_eq!(crossing.first_not_safe_t, Some(0.0));
     assert_eq!(
-        res.verdict,
+        res.verdict(),
         Verdict::NotShownSafe {
             t: 0.0,
             step: 0,
@@ -501,17 +501,17 @@ fn safety_against_boxes_and_balls() {
         },
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();
-    for (k, st) in res.steps.iter().enumerate() {
+    for (k, st) in res.steps().iter().enumerate() {
         // The margins are over the report interval ending at t: its span holds the PRS at
         // both ends, [x - r, x + r] now and at the previous report time.
         let span = &st.span;
-        for prev in &res.steps[k.saturating_sub(1)..=k] {
+        for prev in &res.steps()[k.saturating_sub(1)..=k] {
             let (x, r) = (prev.nominal()[0], prev.prs_radius);
             assert!(span.lo[0] - span.radius <= x - r && x + r <= span.hi[0] + span.radius);
         }
         // The intersection with the interval box (method.md 8.7): the larger margin.
         let gaps = members(&res).map(|m| {
-            let span = &m.steps[k].span;
+            let span = &m.steps()[k].span;
             let (lo, hi) = (span.lo[0] - span.radius, span.hi[0] + span.radius);
             (5.0 - hi, (lo + 4.0) - 1.0)
         });
@@ -521,9 +521,12 @@ fn safety_against_boxes_and_balls() {
         assert!(st.margins[0] <= box_gap && box_gap - st.margins[0] < 1e-12);
         assert!(st.margins[1] <= ball_gap && ball_gap - st.margins[1] < 1e-12);
     }
-    assert!(res.unsafe_sets[0].safe && res.unsafe_sets[1].safe);
-    assert!(!res.unsafe_sets[2].safe);
-    assert!(matches!(res.verdict, Verdict::NotShownSafe { set: 2, .. }));
+    assert!(res.unsafe_sets()[0].safe && res.unsafe_sets()[1].safe);
+    assert!(!res.unsafe_sets()[2].safe);
+    assert!(matches!(
+        res.verdict(),
+        Verdict::NotShownSafe { set: 2, .. }
+    ));
 }
 
 #[test]
@@ -583,13 +586,13 @@ fn pendulum_half_space_uses_inverse_metric() {
             by_spread.max(by_box),
         ]
     };
-    for (k, st) in res.steps.iter().enumerate() {
+    for (k, st) in res.steps().iter().enumerate() {
         // At t = 0 the set is the initial box itself (span radius 0), later a P-ball.
         if matches!(st.det, DetSet::Ball { .. }) {
             assert!(st.span.radius >= st.prs_radius);
         }
         // The intersection with the interval box (method.md 8.7): the larger margin.
-        let wants = members(&res).map(|m| want(&m.steps[k].span));
+        let wants = members(&res).map(|m| want(&m.steps()[k].span));
         let e = wants.fold([f64::NEG_INFINITY; 3], |a, b| {
             [0, 1, 2].map(|j| a[j].max(b[j]))
         });
@@ -621,7 +624,7 @@ fn pendulum_half_space_uses_inverse_metric() {
             .fold(f64::INFINITY, f64::min);
         assert!(st.margins[2] <= closest, "{} > {closest}", st.margins[2]);
     }
-    assert_eq!(res.verdict, Verdict::Safe);
+    assert_eq!(res.verdict(), Verdict::Safe);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -632,19 +635,19 @@ fn pendulum_half_space_uses_inverse_metric() {
 fn pendulum_radii_finite_and_decreasing() {
     let (sys, inf, an) = pendulum_setup();
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.steps.len(), 401);
+    assert_eq!(res.steps().len(), 401);
     // r1 = |(pi/10, 0.2)|_P (the vertex maximising d'Pd, both signs agree with P_12 > 0).
     let d = [std::f64::consts::PI / 10.0, 0.2];
     let r1 = (PENDULUM_P[0] * d[0] * d[0]
         + 2.0 * PENDULUM_P[1] * d[0] * d[1]
         + PENDULUM_P[3] * d[1] * d[1])
         .sqrt();
-    assert!(res.r1 >= r1 && res.r1 - r1 < 1e-14);
-    for st in &res.steps {
+    assert!(res.r1() >= r1 && res.r1() - r1 < 1e-14);
+    for st in res.steps() {
         assert!(st.prs_radius.is_finite() && st.r_t.is_finite() && st.psi.is_finite());
         assert!(st.nominal().iter().all(|v| v.is_finite()));
     }
-    for w in res.steps.windows(2) {
+    for w in res.steps().windows(2) {
         // R_t decreases throughout; the PRS radius once the stochastic part has built up.
         assert!(w[1].det.radius() < w[0].det.radius());
         assert!(w[1].r_t >= w[0].r_t);
@@ -652,7 +655,7 @@ fn pendulum_radii_finite_and_decreasing() {
             assert!(w[1].prs_radius < w[0].prs_radius, "t = {}", w[1].t);
         }
     }
-    let last = res.steps.last().unwrap();
+    let last = res.steps().last().unwrap();
     // R_4 = e^-2 r1; r_4 = sqrt(sigma^2 (1 - e^-4) kappa).
     assert!((last.det.radius() - (-2.0f64).exp() * r1).abs() < 1e-12);
     let psi4 = 0.1130f64.powi(2) * (-(-4.0f64).exp_m1());
@@ -662,7 +665,7 @@ fn pendulum_radii_finite_and_decreasing() {
         last.det.radius(),
         last.r_t,
         last.prs_radius,
-        res.kappa
+        res.kappa()
     );
 }
 
@@ -734,19 +737,19 @@ fn euler_uneven_horizon_domain_and_ball() {
         }],
     };
     let res = engine::run(&sys, &inf, &an).unwrap();
-    assert_eq!(res.steps.len(), 12);
-    assert_eq!(res.steps.last().unwrap().t, 1.05);
-    assert_eq!(res.initial_center, vec![1.0, -1.0]);
+    assert_eq!(res.steps().len(), 12);
+    assert_eq!(res.steps().last().unwrap().t, 1.05);
+    assert_eq!(res.initial_center(), vec![1.0, -1.0]);
     // P = I: r1 = 0.5 (the ball's longest semi-axis), not the bounding box's corner
     // |(0.25, 0.5)| = 0.559.
-    assert!(res.r1 >= 0.5 && res.r1 - 0.5 < 1e-14, "{}", res.r1);
-    assert_eq!(res.r1_bound.balls, BallBound::Joint { balls: 1 });
+    assert!(res.r1() >= 0.5 && res.r1() - 0.5 < 1e-14, "{}", res.r1());
+    assert_eq!(res.r1_bound().balls, BallBound::Joint { balls: 1 });
     // Euler: x*_{k+1} = (1 - 0.04) x*_k on full steps.
-    assert!((res.steps[1].nominal()[0] - 0.96).abs() < 1e-15);
-    assert!(res.validation.conditional_on_domain);
+    assert!((res.steps()[1].nominal()[0] - 0.96).abs() < 1e-15);
+    assert!(res.validation().conditional_on_domain);
     // The domain is a condition, not an unproved step: only the Euler nominal is listed.
     assert!(matches!(
-        res.validation.not_validated[..],
+        res.validation().not_validated[..],
         [Unproved::Nominal { .. }]
     ));
 }
@@ -777,13 +780,17 @@ fn empirical_rate_of_a_linear_drift_is_its_rate() {
         empirical.constants.as_mut().unwrap().c = f64::INFINITY;
         let want = engine::run(sys.as_ref(), &inf, &certified).unwrap();
         let got = engine::run(sys.as_ref(), &inf, &empirical).unwrap();
-        assert_eq!(got.rate.rate, Rate::Empirical { paths: 50 });
+        assert_eq!(got.rate().rate, Rate::Empirical { paths: 50 });
         assert_eq!(
-            got.validation.not_validated[0],
+            got.validation().not_validated[0],
             Unproved::EmpiricalRate { paths: 50 }
         );
-        assert!((got.rate.max_c - exact).abs() < 1e-12, "{}", got.rate.max_c);
-        for (a, b) in want.steps.iter().zip(&got.steps) {
+        assert!(
+            (got.rate().max_c - exact).abs() < 1e-12,
+            "{}",
+            got.rate().max_c
+        );
+        for (a, b) in want.steps().iter().zip(got.steps()) {
             assert!((b.c - exact).abs() < 1e-12, "t = {}: c = {}", b.t, b.c);
             let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(1e-12);
             assert!(close(a.r_t, b.r_t), "t = {}: {} vs {}", a.t, a.r_t, b.r_t);
@@ -824,20 +831,17 @@ fn reach_from_a_box_is_the_run_from_that_box() {
     let prs = reach.from_box(&x0).unwrap();
     // The ball's own questions (the interval box it is intersected with is checked in
     // tests/tests/tighter_sets.rs).
-    let prs = Prs {
-        also: Vec::new(),
-        ..prs
-    };
+    let prs = prs.without_members();
     let mut moved = inf.clone();
     moved.initial = InitialSet::from_box(&x0);
     let direct = engine::run(&sys, &moved, &moved.analyses[0]).unwrap();
-    assert_eq!(prs.steps, direct.steps);
-    assert_eq!(prs.r1, direct.r1);
+    assert_eq!(prs.steps(), direct.steps());
+    assert_eq!(prs.r1(), direct.r1());
     // The spec's own initial set gives another (larger) PRS.
-    assert!(reach.run().unwrap().r1 > prs.r1);
+    assert!(reach.run().unwrap().r1() > prs.r1());
     // Report times only, found from a literal time.
     let st = prs.at(0.3).unwrap();
-    assert_eq!(st.t, prs.steps[30].t);
+    assert_eq!(st.t, prs.steps()[30].t);
     assert!(prs.at(0.305).is_none() && prs.contains(&[0.0, 0.0], 0.305).is_none());
     assert_eq!(prs.contains(st.nominal(), 0.3), Some(true));
     // The hull: the P-ball's extent along each axis, r sqrt((P^-1)_ii), rounded outward.
@@ -922,9 +926,9 @@ fn reach_under_an_input_plan() {
     let plan = InputPlan::steps(vec![0.0, 1.0], vec![vec![0.5], vec![-0.5]]).unwrap();
     let prs = reach.from_box_with(&x0, &plan).unwrap();
     let free = reach.from_box(&x0).unwrap();
-    assert_eq!(prs.r2, 0.0);
-    assert_eq!(prs.input_center, [0.5]);
-    for (st, any) in prs.steps.iter().zip(&free.steps) {
+    assert_eq!(prs.r2(), 0.0);
+    assert_eq!(prs.input_center(), [0.5]);
+    for (st, any) in prs.steps().iter().zip(free.steps()) {
         // x' = -x + u from x0 = 1 (RK4 with step 0.1: within 1e-6 of the exact solution).
         let x = if st.t <= 1.0 {
             0.5 + 0.5 * (-st.t).exp()
@@ -962,9 +966,9 @@ fn reach_at_another_delta() {
         .run()
         .unwrap();
     let ratio = (kappa(2, 0.1, RadiusRule::Amgf) / kappa(2, 1e-3, RadiusRule::Amgf)).sqrt();
-    let (a, b) = (&base.steps[10], &wide.steps[10]);
+    let (a, b) = (&base.steps()[10], &wide.steps()[10]);
     assert!((b.r_t / a.r_t - ratio).abs() < 1e-12);
-    assert_eq!(wide.delta, 0.1);
+    assert_eq!(wide.delta(), 0.1);
     assert!(Reach::new(&sys, &inf, "main")
         .unwrap()
         .with_delta(1.0)
@@ -1015,7 +1019,7 @@ fn a_radius_that_overflows_is_an_error_not_an_infinite_set() {
     // A horizon before the overflow: a finite result, r_t = sqrt(Psi kappa) at 0.8.
     let (sys, inf) = growing(400.0, 0.0, 0.8, Guarantee::Pointwise);
     let res = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
-    let last = res.steps.last().unwrap();
+    let last = res.steps().last().unwrap();
     let psi = (800.0f64 * 0.8).exp_m1() / 800.0;
     assert!((last.psi / psi - 1.0).abs() < 1e-9, "{} vs {psi}", last.psi);
     assert!(last.r_t.is_finite());
@@ -1040,16 +1044,16 @@ fn a_nominal_that_blows_up_is_an_error() {
 fn r_pointwise_is_at_most_the_uniform_radius() {
     let (sys, inf) = growing(40.0, 0.0, 10.0, Guarantee::Uniform);
     let res = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
-    let last = res.steps.last().unwrap();
+    let last = res.steps().last().unwrap();
     assert_eq!(last.t, 10.0);
     assert!(last.psi.is_infinite(), "Psi_10 = e^800 / 80 overflows");
     assert!(last.r_t.is_finite() && last.r_t > 1e170, "{}", last.r_t);
     assert_eq!(last.r_pointwise, last.r_t);
     let k = kappa(1, 1e-2, RadiusRule::Amgf);
-    for st in &res.steps[1..] {
+    for st in &res.steps()[1..] {
         assert!(st.r_pointwise <= st.r_t, "t = {}", st.t);
     }
-    let st = &res.steps[step_at(&res, 1.0)];
+    let st = &res.steps()[step_at(&res, 1.0)];
     let closed = ((80.0f64).exp_m1() / 80.0 * k).sqrt();
     assert!(
         (st.r_pointwise / closed - 1.0).abs() < 1e-9,

@@ -153,14 +153,14 @@ fn corners(d: &DetSet) -> (&[f64], &[f64]) {
 
 /// Index of the report step at time `t` (grids of step `h` starting at 0).
 fn at(res: &Prs, t: f64) -> usize {
-    res.steps
+    res.steps()
         .iter()
         .position(|s| (s.t - t).abs() < 1e-9)
         .expect("time on the grid")
 }
 
 fn half_widths(res: &Prs, k: usize) -> Vec<f64> {
-    let (lo, hi) = corners(&res.steps[k].det);
+    let (lo, hi) = corners(&res.steps()[k].det);
     lo.iter().zip(hi).map(|(a, b)| 0.5 * (b - a)).collect()
 }
 
@@ -205,7 +205,7 @@ fn linear_box_matches_exact_reachable_set() {
         for (integrator, tol) in [(Integrator::Rk4, 1e-9), (Integrator::Euler, 1e-2)] {
             let a = analysis(2.0, 0.01, integrator, lin_constants());
             let res = run_with(&Lin, &lin_info(vec![]), &a, inclusion).unwrap();
-            for st in &res.steps {
+            for st in res.steps() {
                 let e = (-st.t).exp();
                 let (xlo, xhi) = (0.5 * e - (1.0 - e), 1.5 * e + (1.0 - e));
                 let (lo, hi) = (corners(&st.det).0[0], corners(&st.det).1[0]);
@@ -235,28 +235,28 @@ fn linear_runs_through_dispatch() {
     let a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
     let info = lin_info(vec![]);
     let res = engine::run(&Lin, &info, &a).unwrap();
-    assert_eq!(res.method, Method::Interval);
-    assert_eq!(res.inclusion, Some(Inclusion::Jacobian));
-    assert_eq!(res.steps.len(), 11);
+    assert_eq!(res.method(), Method::Interval);
+    assert_eq!(res.inclusion(), Some(Inclusion::Jacobian));
+    assert_eq!(res.steps().len(), 11);
     assert!(matches!(
-        res.validation.not_validated[0],
+        res.validation().not_validated[0],
         Unproved::Embedding { .. }
     ));
     assert!(
-        matches!(&res.steps[0].det, DetSet::Box { lo, hi, .. } if lo == &[0.5] && hi == &[1.5])
+        matches!(&res.steps()[0].det, DetSet::Box { lo, hi, .. } if lo == &[0.5] && hi == &[1.5])
     );
     // r_t agrees with the contraction engine's (same Psi_t, kappa).
     let mut c = a.clone();
     c.spec.method = Method::Contraction;
     let rc = engine::run(&Lin, &info, &c).unwrap();
-    for (s, t) in res.steps.iter().zip(&rc.steps) {
+    for (s, t) in res.steps().iter().zip(rc.steps()) {
         assert_eq!(s.r_t, t.r_t);
         assert_eq!(s.psi, t.psi);
     }
-    assert!(rc.inclusion.is_none());
+    assert!(rc.inclusion().is_none());
     // The initial box at t = 0, P-balls after.
-    assert!(matches!(rc.steps[0].det, DetSet::Box { .. }));
-    assert!(matches!(rc.steps[1].det, DetSet::Ball { .. }));
+    assert!(matches!(rc.steps()[0].det, DetSet::Box { .. }));
+    assert!(matches!(rc.steps()[1].det, DetSet::Ball { .. }));
 }
 
 #[test]
@@ -317,23 +317,23 @@ fn linear_safety_and_membership() {
     ];
     let a = analysis(2.0, 0.01, Integrator::Rk4, lin_constants());
     let res = engine::run(&Lin, &lin_info(sets), &a).unwrap();
-    assert!(res.unsafe_sets[0].safe && res.unsafe_sets[1].safe && res.unsafe_sets[2].safe);
-    assert!(!res.unsafe_sets[3].safe);
+    assert!(res.unsafe_sets()[0].safe && res.unsafe_sets()[1].safe && res.unsafe_sets()[2].safe);
+    assert!(!res.unsafe_sets()[3].safe);
     assert_eq!(
-        res.verdict,
+        res.verdict(),
         Verdict::NotShownSafe {
-            t: res.unsafe_sets[3].first_not_safe_t.unwrap(),
+            t: res.unsafe_sets()[3].first_not_safe_t.unwrap(),
             step: res
-                .steps
+                .steps()
                 .iter()
-                .position(|s| Some(s.t) == res.unsafe_sets[3].first_not_safe_t)
+                .position(|s| Some(s.t) == res.unsafe_sets()[3].first_not_safe_t)
                 .unwrap(),
             set: 3
         }
     );
     // Margins by hand at the last step, over its report interval: the span holds the PRS at
     // t, [lo - r, hi + r] (P = 1), and at the times before it; margins are the span's.
-    let st = res.steps.last().unwrap();
+    let st = res.steps().last().unwrap();
     let (lo, hi, r) = (corners(&st.det).0[0], corners(&st.det).1[0], st.r_t);
     let span = &st.span;
     assert!(span.lo[0] <= lo && hi <= span.hi[0] && r <= span.radius);
@@ -345,7 +345,7 @@ fn linear_safety_and_membership() {
         assert!(*m <= want && *m >= want - 1e-12, "{m} vs {want}");
     }
     // Membership: the box and its r_t-neighbourhood in, beyond it out.
-    let k = res.steps.len() - 1;
+    let k = res.steps().len() - 1;
     assert!(res.contains_at(k, &[0.5 * (lo + hi)]));
     assert!(res.contains_at(k, &[hi + 0.99 * r]));
     assert!(!res.contains_at(k, &[hi + 1.01 * r]));
@@ -373,9 +373,9 @@ fn pendulum_boxes_contain_sampled_trajectories() {
     let slack = 1e-9;
     for x0 in &starts {
         let mut x = x0.to_vec();
-        for (k, st) in jac.steps.iter().enumerate() {
+        for (k, st) in jac.steps().iter().enumerate() {
             if k > 0 {
-                let h = (st.t - jac.steps[k - 1].t) / sub as f64;
+                let h = (st.t - jac.steps()[k - 1].t) / sub as f64;
                 for _ in 0..sub {
                     rk4_step(&Pend::PAPER, &mut x, h);
                 }
@@ -385,12 +385,12 @@ fn pendulum_boxes_contain_sampled_trajectories() {
                 results.push(n);
             }
             for r in results {
-                let (lo, hi) = corners(&r.steps[k].det);
+                let (lo, hi) = corners(&r.steps()[k].det);
                 for i in 0..2 {
                     assert!(
                         lo[i] - slack <= x[i] && x[i] <= hi[i] + slack,
                         "{:?} t = {}: x = {x:?} not in [{lo:?}, {hi:?}]",
-                        r.inclusion,
+                        r.inclusion(),
                         st.t
                     );
                 }
@@ -409,7 +409,7 @@ fn pendulum_boxes_contain_sampled_trajectories() {
         eprintln!(
             "pendulum t = {t}: half-widths jacobian = {hj:?}, mixed = {:?}, natural = {hn:?}, r_t = {}",
             half_widths(&mixed, k),
-            jac.steps[k].r_t
+            jac.steps()[k].r_t
         );
     }
     // Without a coordinate transform the box embedding of the pendulum is not contracting in x

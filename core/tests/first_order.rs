@@ -55,9 +55,9 @@ fn setup(method: Method) -> (ModelInfo, Analysis) {
 
 /// The zonotope member of a result.
 fn zonotope_member(prs: &Prs) -> &Prs {
-    prs.also
+    prs.also()
         .iter()
-        .find(|m| matches!(m.steps[1].det, DetSet::Zonotope { .. }))
+        .find(|m| matches!(m.steps()[1].det, DetSet::Zonotope { .. }))
         .expect("a first-order member")
 }
 
@@ -99,12 +99,12 @@ fn starts() -> Vec<[f64; 2]> {
 /// start's own `eta`) against the remainder, and the sampled hull against the zonotope's.
 fn check(sys: &Pend, prs: &Prs, times: &[f64]) -> Vec<(f64, f64, [f64; 2], [f64; 2])> {
     let member = zonotope_member(prs);
-    let p = &member.constants.metric;
+    let p = &member.constants().metric;
     times
         .iter()
         .map(|&t| {
             let k = member
-                .steps
+                .steps()
                 .iter()
                 .position(|s| (s.t - t).abs() < 1e-9)
                 .expect("a report time");
@@ -115,7 +115,7 @@ fn check(sys: &Pend, prs: &Prs, times: &[f64]) -> Vec<(f64, f64, [f64; 2], [f64;
                 hull_lo,
                 hull_hi,
                 ..
-            } = &member.steps[k].det
+            } = &member.steps()[k].det
             else {
                 panic!("a zonotope at t = {t}");
             };
@@ -183,7 +183,7 @@ fn linear_first_order_set_is_the_closed_form_image() {
     let prs = engine::run(&sys, &info, &analysis).expect("runs");
     let member = zonotope_member(&prs);
     let (l1, l2) = (-10.0 + 80f64.sqrt(), -10.0 - 80f64.sqrt());
-    for st in member.steps.iter().skip(1) {
+    for st in member.steps().iter().skip(1) {
         let t = st.t;
         let (e1, e2) = ((l1 * t).exp(), (l2 * t).exp());
         // exp(A t) = (e1 (A - l2 I) - e2 (A - l1 I)) / (l1 - l2).

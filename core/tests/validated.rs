@@ -155,14 +155,14 @@ fn model(name: &str, x0: &[(f64, f64)], c: f64) -> ModelInfo {
 /// Whether `x(t)` (exact) lies in the PRS at every report time and in the span of its report
 /// interval at 40 times inside it; the first miss if not.
 fn first_miss(prs: &Prs, exact: &dyn Fn(f64) -> Vec<f64>) -> Option<String> {
-    for (k, st) in prs.steps.iter().enumerate() {
+    for (k, st) in prs.steps().iter().enumerate() {
         if !prs.contains_at(k, &exact(st.t)) {
             return Some(format!("t = {}: not in the set", st.t));
         }
         if k == 0 {
             continue;
         }
-        let t0 = prs.steps[k - 1].t;
+        let t0 = prs.steps()[k - 1].t;
         for j in 1..40 {
             let t = t0 + (st.t - t0) * f64::from(j) / 40.0;
             if !prs.span_contains(k, &exact(t)) {
@@ -183,12 +183,12 @@ fn the_stiff_system_is_enclosed_inside_every_step() {
     let corners = [(0.9, 0.9), (0.9, 1.1), (1.1, 0.9), (1.1, 1.1), (1.0, 1.0)];
     for name in ["contraction_validated", "interval_validated"] {
         let prs = Reach::new(&Stiff, &info, name).unwrap().run().unwrap();
-        assert!(prs.internal_steps >= prs.steps.len() - 1);
+        assert!(prs.internal_steps() >= prs.steps().len() - 1);
         for &(x0, y0) in &corners {
             let exact = |t: f64| stiff_exact(x0, y0, t).to_vec();
             assert_eq!(first_miss(&prs, &exact), None, "{name} from ({x0}, {y0})");
         }
-        assert!(prs.validation.not_validated.is_empty(), "{name}");
+        assert!(prs.validation().not_validated.is_empty(), "{name}");
     }
     // One unvalidated RK4 step per report step of 0.1 (h * 20 = 2): its nominal is far off,
     // and the exact solution leaves the "set" (what reachc printed before validated steps).
@@ -196,7 +196,7 @@ fn the_stiff_system_is_enclosed_inside_every_step() {
         .unwrap()
         .run()
         .unwrap();
-    let nominal = rk4.steps[1].nominal()[0];
+    let nominal = rk4.steps()[1].nominal()[0];
     let exact = stiff_exact(1.0, 1.0, 0.1)[0];
     assert!((nominal - exact).abs() > 0.1, "{nominal} vs {exact}");
     assert!(first_miss(&rk4, &|t| stiff_exact(1.0, 1.0, t).to_vec()).is_some());
@@ -212,8 +212,8 @@ fn a_time_varying_drift_is_enclosed_inside_every_step() {
             assert_eq!(first_miss(&prs, &exact), None, "{name} from {x0}");
         }
         // Not vacuous: at t = 2 the set is about the initial width times e^(-4).
-        let last = prs.steps.last().unwrap();
-        let hull = prs.hull_at(prs.steps.len() - 1).unwrap();
+        let last = prs.steps().last().unwrap();
+        let hull = prs.hull_at(prs.steps().len() - 1).unwrap();
         assert!(
             hull[0].hi - hull[0].lo < 0.05,
             "{name}: {hull:?} at t = {}",

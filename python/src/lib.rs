@@ -802,14 +802,14 @@ fn array2<'py>(
 
 fn verdict_dict<'py>(py: Python<'py>, prs: &Prs) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    match prs.verdict {
+    match prs.verdict() {
         Verdict::Safe => d.set_item("verdict", "safe")?,
         Verdict::NoUnsafeSets => d.set_item("verdict", "no unsafe sets")?,
         Verdict::NotShownSafe { t, step, set } => {
             d.set_item("verdict", "not shown safe")?;
             d.set_item("t", t)?;
             d.set_item("step", step)?;
-            d.set_item("set", &prs.unsafe_sets[set].name)?;
+            d.set_item("set", &prs.unsafe_sets()[set].name)?;
         }
     }
     Ok(d)
@@ -819,33 +819,33 @@ fn verdict_dict<'py>(py: Python<'py>, prs: &Prs) -> PyResult<Bound<'py, PyDict>>
 impl ReachResult {
     #[getter]
     fn model(&self) -> &str {
-        &self.prs.model
+        self.prs.model()
     }
 
     #[getter]
     fn analysis(&self) -> &str {
-        &self.prs.analysis
+        self.prs.analysis()
     }
 
     #[getter]
     fn method(&self) -> &str {
-        self.prs.method.name()
+        self.prs.method().name()
     }
 
     #[getter]
     fn delta(&self) -> f64 {
-        self.prs.delta
+        self.prs.delta()
     }
 
     #[getter]
     fn states(&self) -> Vec<String> {
-        self.prs.states.clone()
+        self.prs.states().to_vec()
     }
 
     /// The report times, shape `(k,)`.
     #[getter]
     fn times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.prs.steps.iter().map(|s| s.t).collect())
+        array1(py, self.prs.steps().iter().map(|s| s.t).collect())
     }
 
     /// The nominal state (the centre of the deterministic set), shape `(k, n)`.
@@ -853,11 +853,11 @@ impl ReachResult {
     fn nominal<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let v = self
             .prs
-            .steps
+            .steps()
             .iter()
             .flat_map(|s| s.nominal().iter().copied())
             .collect();
-        array2(py, self.prs.steps.len(), self.prs.n(), v)
+        array2(py, self.prs.steps().len(), self.prs.n(), v)
     }
 
     /// `(lo, hi)`: a rigorous bounding box of the PRS at each report time, shapes `(k, n)`
@@ -867,7 +867,7 @@ impl ReachResult {
         &self,
         py: Python<'py>,
     ) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>) {
-        let (k, n) = (self.prs.steps.len(), self.prs.n());
+        let (k, n) = (self.prs.steps().len(), self.prs.n());
         let (mut lo, mut hi) = (Vec::with_capacity(k * n), Vec::with_capacity(k * n));
         for i in 0..k {
             match self.prs.hull_at(i) {
@@ -887,51 +887,54 @@ impl ReachResult {
     /// The stochastic radius `r_t` (in the metric's norm), shape `(k,)`.
     #[getter]
     fn r<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.prs.steps.iter().map(|s| s.r_t).collect())
+        array1(py, self.prs.steps().iter().map(|s| s.r_t).collect())
     }
 
     /// The radius of the deterministic set around the nominal state, shape `(k,)`.
     #[getter]
     fn det_radius<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.prs.steps.iter().map(|s| s.det.radius()).collect())
+        array1(
+            py,
+            self.prs.steps().iter().map(|s| s.det.radius()).collect(),
+        )
     }
 
     /// The radius of a metric ball around the nominal state holding the PRS, shape `(k,)`.
     #[getter]
     fn prs_radius<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.prs.steps.iter().map(|s| s.prs_radius).collect())
+        array1(py, self.prs.steps().iter().map(|s| s.prs_radius).collect())
     }
 
     /// The contraction rate on the step ending at each report time, shape `(k,)`.
     #[getter]
     fn rates<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.prs.steps.iter().map(|s| s.c).collect())
+        array1(py, self.prs.steps().iter().map(|s| s.c).collect())
     }
 
     /// The noise level on the step ending at each report time, shape `(k,)`.
     #[getter]
     fn sigmas<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.prs.steps.iter().map(|s| s.sigma).collect())
+        array1(py, self.prs.steps().iter().map(|s| s.sigma).collect())
     }
 
     /// The safety margins, shape `(k, m)` for `m` unsafe sets (`> 0`: shown safe).
     #[getter]
     fn margins<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let m = self.prs.unsafe_sets.len();
+        let m = self.prs.unsafe_sets().len();
         let v = self
             .prs
-            .steps
+            .steps()
             .iter()
             .flat_map(|s| s.margins.iter().copied())
             .collect();
-        array2(py, self.prs.steps.len(), m, v)
+        array2(py, self.prs.steps().len(), m, v)
     }
 
     /// The names of the unsafe sets.
     #[getter]
     fn unsafe_sets(&self) -> Vec<String> {
         self.prs
-            .unsafe_sets
+            .unsafe_sets()
             .iter()
             .map(|u| u.name.clone())
             .collect()
@@ -943,7 +946,7 @@ impl ReachResult {
     #[getter]
     fn goals<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         self.prs
-            .goals
+            .goals()
             .iter()
             .map(|g| {
                 let d = PyDict::new(py);
@@ -962,7 +965,7 @@ impl ReachResult {
                         d.set_item("status", "not_shown")?;
                         d.set_item("why", kind)?;
                         d.set_item("why_t", t)?;
-                        d.set_item("why_set", set.map(|s| &self.prs.unsafe_sets[s].name))?;
+                        d.set_item("why_set", set.map(|s| &self.prs.unsafe_sets()[s].name))?;
                     }
                 }
                 d.set_item("margins", array1(py, g.margins.clone()))?;
@@ -975,7 +978,7 @@ impl ReachResult {
     #[getter]
     fn metric<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let n = self.prs.n();
-        array2(py, n, n, self.prs.constants.metric.clone())
+        array2(py, n, n, self.prs.constants().metric.clone())
     }
 
     /// `{"verdict": "safe" | "no unsafe sets" | "not shown safe", and for the last "t", "step",
@@ -1021,7 +1024,7 @@ impl ReachResult {
             .prs
             .step_index(t)
             .ok_or_else(|| PyIndexError::new_err(format!("{t} is not a report time")))?;
-        let det = &self.prs.steps[k].det;
+        let det = &self.prs.steps()[k].det;
         let d = PyDict::new(py);
         d.set_item("shape", det.shape())?;
         d.set_item("center", array1(py, det.center().to_vec()))?;
@@ -1061,21 +1064,21 @@ impl ReachResult {
     /// first-order zonotopes; each a result of its own (its sets, metric, hulls, membership).
     #[getter]
     fn members(&self) -> Vec<ReachResult> {
-        results(&self.prs.also)
+        results(self.prs.also())
     }
 
     /// A split result's pieces (method.md 8.11; empty without a split): each piece's own
     /// result, from its part of the initial box, at the same delta; the PRS is their union.
     #[getter]
     fn pieces(&self) -> Vec<ReachResult> {
-        results(&self.prs.pieces)
+        results(self.prs.pieces())
     }
 
     /// What this result is within an intersection: `"own"` for an analysis' result,
     /// `"metric"`, `"box"`, `"first_order"` or `"linearised"` for a member.
     #[getter]
     fn role(&self) -> &'static str {
-        self.prs.role.name()
+        self.prs.role().name()
     }
 
     /// The CLI's `ANALYSIS.json`, byte for byte (with its final newline).
@@ -1098,9 +1101,9 @@ impl ReachResult {
     fn __repr__(&self) -> String {
         format!(
             "Result({:?} of {:?}: {} report times)",
-            self.prs.analysis,
-            self.prs.model,
-            self.prs.steps.len()
+            self.prs.analysis(),
+            self.prs.model(),
+            self.prs.steps().len()
         )
     }
 }

@@ -536,7 +536,7 @@ fn run_analyses<S: System + Sync>(
                         report::probability::goal_line(
                             &info.goals,
                             &info.unsafe_sets,
-                            res.horizon,
+                            res.horizon(),
                             p
                         )
                     ),
@@ -560,7 +560,10 @@ fn run_analyses<S: System + Sync>(
         }
         let probability = probability.and_then(Result::ok);
         let goal_probabilities: Vec<_> = goal_probabilities.into_iter().flatten().collect();
-        not_safe |= matches!(res.verdict, reachc_core::prs::Verdict::NotShownSafe { .. });
+        not_safe |= matches!(
+            res.verdict(),
+            reachc_core::prs::Verdict::NotShownSafe { .. }
+        );
         let mut csv = Vec::new();
         // Writing into memory cannot fail.
         let _ = report::write_csv(&res, &mut csv);

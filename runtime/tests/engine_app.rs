@@ -288,11 +288,11 @@ fn moving_sets_are_written_with_their_positions() {
         stay: false,
     }];
     let mut prs = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
-    let steps = prs.steps.len();
+    let steps = prs.steps().len();
     assert!(steps > 2);
     // The wall moves out by 0.25 per report interval, the goal's centre by 0.125.
-    prs.unsafe_sets[1].swept = (0..steps).map(|k| wall(2.0 + 0.25 * k as f64)).collect();
-    prs.goals[0].swept = (0..steps).map(|k| near(0.125 * k as f64)).collect();
+    prs.unsafe_sets_mut()[1].swept = (0..steps).map(|k| wall(2.0 + 0.25 * k as f64)).collect();
+    prs.goals_mut()[0].swept = (0..steps).map(|k| near(0.125 * k as f64)).collect();
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&prs)).unwrap();
     let (fixed, moving) = (&v["unsafe_sets"][0], &v["unsafe_sets"][1]);
     assert_eq!(fixed["name"], "high");
@@ -317,17 +317,17 @@ fn moving_sets_are_written_with_their_positions() {
         );
     }
     // The same form for an unbounded side as `reachc inspect --json`: `null`.
-    prs.unsafe_sets[0].swept = vec![high; steps];
+    prs.unsafe_sets_mut()[0].swept = vec![high; steps];
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&prs)).unwrap();
     assert_eq!(
         v["unsafe_sets"][0]["swept"][steps - 1],
         serde_json::json!({"kind": "box", "sides": [{"state": "x", "range": [3.0, null]}]})
     );
     // Without positions the file is the fixed sets' file, byte for byte.
-    for u in &mut prs.unsafe_sets {
+    for u in prs.unsafe_sets_mut() {
         u.swept.clear();
     }
-    prs.goals[0].swept.clear();
+    prs.goals_mut()[0].swept.clear();
     let fixed = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
     assert_eq!(report::to_json(&prs), report::to_json(&fixed));
 }

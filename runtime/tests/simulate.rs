@@ -317,7 +317,7 @@ fn simulated_paths_are_the_recorded_sample_paths() {
             };
             let rep = simulate(sys, info, &r, &opts);
             let sampled = simulate::result_paths(sys, info, &r, &opts).unwrap();
-            for (k, (st, res)) in rep.steps.iter().zip(&r.steps).enumerate() {
+            for (k, (st, res)) in rep.steps.iter().zip(r.steps()).enumerate() {
                 let x = &sampled[0][k * sys.n..][..sys.n];
                 // The identity metric's distance, summed as the simulation sums it.
                 let q = x
@@ -373,7 +373,7 @@ fn a_too_small_prs_fails_the_coverage_check() {
     );
 
     let mut shrunk = r.clone();
-    for st in &mut shrunk.steps {
+    for st in shrunk.steps_mut() {
         st.prs_radius *= 0.6;
     }
     let rep = simulate(&LINEAR, &good, &shrunk, &opts);
@@ -413,7 +413,7 @@ fn reports_say_what_was_checked() {
     };
     // The tube narrowed between report times: paths leave it.
     let mut narrow = run(&sys, &uniform);
-    for st in &mut narrow.steps[1..] {
+    for st in &mut narrow.steps_mut()[1..] {
         st.span.radius *= 0.5;
     }
     let rep = simulate(&sys, &uniform, &narrow, &opts);

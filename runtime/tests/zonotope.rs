@@ -113,7 +113,7 @@ fn zonotopes() -> Prs {
         .unwrap()
         .run()
         .unwrap();
-    for st in &mut r.steps {
+    for st in r.steps_mut() {
         let (lo, hi) = st.det.box_hull().unwrap();
         let center: Vec<f64> = (0..2).map(|i| 0.5 * (lo[i] + hi[i])).collect();
         let half: Vec<f64> = (0..2).map(|i| 0.5 * (hi[i] - lo[i])).collect();
@@ -137,22 +137,22 @@ fn zonotopes() -> Prs {
         };
     }
     // Its own first-order member (the run's real one) would cut the synthetic sets.
-    r.also.clear();
-    r.role = Role::FirstOrder;
+    r.also_mut().clear();
+    r.set_role(Role::FirstOrder);
     r
 }
 
 /// The contraction run's ball alone (without the interval box it may be cut by).
 fn ball() -> Prs {
     let mut r = Reach::new(&Decay, &model(), "ball").unwrap().run().unwrap();
-    r.also.clear();
+    r.also_mut().clear();
     r
 }
 
 /// [`ball`] cut by [`zonotopes`] as the member of its intersection.
 fn ball_cut_by_zonotopes() -> Prs {
     let mut r = ball();
-    r.also = vec![zonotopes()];
+    *r.also_mut() = vec![zonotopes()];
     r
 }
 
@@ -169,7 +169,7 @@ fn csv(prs: &Prs) -> String {
 fn zonotopes_render() {
     let z = zonotopes();
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&z)).unwrap();
-    let (st, det) = (&z.steps[3], &v["steps"][3]["det_set"]);
+    let (st, det) = (&z.steps()[3], &v["steps"][3]["det_set"]);
     let DetSet::Zonotope {
         center,
         generators,
@@ -261,7 +261,7 @@ fn zonotope_hulls_and_membership() {
         (s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     };
     let (mut inside, mut outside) = (0, 0);
-    for (k, st) in z.steps.iter().enumerate() {
+    for (k, st) in z.steps().iter().enumerate() {
         let DetSet::Zonotope {
             center,
             generators,
@@ -310,6 +310,6 @@ fn zonotope_hulls_and_membership() {
     }
     assert_eq!(
         (inside, outside),
-        (200 * z.steps.len(), 200 * z.steps.len())
+        (200 * z.steps().len(), 200 * z.steps().len())
     );
 }

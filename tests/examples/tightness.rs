@@ -42,7 +42,7 @@ fn main() {
                 let Ok(prs) = Reach::new(&sys, &info, &spec_a.name).and_then(|r| r.run()) else {
                     continue;
                 };
-                let Some(hull) = prs.hull(prs.horizon) else {
+                let Some(hull) = prs.hull(prs.horizon()) else {
                     continue;
                 };
                 let opts = Options {
@@ -51,9 +51,9 @@ fn main() {
                     dt: Some(spec_a.step / 10.0),
                     ..Options::default()
                 };
-                let times = [0.0, prs.horizon];
+                let times = [0.0, prs.horizon()];
                 let Ok(states) =
-                    sample_paths(&sys, &info, &times, Some(&prs.initial_center), &opts)
+                    sample_paths(&sys, &info, &times, Some(prs.initial_center()), &opts)
                 else {
                     continue;
                 };

@@ -34,12 +34,12 @@ pub fn inline(source: &str) -> (Interpreter, ModelInfo) {
 /// of epochs; panics without one.
 pub fn linearised_member(prs: &Prs) -> (&Prs, usize) {
     let m = prs
-        .also
+        .also()
         .iter()
-        .find(|m| m.role == Role::Linearised)
+        .find(|m| m.role() == Role::Linearised)
         .expect("a linearised Gaussian member");
     let epochs = m
-        .validation
+        .validation()
         .rigorous
         .iter()
         .find_map(|p| match p {

@@ -37,11 +37,11 @@ fn the_logistic_flow_lies_in_the_first_order_sets_and_fills_them() {
         let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
         // The interval method keeps the member only where it cuts its box, which in one
         // dimension is already this tight.
-        let first = prs.also.iter().find(|m| m.role == Role::FirstOrder);
+        let first = prs.also().iter().find(|m| m.role() == Role::FirstOrder);
         assert!(first.is_some() || method == "interval", "{method}");
         let mut worst = [0.0f64; 2];
-        for k in 1..prs.steps.len() {
-            let t = prs.steps[k].t;
+        for k in 1..prs.steps().len() {
+            let t = prs.steps()[k].t;
             let (lo, hi) = (logistic(0.6, t), logistic(0.8, t));
             for (what, set) in [("first-order member", first), ("PRS", Some(&prs))] {
                 let Some(set) = set else { continue };
@@ -81,7 +81,7 @@ fn a_linear_time_varying_sde_gets_its_exact_image_and_variance() {
     );
     let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
     let (m, epochs) = linearised_member(&prs);
-    let factor = reflection_factor(2, epochs, m.delta);
+    let factor = reflection_factor(2, epochs, m.delta());
     // State (Phi row-major, Sigma_11, Sigma_12, Sigma_22), RK4 in time.
     let rhs = |t: f64, y: &[f64; 7]| -> [f64; 7] {
         let k = 2.0 + t.sin();
@@ -105,8 +105,8 @@ fn a_linear_time_varying_sde_gets_its_exact_image_and_variance() {
     let h: f64 = 1e-4;
     let (mut y, mut t) = ([1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0], 0.0f64);
     let mut worst = 0.0f64;
-    for k in 1..m.steps.len() {
-        let until = m.steps[k].t;
+    for k in 1..m.steps().len() {
+        let until = m.steps()[k].t;
         while t < until - 1e-12 {
             let h = h.min(until - t);
             let add = |y: &[f64; 7], d: &[f64; 7], c: f64| std::array::from_fn(|i| y[i] + c * d[i]);

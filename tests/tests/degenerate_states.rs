@@ -147,10 +147,10 @@ fn first_escape(sys: &dyn System, info: &ModelInfo, prs: &Prs) -> Option<String>
             if !prs.contains_at(0, &x) {
                 return Some(format!("start {s} {x:?} is outside the PRS at t = 0"));
             }
-            for k in 1..prs.steps.len() {
+            for k in 1..prs.steps().len() {
                 let u = plan(k - 1);
-                let t0 = prs.steps[k - 1].t;
-                let h = (prs.steps[k].t - t0) / SUB as f64;
+                let t0 = prs.steps()[k - 1].t;
+                let h = (prs.steps()[k].t - t0) / SUB as f64;
                 for j in 0..SUB {
                     let t = t0 + j as f64 * h;
                     let k1 = rhs(&x, &u, t);
@@ -168,14 +168,14 @@ fn first_escape(sys: &dyn System, info: &ModelInfo, prs: &Prs) -> Option<String>
                             "start {s}, input plan {p}: {x:?} at t = {} is outside the span \
                              ending at {}",
                             t + h,
-                            prs.steps[k].t
+                            prs.steps()[k].t
                         ));
                     }
                 }
                 if !prs.contains_at(k, &x) {
                     return Some(format!(
                         "start {s}, input plan {p}: {x:?} is outside the PRS at t = {}",
-                        prs.steps[k].t
+                        prs.steps()[k].t
                     ));
                 }
             }
@@ -204,7 +204,7 @@ fn point_starts_noise_free_states_inputs_and_couplings_in_every_combination() {
             let prs = Reach::for_analysis(&sys, &info, analysis)
                 .and_then(|r| r.run())
                 .unwrap_or_else(|e| panic!("{name}: {e}\n{source}"));
-            let last = prs.steps.last().expect("report times");
+            let last = prs.steps().last().expect("report times");
             assert!((last.t - 1.0).abs() < 1e-12, "{name}");
             // Finite, and not vacuous: every coordinate's bound at the horizon is within 0.6
             // of the nominal (the states move by about 0.1 to 0.4 over the horizon).
@@ -224,7 +224,7 @@ fn point_starts_noise_free_states_inputs_and_couplings_in_every_combination() {
             // The metric the objective chose stays within its condition bound (it was about
             // e^60 for `d`).
             let n = sys.n();
-            let cond = condition(&prs.constants.metric, n);
+            let cond = condition(&prs.constants().metric, n);
             assert!(cond <= 1.0001e4, "{name}: cond(P) = {cond:e}");
             if let Some(escape) = first_escape(&sys, &info, &prs) {
                 panic!("{name}: {escape}");
@@ -241,7 +241,7 @@ fn point_starts_noise_free_states_inputs_and_couplings_in_every_combination() {
                 assert!(report.passed(), "{name}: Monte Carlo check failed");
             } else {
                 // Without noise there is no stochastic radius.
-                assert!(prs.steps.iter().all(|s| s.r_t == 0.0), "{name}");
+                assert!(prs.steps().iter().all(|s| s.r_t == 0.0), "{name}");
             }
             if analysis.spec.method == Method::Interval && !v.noise {
                 // `d` does not depend on the others: its box stays a sliver around the exact

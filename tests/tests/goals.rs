@@ -23,9 +23,9 @@ fn margins_and_the_first_time_follow_the_flow() {
          analysis a { method = contraction  delta = 1e-3  horizon = 2  step = 0.01 }",
         "a",
     );
-    let g = &prs.goals[0];
+    let g = &prs.goals()[0];
     assert_eq!((g.window.lo, g.window.hi, g.stay), (0.0, 2.0, false));
-    for (st, &m) in prs.steps.iter().zip(&g.margins) {
+    for (st, &m) in prs.steps().iter().zip(&g.margins) {
         let exact = 0.5 - 1.1 * (-st.t).exp();
         assert!(
             m <= exact && m >= exact - 1e-3,
@@ -122,7 +122,7 @@ fn misses_say_why() {
                  goal gap box { x in [-1, 5] } within [0.501, 0.509]\n";
     let uniform = format!("{model}analysis a {{ horizon = 2.5  step = 0.01  delta = 1e-3 }}");
     let prs = run(&uniform, "a");
-    let outcome = |i: usize| prs.goals[i].outcome.clone();
+    let outcome = |i: usize| prs.goals()[i].outcome.clone();
     let GoalOutcome::NotShown(GoalMiss::Unsafe { t, set: 0 }) = outcome(0) else {
         panic!("{:?}", outcome(0));
     };
@@ -135,7 +135,7 @@ fn misses_say_why() {
     let free = "model push\nstate x = 0\nnoise w\ndrift { x' = 1 }\ndiffusion { x: 0.01 * w }\n\
                 goal pass box { x in [0.2, 0.8] } within [0, 0.9] stay\n\
                 analysis a { horizon = 2.5  step = 0.01  delta = 1e-3 }";
-    let left = run(free, "a").goals[0].outcome.clone();
+    let left = run(free, "a").goals()[0].outcome.clone();
     let GoalOutcome::NotShown(GoalMiss::Leaves { t }) = left else {
         panic!("{left:?}");
     };
@@ -148,7 +148,7 @@ fn misses_say_why() {
     );
     let prs = run(&pointwise, "p");
     assert!(prs
-        .goals
+        .goals()
         .iter()
         .all(|g| g.outcome == GoalOutcome::NeedsUniform));
 }
@@ -214,12 +214,12 @@ fn reaching_alone_uses_the_pointwise_radius() {
         let reach = Reach::new(&sys, &info, analysis).unwrap();
         let prs = reach.run().unwrap();
         assert!(
-            prs.goals[0].reached(),
+            prs.goals()[0].reached(),
             "{analysis}: {:?}",
-            prs.goals[0].outcome
+            prs.goals()[0].outcome
         );
         // Each margin is that of a box holding the pointwise set: inside the uniform one's.
-        for (k, &m) in prs.goals[0].margins.iter().enumerate() {
+        for (k, &m) in prs.goals()[0].margins.iter().enumerate() {
             let uniform = prs.hull_at(k).unwrap()[0].lo - 0.5;
             let pointwise = prs.pointwise_hull_at(k).unwrap()[0].lo - 0.5;
             assert!(
@@ -237,5 +237,5 @@ fn reaching_alone_uses_the_pointwise_radius() {
         );
     }
     let pointwise = run(src, "p");
-    assert_eq!(pointwise.goals[1].outcome, GoalOutcome::NeedsUniform);
+    assert_eq!(pointwise.goals()[1].outcome, GoalOutcome::NeedsUniform);
 }

@@ -29,15 +29,15 @@ fn with_and_without_ball(sys: &Interpreter, info: &ModelInfo, analysis: &str) ->
     let boxed = reach
         .from_box(&info.initial.bounding_box().unwrap())
         .unwrap();
-    let (r1, before) = (ball.r1, boxed.r1);
+    let (r1, before) = (ball.r1(), boxed.r1());
     let (end, end_before) = (
-        ball.steps.last().unwrap().prs_radius,
-        boxed.steps.last().unwrap().prs_radius,
+        ball.steps().last().unwrap().prs_radius,
+        boxed.steps().last().unwrap().prs_radius,
     );
     println!("{analysis}: r1 {before} -> {r1}, PRS radius at the horizon {end_before} -> {end}");
     assert!(r1 < before, "{analysis}: r1 {r1} >= {before}");
     assert!(end <= end_before, "{analysis}: {end} > {end_before}");
-    assert_eq!(ball.r1_bound.balls, BallBound::Joint { balls: 1 });
+    assert_eq!(ball.r1_bound().balls, BallBound::Joint { balls: 1 });
     (ball, boxed)
 }
 
@@ -93,20 +93,20 @@ fn a_ball_alone_gets_the_pencil_radius() {
         &[("state x[1..N] in [-0.1, 0.1]", chain_ball.as_str())],
     );
     let (chain, chain_box) = with_and_without_ball(&sys, &info, "contraction");
-    assert!(chain_box.r1 >= 0.1 * 12f64.sqrt() * (1.0 - 1e-12));
+    assert!(chain_box.r1() >= 0.1 * 12f64.sqrt() * (1.0 - 1e-12));
 
     for (prs, m, r) in [
         (&pendulum, m, 1.0),
         (&msd, DMatrix::identity(2, 2), 0.1),
         (&chain, DMatrix::identity(12, 12), 0.1),
     ] {
-        let exact = pencil_radius(&prs.constants.metric, &m, r);
+        let exact = pencil_radius(&prs.constants().metric, &m, r);
         assert!(
-            prs.r1 >= exact * (1.0 - 1e-12) && prs.r1 <= exact * (1.0 + 1e-9),
+            prs.r1() >= exact * (1.0 - 1e-12) && prs.r1() <= exact * (1.0 + 1e-9),
             "{} {exact}",
-            prs.r1
+            prs.r1()
         );
-        assert_eq!(prs.r1_bound.boxes, R1Method::Vertices { active: 0 });
+        assert_eq!(prs.r1_bound().boxes, R1Method::Vertices { active: 0 });
         assert!(reachc_runtime::report::summary(prs).contains("over the initial ball, exact"));
     }
 }
@@ -130,8 +130,8 @@ fn a_ball_times_a_box_gets_the_joint_maximum() {
         ],
     );
     let (prs, _) = with_and_without_ball(&sys, &info, "contraction");
-    assert_eq!(prs.r1_bound.boxes, R1Method::Vertices { active: 1 });
-    let p = &prs.constants.metric;
+    assert_eq!(prs.r1_bound().boxes, R1Method::Vertices { active: 1 });
+    let p = &prs.constants().metric;
     let mut sampled = 0.0f64;
     let angles = 200_000;
     for dtheta in [-0.1, 0.1] {
@@ -145,8 +145,8 @@ fn a_ball_times_a_box_gets_the_joint_maximum() {
         }
     }
     assert!(
-        sampled <= prs.r1 && prs.r1 <= sampled * (1.0 + 1e-9),
+        sampled <= prs.r1() && prs.r1() <= sampled * (1.0 + 1e-9),
         "r1 {}, sampled {sampled}",
-        prs.r1
+        prs.r1()
     );
 }

@@ -85,7 +85,7 @@ fn first_escape(
     seed: u64,
 ) -> Option<String> {
     let (n, p) = (sys.n(), sys.p());
-    let validated = r.integrator == Integrator::Validated;
+    let validated = r.integrator() == Integrator::Validated;
     // A genuine under-approximation (a wrong inclusion, face or step) misses by far more.
     let tol = |v: f64| if validated { 1e-9 } else { 1e-6 } * (1.0 + v.abs());
     let mut rng = Rng(seed);
@@ -98,9 +98,9 @@ fn first_escape(
         let mut x = initial_state(info, &mut rng);
         let hold = 1 + (rng.next() * 20.0) as usize;
         let mut u = vec![0.0; p];
-        for (k, st) in r.steps.iter().enumerate() {
+        for (k, st) in r.steps().iter().enumerate() {
             if k > 0 {
-                let (t0, h) = (r.steps[k - 1].t, (st.t - r.steps[k - 1].t) / 20.0);
+                let (t0, h) = (r.steps()[k - 1].t, (st.t - r.steps()[k - 1].t) / 20.0);
                 for j in 0..20 {
                     let t = t0 + j as f64 * h;
                     let k1 = rhs(&x, &u, t);
@@ -144,7 +144,7 @@ fn first_escape(
             }
             let (lo, hi) = y_box(&st.det);
             // The box's coordinates: x itself, or y = T x.
-            let y: Vec<f64> = match &r.transform {
+            let y: Vec<f64> = match &r.transform() {
                 None => x.clone(),
                 Some(tr) => tr
                     .matrix
@@ -253,16 +253,16 @@ fn pendulum_in_transformed_coordinates() {
     let a = std::f64::consts::PI / 10.0;
     for inclusion in [Inclusion::Natural, Inclusion::Jacobian, Inclusion::Mixed] {
         let (r, _, _) = pendulum_interval("paper_interval", inclusion);
-        let tr = r.transform.as_ref().unwrap();
+        let tr = r.transform().unwrap();
         assert_eq!(tr.matrix, [1.0, 0.2, 1.0, 0.0]);
         assert!(tr.inverse_error > 0.0 && tr.inverse_error < 1e-14);
-        let first = &r.steps[0].det;
+        let first = &r.steps()[0].det;
         assert!(matches!(first, DetSet::Parallelotope { .. }));
         let (lo, hi) = y_box(first);
         // y1 = theta + 0.2 omega over X0: +-(pi/10 + 0.04), rounded outward.
         assert!(hi[0] >= a + 0.04 && hi[0] <= a + 0.04 + 1e-15 && lo[0] == -hi[0]);
         assert!(hi[1] == a && lo[1] == -a);
-        let last = &r.steps.last().unwrap().det;
+        let last = &r.steps().last().unwrap().det;
         let (llo, lhi) = y_box(last);
         let half: Vec<f64> = (0..2).map(|i| (lhi[i] - llo[i]) / 2.0).collect();
         let name = inclusion.name();
@@ -275,8 +275,8 @@ fn pendulum_in_transformed_coordinates() {
         let mut spec = info.analysis("paper_interval").unwrap().spec.clone();
         spec.inclusion = inclusion;
         let boxes = engine::interval_boxes(&sys, &info, &spec).unwrap();
-        assert_eq!(boxes.len(), r.steps.len());
-        for ((t, lo, hi), st) in boxes.iter().zip(&r.steps) {
+        assert_eq!(boxes.len(), r.steps().len());
+        for ((t, lo, hi), st) in boxes.iter().zip(r.steps()) {
             assert_eq!(*t, st.t);
             assert_eq!((&lo[..], &hi[..]), y_box(&st.det));
         }
@@ -297,14 +297,19 @@ fn pendulum_in_transformed_coordinates() {
 #[test]
 fn transformed_pendulum_prs_covers_monte_carlo_paths() {
     let (r, sys, info) = pendulum_interval("interval", Inclusion::Jacobian);
-    assert_eq!(r.guarantee, reachc_runtime::model::Guarantee::Uniform);
-    assert!(r.validation.not_validated.iter().all(|u| !matches!(
+    assert_eq!(r.guarantee(), reachc_runtime::model::Guarantee::Uniform);
+    assert!(r.validation().not_validated.iter().all(|u| !matches!(
         u,
         reachc_runtime::prs::Unproved::Nominal { .. }
             | reachc_runtime::prs::Unproved::Embedding { .. }
     )));
     let dt: f64 = 0.002;
-    let step_of = |t: f64| r.steps.iter().position(|s| (s.t - t).abs() < 1e-9).unwrap();
+    let step_of = |t: f64| {
+        r.steps()
+            .iter()
+            .position(|s| (s.t - t).abs() < 1e-9)
+            .unwrap()
+    };
     let mut rng = Rng(11);
     let paths = 1000;
     let (mut left_tube, mut outside_at_4) = (0usize, 0usize);
@@ -312,10 +317,10 @@ fn transformed_pendulum_prs_covers_monte_carlo_paths() {
         let mut x = initial_state(&info, &mut rng);
         let mut t = 0.0;
         let mut left = false;
-        for k in 1..r.steps.len() {
+        for k in 1..r.steps().len() {
             // The path steps inside report interval k: each state lies in its span.
-            while t < r.steps[k].t - 1e-12 {
-                let until = (t + dt).min(r.steps[k].t);
+            while t < r.steps()[k].t - 1e-12 {
+                let until = (t + dt).min(r.steps()[k].t);
                 let h = until - t;
                 euler_maruyama(&sys, &mut x, &mut t, until, h, &mut rng);
                 left |= !r.span_contains(k, &x);
@@ -332,7 +337,7 @@ fn transformed_pendulum_prs_covers_monte_carlo_paths() {
     );
     // Not vacuous: a point 2 r_t beyond the parallelotope along theta is outside.
     let k = step_of(4.0);
-    let st = &r.steps[k];
+    let st = &r.steps()[k];
     let far = [st.det.box_hull().unwrap().1[0] + 2.0 * st.r_t, 0.0];
     assert!(!r.contains_at(k, &far));
     assert!(r.contains_at(k, &[0.0, 0.0]));
@@ -340,7 +345,7 @@ fn transformed_pendulum_prs_covers_monte_carlo_paths() {
 
 /// The PRS's bounding-box half-widths at the final report time.
 fn final_half_widths(r: &Prs) -> Vec<f64> {
-    let hull = r.hull_at(r.steps.len() - 1).unwrap();
+    let hull = r.hull_at(r.steps().len() - 1).unwrap();
     hull.iter().map(|b| (b.hi - b.lo) / 2.0).collect()
 }
 
@@ -377,14 +382,14 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
     // `metric = auto` is chosen for the PRS volume (c = -0.86; the rate-optimal metric
     // certifies -0.99 but gives a larger PRS).
     assert!(
-        contraction.constants.c < -0.8,
+        contraction.constants().c < -0.8,
         "c = {}",
-        contraction.constants.c
+        contraction.constants().c
     );
     // The default's own box still wraps; the first-order members (8.8, and 8.10: msd's noise
     // is constant) cut it.
-    let (box_lo, box_hi) = first.steps.last().unwrap().det.box_hull().unwrap();
-    let roles: Vec<Role> = first.also.iter().map(|m| m.role).collect();
+    let (box_lo, box_hi) = first.steps().last().unwrap().det.box_hull().unwrap();
+    let roles: Vec<Role> = first.also().iter().map(|m| m.role()).collect();
     assert_eq!(roles, [Role::FirstOrder, Role::Linearised]);
     for i in 0..2 {
         assert!(
@@ -404,10 +409,10 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
             "state {i}: plain {hp:?} vs contraction {hc:?}"
         );
     }
-    assert!(first.hints.is_empty(), "{:?}", first.hints);
+    assert!(first.hints().is_empty(), "{:?}", first.hints());
     // The hint names the horizon, x and both widths (the wrapping box against a P-ball of the
     // same constants).
-    match plain.hints.as_slice() {
+    match plain.hints() {
         [Hint::Wrapping {
             t,
             state,
@@ -422,29 +427,26 @@ fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
             // Near the contraction analysis' own ball (each analysis' metric is chosen for its
             // own method's PRS, so the two differ a little; that ball is at delta / 2 beside the
             // linearised Gaussian set of method.md 8.10, which makes the PRS itself smaller).
-            let ball = Prs {
-                also: Vec::new(),
-                ..contraction.clone()
-            };
+            let ball = contraction.clone().without_members();
             let hb = final_half_widths(&ball);
             assert!(
                 (ball_half_width - hb[0]).abs() <= 0.1 * hb[0],
                 "{ball_half_width} vs {}",
                 hb[0]
             );
-            assert_eq!(*c, plain.constants.c);
+            assert_eq!(*c, plain.constants().c);
         }
         other => panic!("expected one wrapping hint, got {other:?}"),
     }
-    assert!(auto.hints.is_empty(), "{:?}", auto.hints);
-    assert!(contraction.hints.is_empty());
+    assert!(auto.hints().is_empty(), "{:?}", auto.hints());
+    assert!(contraction.hints().is_empty());
     let summary = reachc_runtime::report::summary(&plain);
     assert!(
         summary.contains("hint: the box grows") && summary.contains("try `transform = auto`"),
         "{summary}"
     );
     // Every output says the transform was chosen automatically.
-    let tr = auto.transform.as_ref().unwrap();
+    let tr = auto.transform().unwrap();
     assert!(matches!(
         tr.source,
         TransformSource::Auto(AutoFit::LogNorm { chosen, identity }) if chosen < -0.98 && identity == 1.0

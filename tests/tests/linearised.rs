@@ -30,12 +30,12 @@ fn a_linear_system_gets_the_exact_image_and_covariance() {
     );
     let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
     let (m, epochs) = linearised_member(&prs);
-    assert_eq!(prs.delta, 1e-3);
-    assert!(m.delta <= 5e-4 && m.delta > 4.99e-4, "{}", m.delta);
-    let factor = reflection_factor(2, epochs, m.delta);
+    assert_eq!(prs.delta(), 1e-3);
+    assert!(m.delta() <= 5e-4 && m.delta() > 4.99e-4, "{}", m.delta());
+    let factor = reflection_factor(2, epochs, m.delta());
     let h = [0.1, 0.1];
     let mut worst = 0.0f64;
-    for (k, st) in m.steps.iter().enumerate().skip(1) {
+    for (k, st) in m.steps().iter().enumerate().skip(1) {
         let t = st.t;
         let (e1, e2) = ((-t).exp(), (-2.0 * t).exp());
         let phi = [
@@ -82,7 +82,7 @@ fn noise_free_flows_lie_in_the_member_and_fill_it() {
         let k = m.step_index(t).unwrap();
         let hull = m.hull_at(k).unwrap();
         let mut spread = [0.0f64; 2];
-        let centre = m.steps[k].det.center().to_vec();
+        let centre = m.steps()[k].det.center().to_vec();
         for &x0 in &starts {
             let (mut x, mut s) = (x0, 0.0);
             rk4(&sys, &mut x, &mut s, t, 1e-4);
@@ -118,16 +118,16 @@ fn the_default_analyses_split_delta_with_the_member() {
     for analysis in ["contraction", "interval"] {
         let prs = Reach::new(&sys, &info, analysis).unwrap().run().unwrap();
         let (m, epochs) = linearised_member(&prs);
-        assert_eq!(prs.delta, 1e-3);
-        assert_eq!(m.delta, (1e-3f64 / 2.0).next_down());
-        assert_eq!(epochs, m.internal_steps);
-        for other in prs.also.iter().filter(|o| o.role != Role::Linearised) {
-            assert_eq!(other.delta, (1e-3f64 / 2.0).next_down());
+        assert_eq!(prs.delta(), 1e-3);
+        assert_eq!(m.delta(), (1e-3f64 / 2.0).next_down());
+        assert_eq!(epochs, m.internal_steps());
+        for other in prs.also().iter().filter(|o| o.role() != Role::Linearised) {
+            assert_eq!(other.delta(), (1e-3f64 / 2.0).next_down());
         }
-        let k = prs.steps.len() - 1;
+        let k = prs.steps().len() - 1;
         let omega = 0.5 * (prs.hull_at(k).unwrap()[1].hi - prs.hull_at(k).unwrap()[1].lo);
         assert!(omega <= 0.1065, "{analysis}: omega {omega}");
-        assert!(m.steps.iter().all(|s| s.r_t == 0.0));
+        assert!(m.steps().iter().all(|s| s.r_t == 0.0));
     }
     let source = std::fs::read_to_string(workspace().join("specs/pendulum.sde")).unwrap();
     let source = source.replace(
@@ -139,8 +139,8 @@ fn the_default_analyses_split_delta_with_the_member() {
         .unwrap()
         .run()
         .unwrap();
-    assert!(prs.also.iter().all(|m| m.role != Role::Linearised));
-    assert_eq!(prs.delta, 1e-3);
+    assert!(prs.also().iter().all(|m| m.role() != Role::Linearised));
+    assert_eq!(prs.delta(), 1e-3);
 }
 
 /// The member's Gaussian box over whole report intervals, against sampled paths: `x' = -20 x +
@@ -160,7 +160,7 @@ fn sampled_paths_stay_in_the_member_between_report_times() {
     );
     let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
     let (m, _) = linearised_member(&prs);
-    assert!(m.delta <= 0.1);
+    assert!(m.delta() <= 0.1);
     let (rate, dt, per) = (20.0f64, 1e-4f64, 500usize);
     let decay = (-rate * dt).exp();
     let sd = ((1.0 - decay * decay) / (2.0 * rate)).sqrt();
@@ -168,9 +168,9 @@ fn sampled_paths_stay_in_the_member_between_report_times() {
     let mut rng = reachc_e2e::Rng(0x05ee_d0f0);
     let (mut left_member, mut left_pointwise) = (0usize, 0usize);
     // In one dimension the member's span and set are intervals (its zonotope's hull is exact).
-    let bounds: Vec<((f64, f64), (f64, f64))> = (1..m.steps.len())
+    let bounds: Vec<((f64, f64), (f64, f64))> = (1..m.steps().len())
         .map(|k| {
-            let span = &m.steps[k].span;
+            let span = &m.steps()[k].span;
             assert_eq!(span.radius, 0.0);
             let set = m.hull_at(k).unwrap()[0];
             ((span.lo[0], span.hi[0]), (set.lo, set.hi))
@@ -196,7 +196,7 @@ fn sampled_paths_stay_in_the_member_between_report_times() {
         left_member as f64 / paths as f64,
         left_pointwise as f64 / paths as f64,
     );
-    assert!(fm <= m.delta, "{fm} of the paths left the member");
+    assert!(fm <= m.delta(), "{fm} of the paths left the member");
     assert!(
         fp > 0.5,
         "only {fp} left the pointwise band: the test cannot tell"
@@ -219,7 +219,7 @@ fn first_order_sets_that_lose_their_shape_say_so() {
     let loose = |source: &str| {
         let (sys, info) = inline(source);
         let prs = Reach::new(&sys, &info, "c").unwrap().run().unwrap();
-        prs.hints.iter().find_map(|h| match *h {
+        prs.hints().iter().find_map(|h| match *h {
             Hint::FirstOrderLoose {
                 t,
                 remainder,
@@ -245,9 +245,9 @@ fn first_order_sets_that_lose_their_shape_say_so() {
         .run()
         .unwrap();
     assert!(
-        prs.hints.contains(&Hint::FirstOrderUnbounded),
+        prs.hints().contains(&Hint::FirstOrderUnbounded),
         "{:?}",
-        prs.hints
+        prs.hints()
     );
 }
 
@@ -265,11 +265,11 @@ fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
         .unwrap()
         .run()
         .unwrap();
-    assert_eq!(prs.role, Role::Linearised);
-    assert!(prs.also.is_empty());
-    assert_eq!(prs.delta, 1e-2);
+    assert_eq!(prs.role(), Role::Linearised);
+    assert!(prs.also().is_empty());
+    assert_eq!(prs.delta(), 1e-2);
     let why = prs
-        .hints
+        .hints()
         .iter()
         .find_map(|h| match h {
             Hint::LinearisedAlone { failed } => Some(failed.to_string()),
@@ -280,15 +280,15 @@ fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
         why.contains("the local rates cannot be certified at t = 2.95"),
         "{why}"
     );
-    assert!(prs.validation.not_validated.is_empty());
+    assert!(prs.validation().not_validated.is_empty());
     assert!(prs
-        .validation
+        .validation()
         .rigorous
         .iter()
         .any(|p| matches!(p, Proved::LinearisedGaussian { .. })));
-    assert!(matches!(prs.verdict, Verdict::Safe));
+    assert!(matches!(prs.verdict(), Verdict::Safe));
     // Noise-free flows from the corners (a sample of 16 of the 128) and the centre.
-    let bounds = prs.initial.bounding_box().unwrap();
+    let bounds = prs.initial().bounding_box().unwrap();
     let mut starts: Vec<Vec<f64>> = (0..16u32)
         .map(|c| {
             (0..7)
@@ -302,7 +302,7 @@ fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
     starts.push(bounds.iter().map(|b| 0.5 * (b.lo + b.hi)).collect());
     for start in starts {
         let (mut x, mut t) = (start, 0.0);
-        for (k, st) in prs.steps.iter().enumerate().skip(1).step_by(8) {
+        for (k, st) in prs.steps().iter().enumerate().skip(1).step_by(8) {
             rk4(&sys, &mut x, &mut t, st.t, 1e-3);
             assert!(prs.contains_at(k, &x), "t = {}: {x:?}", st.t);
         }

@@ -21,10 +21,10 @@ fn mu_p(p: &[f64], j: &[f64]) -> f64 {
 
 fn run(sys: &Interpreter, info: &ModelInfo, analysis: &str) -> Prs {
     let prs = Reach::new(sys, info, analysis).unwrap().run().unwrap();
-    assert_eq!(prs.rate.rate, Rate::Local);
-    assert!(!prs.validation.conditional_on_domain);
-    assert!(prs.validation.not_validated.is_empty());
-    assert_eq!(prs.regions.len(), prs.internal_steps);
+    assert_eq!(prs.rate().rate, Rate::Local);
+    assert!(!prs.validation().conditional_on_domain);
+    assert!(prs.validation().not_validated.is_empty());
+    assert_eq!(prs.regions().len(), prs.internal_steps());
     prs
 }
 
@@ -35,10 +35,10 @@ fn local_rates_bound_the_measure_over_their_regions() {
     let (sys, info) = shipped("vanderpol_feedback.sde");
     for analysis in ["contraction", "interval"] {
         let prs = run(&sys, &info, analysis);
-        let p = &prs.constants.metric;
+        let p = &prs.constants().metric;
         let mut j = [0.0; 4];
         let mut worst_gap = f64::INFINITY;
-        for r in &prs.regions {
+        for r in prs.regions() {
             for a in 0..=20 {
                 for b in 0..=20 {
                     let x = [
@@ -65,7 +65,7 @@ fn sampled_paths_never_leave_the_regions() {
     let (sys, info) = shipped("vanderpol_feedback.sde");
     let prs = run(&sys, &info, "contraction");
     let mut times = vec![0.0];
-    times.extend(prs.regions.iter().map(|r| r.t1));
+    times.extend(prs.regions().iter().map(|r| r.t1));
     let opts = Options {
         paths: 2000,
         seed: 7,
@@ -74,7 +74,7 @@ fn sampled_paths_never_leave_the_regions() {
     let paths = sample_paths(&sys, &info, &times, None, &opts).unwrap();
     let n = 2;
     for path in &paths {
-        for (k, r) in prs.regions.iter().enumerate() {
+        for (k, r) in prs.regions().iter().enumerate() {
             // Both ends of step k.
             for x in [&path[k * n..(k + 1) * n], &path[(k + 1) * n..(k + 2) * n]] {
                 let inside = (0..n).all(|i| r.lo[i] <= x[i] && x[i] <= r.hi[i]);
@@ -96,14 +96,14 @@ fn a_time_varying_diffusion_gets_sigma_per_step() {
     let (sys, info) = interpreter_of(model);
     let prs = run(&sys, &info, "a");
     let g = |t: f64| 0.1 * (1.0 + t.sin());
-    for r in &prs.regions {
+    for r in prs.regions() {
         let top = g(r.t0).max(g(r.t1));
         assert!(r.sigma >= top, "[{}, {}]: {} < {top}", r.t0, r.t1, r.sigma);
         // Within the step's own range (sin is 1-Lipschitz) plus rounding.
         assert!(r.sigma <= top + 0.1 * (r.t1 - r.t0) + 1e-9, "{r:?}");
     }
     let (lo, hi) = prs
-        .regions
+        .regions()
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(a, b), r| {
             (a.min(r.sigma), b.max(r.sigma))
@@ -134,11 +134,11 @@ fn local_rates_are_never_looser_than_the_global_rate() {
             global.spec.rate = Rate::Global;
             let global = reachc_runtime::engine::run(&sys, &info, &global).unwrap();
             let (l, g) = (
-                local.steps.last().unwrap().prs_radius,
-                global.steps.last().unwrap().prs_radius,
+                local.steps().last().unwrap().prs_radius,
+                global.steps().last().unwrap().prs_radius,
             );
             assert!(l <= g * (1.0 + 1e-9), "{name}: {l} > {g}");
-            assert!(local.rate.max_c <= consts.c, "{name}");
+            assert!(local.rate().max_c <= consts.c, "{name}");
         }
     }
 }

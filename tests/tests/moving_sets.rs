@@ -56,11 +56,11 @@ fn a_moving_wall_is_checked_where_it_is_nearest_over_each_interval() {
         .unwrap()
         .run()
         .unwrap();
-    let swept = &moving.unsafe_sets[0].swept;
-    assert_eq!(swept.len(), moving.steps.len());
-    assert!(fixed.unsafe_sets[0].swept.is_empty());
-    for (k, (m, f)) in moving.steps.iter().zip(&fixed.steps).enumerate() {
-        let nearest = if k == 0 { 0.0 } else { moving.steps[k - 1].t };
+    let swept = &moving.unsafe_sets()[0].swept;
+    assert_eq!(swept.len(), moving.steps().len());
+    assert!(fixed.unsafe_sets()[0].swept.is_empty());
+    for (k, (m, f)) in moving.steps().iter().zip(fixed.steps()).enumerate() {
+        let nearest = if k == 0 { 0.0 } else { moving.steps()[k - 1].t };
         let UnsafeShape::HalfSpace { offset, .. } = swept[k] else {
             panic!("{:?}", swept[k])
         };
@@ -127,9 +127,9 @@ fn a_moving_goal_is_reached_where_it_is() {
         .unwrap()
         .run()
         .unwrap();
-    let (gm, gf) = (&moving.goals[0], &fixed.goals[0]);
-    assert_eq!(gm.swept.len(), moving.steps.len());
-    for (k, st) in moving.steps.iter().enumerate() {
+    let (gm, gf) = (&moving.goals()[0], &fixed.goals()[0]);
+    assert_eq!(gm.swept.len(), moving.steps().len());
+    for (k, st) in moving.steps().iter().enumerate() {
         let UnsafeShape::Box(sides) = &gm.swept[k][0] else {
             panic!()
         };
@@ -173,7 +173,7 @@ fn a_table_moves_a_set_as_the_same_expression_of_t_does() {
         .unwrap()
         .run()
         .unwrap();
-    for (k, (a, b)) in table.steps.iter().zip(&line.steps).enumerate() {
+    for (k, (a, b)) in table.steps().iter().zip(line.steps()).enumerate() {
         assert!((a.margins[0] - b.margins[0]).abs() < 1e-12, "step {k}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -188,14 +188,21 @@ fn the_overtaking_spec_avoids_the_moving_lead_vehicle() {
     assert!(info.has_moving_sets());
     let reach = Reach::new(&sys, &info, "contraction").unwrap();
     let prs = reach.run().unwrap();
-    assert!(prs.unsafe_sets.iter().all(|u| u.safe), "{:?}", prs.verdict);
-    assert!(matches!(prs.goals[0].outcome, GoalOutcome::Reached { .. }));
+    assert!(
+        prs.unsafe_sets().iter().all(|u| u.safe),
+        "{:?}",
+        prs.verdict()
+    );
+    assert!(matches!(
+        prs.goals()[0].outcome,
+        GoalOutcome::Reached { .. }
+    ));
     // The box follows the lead: its lower end in `s` grows by about 15 m/s.
-    let lo = |k: usize| match &prs.unsafe_sets[0].swept[k] {
+    let lo = |k: usize| match &prs.unsafe_sets()[0].swept[k] {
         UnsafeShape::Box(sides) => sides[0].1.lo,
         other => panic!("{other:?}"),
     };
-    let (first, last) = (lo(1), lo(prs.steps.len() - 1));
+    let (first, last) = (lo(1), lo(prs.steps().len() - 1));
     assert!(
         ((last - first) / (7.0 - 0.05) - 15.0).abs() < 0.5,
         "{first} .. {last}"

@@ -18,7 +18,7 @@ fn members_over_budget_are_written_as_their_bounding_boxes() {
         .run()
         .unwrap();
     assert!(
-        prs.also.len() >= 2,
+        prs.also().len() >= 2,
         "the pendulum's contraction run has members"
     );
     let full_text = to_json_within(&prs, Default::default(), usize::MAX);
@@ -31,9 +31,9 @@ fn members_over_budget_are_written_as_their_bounding_boxes() {
     for key in ["steps", "unsafe_sets", "verdict", "validated", "constants"] {
         assert_eq!(full[key], boxed[key], "{key}");
     }
-    let p = &prs.constants.metric;
+    let p = &prs.constants().metric;
     let n = prs.n();
-    for (j, member) in prs.also.iter().enumerate() {
+    for (j, member) in prs.also().iter().enumerate() {
         let (f, b) = (&full["also"][j], &boxed["also"][j]);
         assert!(f.get("boxed").is_none());
         assert_eq!(b["boxed"], Value::Bool(true));

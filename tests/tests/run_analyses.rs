@@ -38,17 +38,17 @@ fn linear_constants_psi_and_radius_match_closed_forms_and_reference() {
     ] {
         let (r, _, _) = run("linear.sde", analysis);
         // dX = -0.4 X dt + sqrt(2) dW: c = mu(-0.4 I) exactly, sigma = sqrt(2).
-        assert_eq!(r.constants.c, -0.4, "{analysis}");
+        assert_eq!(r.constants().c, -0.4, "{analysis}");
         let s2 = std::f64::consts::SQRT_2;
-        assert!(r.constants.sigma >= s2 && r.constants.sigma <= s2 * (1.0 + 1e-15));
-        let reference = reference_kappa(2, r.delta, field);
+        assert!(r.constants().sigma >= s2 && r.constants().sigma <= s2 * (1.0 + 1e-15));
+        let reference = reference_kappa(2, r.delta(), field);
         assert!(
-            (r.kappa - reference).abs() <= 1e-9 * reference,
+            (r.kappa() - reference).abs() <= 1e-9 * reference,
             "{} vs {reference}",
-            r.kappa
+            r.kappa()
         );
-        assert!(r.kappa >= reference * (1.0 - 1e-12));
-        for s in r.steps.iter().skip(1) {
+        assert!(r.kappa() >= reference * (1.0 - 1e-12));
+        for s in r.steps().iter().skip(1) {
             // Psi_t = sigma^2 (e^{2ct} - 1) / (2c) with sigma^2 = 2, c = -0.4.
             let closed = 2.0 * (-0.8 * s.t).exp_m1() / -0.8;
             assert!(
@@ -60,7 +60,7 @@ fn linear_constants_psi_and_radius_match_closed_forms_and_reference() {
             // amgf on an affine model: the exact Gaussian radius, whose chi-square quantile is
             // -2 ln(delta) for n = 2 (method.md section 8.1); the paper rule keeps its kappa.
             let factor = match analysis {
-                "amgf_rule" => -2.0 * r.delta.ln(),
+                "amgf_rule" => -2.0 * r.delta().ln(),
                 _ => reference,
             };
             let r_t = (closed * factor).sqrt();
@@ -72,7 +72,7 @@ fn linear_constants_psi_and_radius_match_closed_forms_and_reference() {
             // X0 = 0 exactly and no inputs: the deterministic set is the nominal point.
             assert_eq!(s.det.radius(), 0.0);
         }
-        assert!((r.steps.last().unwrap().t - 1.5).abs() < 1e-12);
+        assert!((r.steps().last().unwrap().t - 1.5).abs() < 1e-12);
     }
 }
 
@@ -84,7 +84,12 @@ fn pendulum_prs_covers_monte_carlo_paths() {
     let n = sys.n();
     let dt: f64 = 0.002;
     let checkpoints = [1.0, 2.0, 4.0];
-    let step_of = |t: f64| r.steps.iter().position(|s| (s.t - t).abs() < 1e-9).unwrap();
+    let step_of = |t: f64| {
+        r.steps()
+            .iter()
+            .position(|s| (s.t - t).abs() < 1e-9)
+            .unwrap()
+    };
     let mut rng = Rng(42);
     let paths = 1000;
     let mut outside = [0usize; 3];
@@ -102,9 +107,9 @@ fn pendulum_prs_covers_monte_carlo_paths() {
         let mut t = 0.0;
         for (k, &tc) in checkpoints.iter().enumerate() {
             euler_maruyama(&sys, &mut x, &mut t, tc, dt, &mut rng);
-            let s = &r.steps[step_of(tc)];
+            let s = &r.steps()[step_of(tc)];
             let d: Vec<f64> = x.iter().zip(s.nominal()).map(|(a, b)| a - b).collect();
-            let p = &r.constants.metric;
+            let p = &r.constants().metric;
             let norm = (0..n)
                 .map(|i| (0..n).map(|j| d[i] * p[i * n + j] * d[j]).sum::<f64>())
                 .sum::<f64>()
@@ -136,11 +141,15 @@ fn pendulum_prs_covers_monte_carlo_paths() {
 fn pendulum_auto_metric_meets_the_papers_constants() {
     let (r, _, _) = run("pendulum.sde", "contraction");
     // Paper: c = -0.5, sigma = 0.1130 with P = [[35.68, 2.21], [2.21, 1.27]]; optimum c ~ -0.513.
-    assert!(r.constants.c <= -0.50, "c = {}", r.constants.c);
+    assert!(r.constants().c <= -0.50, "c = {}", r.constants().c);
     assert!(
-        r.constants.c >= -0.5133,
+        r.constants().c >= -0.5133,
         "c = {} is below the SDP optimum",
-        r.constants.c
+        r.constants().c
     );
-    assert!(r.constants.sigma <= 0.114, "sigma = {}", r.constants.sigma);
+    assert!(
+        r.constants().sigma <= 0.114,
+        "sigma = {}",
+        r.constants().sigma
+    );
 }

@@ -33,10 +33,10 @@ fn run(split: &str) -> Prs {
 #[test]
 fn a_split_of_ones_is_the_unsplit_result() {
     let (plain, ones) = (run(""), run("split = [1, 1]"));
-    assert!(ones.pieces.is_empty() && ones.split == Split::Off);
-    assert_eq!(plain.steps, ones.steps);
-    assert_eq!(plain.unsafe_sets, ones.unsafe_sets);
-    assert_eq!(plain.verdict, ones.verdict);
+    assert!(ones.pieces().is_empty() && ones.split() == &Split::Off);
+    assert_eq!(plain.steps(), ones.steps());
+    assert_eq!(plain.unsafe_sets(), ones.unsafe_sets());
+    assert_eq!(plain.verdict(), ones.verdict());
     assert_eq!(
         reachc_runtime::report::result::to_json(&plain),
         reachc_runtime::report::result::to_json(&ones)
@@ -51,54 +51,54 @@ fn the_union_holds_its_pieces_and_every_flow_and_is_tighter() {
     let (sys, info) = inline(&spec("split = [4, 3]"));
     let union = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
     let plain = run("");
-    assert_eq!(union.split, Split::Counts(vec![4, 3]));
-    assert_eq!(union.pieces.len(), 12);
+    assert_eq!(union.split(), &Split::Counts(vec![4, 3]));
+    assert_eq!(union.pieces().len(), 12);
     // The pieces tile the initial box: state x in 4 parts, v in 3, the cuts shared.
     let boxes: Vec<_> = union
-        .pieces
+        .pieces()
         .iter()
-        .map(|p| p.initial.bounding_box().unwrap())
+        .map(|p| p.initial().bounding_box().unwrap())
         .collect();
     assert_eq!((boxes[0][0].lo, boxes[0][1].lo), (-1.2, -1.0));
     assert_eq!((boxes[11][0].hi, boxes[11][1].hi), (1.2, 1.0));
     assert_eq!(boxes[0][1].hi, boxes[1][1].lo);
     assert_eq!(boxes[2][0].hi, boxes[3][0].lo);
     assert_eq!(boxes[0][0].hi, boxes[3][0].lo);
-    for (k, st) in union.steps.iter().enumerate() {
+    for (k, st) in union.steps().iter().enumerate() {
         let hull = union.hull_at(k).unwrap();
         assert!(matches!(st.det, DetSet::Box { .. }) && st.r_t == 0.0);
-        for p in &union.pieces {
-            assert_eq!(p.steps[k].t, st.t);
+        for p in union.pieces() {
+            assert_eq!(p.steps()[k].t, st.t);
             for (u, q) in hull.iter().zip(p.hull_at(k).unwrap()) {
                 assert!(u.lo <= q.lo && q.hi <= u.hi, "t = {}: {u:?} vs {q:?}", st.t);
             }
         }
         // The smallest margin of any piece, and one piece reaches each side of the hull.
         let least = union
-            .pieces
+            .pieces()
             .iter()
-            .map(|p| p.steps[k].margins[0])
+            .map(|p| p.steps()[k].margins[0])
             .fold(f64::INFINITY, f64::min);
         assert_eq!(st.margins[0], least);
         for (i, u) in hull.iter().enumerate() {
             assert!(union
-                .pieces
+                .pieces()
                 .iter()
                 .any(|p| p.hull_at(k).unwrap()[i].lo == u.lo));
             assert!(union
-                .pieces
+                .pieces()
                 .iter()
                 .any(|p| p.hull_at(k).unwrap()[i].hi == u.hi));
         }
     }
     // The verdict: the union meets the half-space where some piece's set does.
     let unsafe_pieces = union
-        .pieces
+        .pieces()
         .iter()
-        .filter(|p| matches!(p.verdict, Verdict::NotShownSafe { .. }))
+        .filter(|p| matches!(p.verdict(), Verdict::NotShownSafe { .. }))
         .count();
     assert_eq!(
-        matches!(union.verdict, Verdict::NotShownSafe { .. }),
+        matches!(union.verdict(), Verdict::NotShownSafe { .. }),
         unsafe_pieces > 0
     );
     // Noise-free flows from a grid over the whole initial box (RK4, step 1e-3): in the union
@@ -114,7 +114,7 @@ fn the_union_holds_its_pieces_and_every_flow_and_is_tighter() {
                 })
                 .unwrap();
             let mut t = 0.0;
-            for (k, st) in union.steps.iter().enumerate() {
+            for (k, st) in union.steps().iter().enumerate() {
                 while t < st.t - 1e-12 {
                     let h = (st.t - t).min(1e-3);
                     let f = |y: [f64; 2], out: &mut [f64; 2]| sys.drift(&y, &[], 0.0, out);
@@ -135,14 +135,18 @@ fn the_union_holds_its_pieces_and_every_flow_and_is_tighter() {
                     "t = {}: {x:?} outside the union",
                     st.t
                 );
-                assert!(union.pieces[home].contains_at(k, &x), "t = {}: {x:?}", st.t);
+                assert!(
+                    union.pieces()[home].contains_at(k, &x),
+                    "t = {}: {x:?}",
+                    st.t
+                );
                 assert!(union.span_contains(k, &x));
             }
         }
     }
     // A point outside every piece's set (beyond the hull) is outside; the hull's centre of a
     // late step lies in some piece.
-    let k = union.steps.len() - 1;
+    let k = union.steps().len() - 1;
     let hull = union.hull_at(k).unwrap();
     assert!(!union.contains_at(k, &[hull[0].hi + 0.01, hull[1].hi + 0.01]));
     // Tighter than one piece: the remainder is quadratic in the pieces' widths.
@@ -190,35 +194,35 @@ fn an_automatic_split_tiles_the_box_within_its_budget() {
     let auto = run("split = auto(pieces = 12)");
     let plain = run("");
     assert_eq!(
-        auto.split,
-        Split::Auto {
+        auto.split(),
+        &Split::Auto {
             pieces: 12,
             seconds: None
         }
     );
-    let n = auto.pieces.len();
+    let n = auto.pieces().len();
     assert!((2..=12).contains(&n), "{n} pieces");
     let area: f64 = auto
-        .pieces
+        .pieces()
         .iter()
         .map(|p| {
-            let b = p.initial.bounding_box().unwrap();
+            let b = p.initial().bounding_box().unwrap();
             (b[0].hi - b[0].lo) * (b[1].hi - b[1].lo)
         })
         .sum();
     assert!((area - 2.4 * 2.0).abs() < 1e-12, "{area}");
     // No two pieces overlap (beyond a shared cut).
-    for (a, p) in auto.pieces.iter().enumerate() {
-        for q in &auto.pieces[a + 1..] {
+    for (a, p) in auto.pieces().iter().enumerate() {
+        for q in &auto.pieces()[a + 1..] {
             let (x, y) = (
-                p.initial.bounding_box().unwrap(),
-                q.initial.bounding_box().unwrap(),
+                p.initial().bounding_box().unwrap(),
+                q.initial().bounding_box().unwrap(),
             );
             let overlap = |i: usize| (x[i].hi.min(y[i].hi) - x[i].lo.max(y[i].lo)).max(0.0);
             assert_eq!(overlap(0) * overlap(1), 0.0);
         }
     }
-    let k = auto.steps.len() - 1;
+    let k = auto.steps().len() - 1;
     let (a, b) = (auto.hull_at(k).unwrap(), plain.hull_at(k).unwrap());
     for i in 0..2 {
         eprintln!(
@@ -228,7 +232,7 @@ fn an_automatic_split_tiles_the_box_within_its_budget() {
         );
         assert!(a[i].hi - a[i].lo < 0.8 * (b[i].hi - b[i].lo));
     }
-    assert_eq!(run("split = auto(pieces = 12)").steps, auto.steps);
+    assert_eq!(run("split = auto(pieces = 12)").steps(), auto.steps());
 }
 
 /// The probability of safety of a split analysis (method.md 8.9): the deterministic sets are
@@ -241,7 +245,7 @@ fn a_split_analysis_gets_a_probability_of_safety() {
     let (sys, info) = inline(&source);
     let reach = Reach::new(&sys, &info, "a").unwrap();
     assert!(matches!(
-        reach.run().unwrap().verdict,
+        reach.run().unwrap().verdict(),
         Verdict::NotShownSafe { .. }
     ));
     let p = reach.safety_probability().unwrap();
@@ -276,7 +280,7 @@ fn a_failing_piece_is_named() {
             .unwrap()
             .run()
             .unwrap()
-            .pieces
+            .pieces()
             .len(),
         2
     );
@@ -314,13 +318,13 @@ fn split_auto_cuts_pieces_that_cannot_run() {
     assert_eq!(one, whole);
     let prs = Reach::new(&sys, &info, "auto").unwrap().run().unwrap();
     assert!(
-        prs.pieces.len() > 1 && prs.pieces.len() <= 16,
+        prs.pieces().len() > 1 && prs.pieces().len() <= 16,
         "{}",
-        prs.pieces.len()
+        prs.pieces().len()
     );
     for i in 0..=60 {
         let x0 = 3.0 * f64::from(i) / 60.0;
-        for (k, st) in prs.steps.iter().enumerate() {
+        for (k, st) in prs.steps().iter().enumerate() {
             let x = x0 / (1.0 - x0 * st.t);
             assert!(prs.contains_at(k, &[x]), "x0 = {x0}, t = {}: {x}", st.t);
         }
@@ -333,18 +337,18 @@ fn split_auto_cuts_pieces_that_cannot_run() {
 fn the_time_budget_of_an_automatic_split() {
     let none = run("split = auto(seconds = 0)");
     let plain = run("");
-    assert_eq!(none.pieces.len(), 1);
-    assert_eq!(none.pieces[0].steps, plain.steps);
+    assert_eq!(none.pieces().len(), 1);
+    assert_eq!(none.pieces()[0].steps(), plain.steps());
     let hour = run("split = auto(pieces = 12, seconds = 3600)");
     let free = run("split = auto(pieces = 12)");
     assert_eq!(
-        hour.split,
-        Split::Auto {
+        hour.split(),
+        &Split::Auto {
             pieces: 12,
             seconds: Some(3600)
         }
     );
-    let boxes = |p: &Prs| -> Vec<_> { p.pieces.iter().map(|q| q.initial.clone()).collect() };
+    let boxes = |p: &Prs| -> Vec<_> { p.pieces().iter().map(|q| q.initial().clone()).collect() };
     assert_eq!(boxes(&hour), boxes(&free));
-    assert_eq!(hour.steps, free.steps);
+    assert_eq!(hour.steps(), free.steps());
 }

@@ -200,14 +200,14 @@ fn a_union_takes_the_largest_amount_of_its_pieces() {
     );
     let reach = Reach::new(&sys, &info, "a").unwrap();
     let prs = reach.run().unwrap();
-    assert_eq!(prs.pieces.len(), 2);
+    assert_eq!(prs.pieces().len(), 2);
     let c = [Constraint::HalfSpace {
         normal: vec![1.0, 1.0],
         bound: 2.0,
     }];
     let whole = half_space_amounts(&reach.tighten(&prs, &c).unwrap(), 0, 2.0);
     let pieces: Vec<Vec<f64>> = prs
-        .pieces
+        .pieces()
         .iter()
         .map(|p| half_space_amounts(&reach.tighten(p, &c).unwrap(), 0, 2.0))
         .collect();
@@ -251,7 +251,7 @@ fn bad_constraints_and_results_without_a_ball_are_refused() {
         assert_eq!(refused(c), TightenError::Malformed { index: 0, what });
     }
     let mut gaussian_only = prs.clone();
-    gaussian_only.role = Role::Linearised;
+    gaussian_only.set_role(Role::Linearised);
     assert_eq!(
         reach.tighten(&gaussian_only, &[]).unwrap_err(),
         TightenError::NoDeviationBound

@@ -13,7 +13,9 @@ use reachc_runtime::{Prs, Reach};
 
 /// The sum of the logs of the PRS's bounding-box half-widths at the horizon.
 fn log_volume(prs: &Prs) -> f64 {
-    let hull = prs.hull(prs.horizon).expect("the horizon is a report time");
+    let hull = prs
+        .hull(prs.horizon())
+        .expect("the horizon is a report time");
     hull.iter().map(|b| (0.5 * (b.hi - b.lo)).ln()).sum()
 }
 
@@ -23,16 +25,16 @@ fn log_volume(prs: &Prs) -> f64 {
 fn linear_pointwise_radius_is_the_exact_chi2_radius() {
     let (sys, info) = shipped("linear.sde");
     let prs = Reach::new(&sys, &info, "amgf_rule").unwrap().run().unwrap();
-    assert!(prs.validation.rigorous.contains(&Proved::ExactGaussian));
+    assert!(prs.validation().rigorous.contains(&Proved::ExactGaussian));
     let q = -2.0 * 1e-3f64.ln();
-    let g = prs.radius_rule.gaussian.expect("an affine system");
+    let g = prs.radius_rule().gaussian.expect("an affine system");
     assert!(
         g.quantile >= q && g.quantile <= q * (1.0 + 1e-12),
         "{}",
         g.quantile
     );
     let mut worst = 0.0f64;
-    for step in &prs.steps[1..] {
+    for step in &prs.steps()[1..] {
         let exact = (q * 2.5 * -(-0.8 * step.t).exp_m1()).sqrt();
         assert!(
             step.r_t >= exact * (1.0 - 1e-15),
@@ -90,14 +92,14 @@ fn the_mixture_bound_replaces_an_exploding_tube_and_holds() {
          analysis uniform {\n  metric = identity\n  delta = 0.1\n  horizon = 2\n  step = 0.02\n}\n",
     );
     let prs = Reach::new(&sys, &info, "uniform").unwrap().run().unwrap();
-    let g = prs.radius_rule.gaussian.expect("an affine system");
+    let g = prs.radius_rule().gaussian.expect("an affine system");
     assert_eq!(g.uniform, Some(UniformBound::Mixture));
     assert!(prs
-        .validation
+        .validation()
         .rigorous
         .iter()
         .any(|p| matches!(p, Proved::GaussianMixture { .. })));
-    for step in &prs.steps[1..] {
+    for step in &prs.steps()[1..] {
         assert!(step.r_t >= step.r_pointwise);
         assert!(step.r_t <= 3.0 * step.r_pointwise, "t = {}", step.t);
     }
@@ -153,7 +155,7 @@ fn metric_auto_is_never_worse_than_the_identity() {
             // enters only through the nominal's defect, bounded in the P-norm, and through the
             // shares of delta (per-state metrics: the set at delta / 3 against delta / 2 with
             // one metric): within 0.05.
-            let slack = if a.also.iter().any(|m| m.role == Role::Linearised) {
+            let slack = if a.also().iter().any(|m| m.role() == Role::Linearised) {
                 0.05
             } else {
                 1e-9
@@ -183,14 +185,14 @@ fn the_initial_box_is_the_set_at_time_zero() {
         .unwrap()
         .run()
         .unwrap();
-    let start = &prs.steps[0];
+    let start = &prs.steps()[0];
     assert!(
         (start.margins[0] - 0.02).abs() <= 1e-12,
         "{}",
         start.margins[0]
     );
     // The ball around the box reaches past the half-space.
-    let w = prs.constants.spread[0];
+    let w = prs.constants().spread[0];
     assert!(1.05 + start.det.radius() * w > 1.12);
     assert_eq!(prs.contains(&[1.1, 0.05], 0.0), Some(true));
     assert_eq!(prs.contains(&[1.11, 0.0], 0.0), Some(false));
@@ -208,18 +210,22 @@ fn several_metrics_intersect_their_sets() {
     // The second metric's ball, and each metric's first-order set (8.8); both keep the flow's
     // shape (remainder at most a tenth of the linear part, with the sliced mean-value Jacobian
     // of method.md 8.8), so neither run computes an interval box (section 8.7).
-    let balls: Vec<&Prs> = prs.also.iter().filter(|m| m.role == Role::Metric).collect();
-    let count = |role: Role| prs.also.iter().filter(|m| m.role == role).count();
+    let balls: Vec<&Prs> = prs
+        .also()
+        .iter()
+        .filter(|m| m.role() == Role::Metric)
+        .collect();
+    let count = |role: Role| prs.also().iter().filter(|m| m.role() == role).count();
     assert_eq!(
         (balls.len(), count(Role::Box), count(Role::FirstOrder)),
         (1, 0, 2)
     );
-    assert_eq!(balls[0].method, Method::Contraction);
-    assert_eq!(prs.delta, 1e-3);
-    for m in &prs.also {
-        assert_eq!(m.delta, (1e-3f64 / 2.0).next_down());
+    assert_eq!(balls[0].method(), Method::Contraction);
+    assert_eq!(prs.delta(), 1e-3);
+    for m in prs.also() {
+        assert_eq!(m.delta(), (1e-3f64 / 2.0).next_down());
     }
-    let k = prs.steps.len() - 1;
+    let k = prs.steps().len() - 1;
     let hull = prs.hull_at(k).unwrap();
     let (theta, omega) = (
         0.5 * (hull[0].hi - hull[0].lo),
@@ -232,9 +238,9 @@ fn several_metrics_intersect_their_sets() {
     let theirs = balls[0].hull_at(k).unwrap();
     assert!(theirs[1].hi >= hull[1].hi && theirs[0].hi >= hull[0].hi);
     // A point of the first metric's ball along omega, beyond the intersection's box.
-    let st = &prs.steps[k];
+    let st = &prs.steps()[k];
     let c = st.det.center();
-    let p = &prs.constants.metric;
+    let p = &prs.constants().metric;
     let omega_far = st.prs_radius / p[3].sqrt() * 0.999;
     let x = [c[0], c[1] + omega_far];
     assert!(omega_far > 0.6, "{omega_far}");
@@ -272,19 +278,19 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
     let (sys, info) = inline(&source);
     let reach = Reach::new(&sys, &info, "contraction").unwrap();
     let prs = reach.run().unwrap();
-    let roles = |p: &Prs| p.also.iter().map(|m| m.role).collect::<Vec<_>>();
+    let roles = |p: &Prs| p.also().iter().map(|m| m.role()).collect::<Vec<_>>();
     assert_eq!(roles(&prs), [Role::Box]);
-    let boxes = &prs.also[0];
-    assert_eq!((boxes.method, boxes.delta), (Method::Interval, prs.delta));
+    let boxes = &prs.also()[0];
+    assert_eq!(
+        (boxes.method(), boxes.delta()),
+        (Method::Interval, prs.delta())
+    );
     // The same stochastic radii widen both sets.
-    for (a, b) in prs.steps.iter().zip(&boxes.steps) {
+    for (a, b) in prs.steps().iter().zip(boxes.steps()) {
         assert_eq!((a.t, a.r_t), (b.t, b.r_t));
     }
     let k = prs.step_index(1.2).unwrap();
-    let ball = Prs {
-        also: Vec::new(),
-        ..prs.clone()
-    };
+    let ball = prs.clone().without_members();
     let half = |p: &Prs| {
         let h = p.hull_at(k).unwrap();
         (0.5 * (h[0].hi - h[0].lo), 0.5 * (h[1].hi - h[1].lo))
@@ -296,7 +302,7 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
     );
     assert!(cut.0 <= own.0);
     // Along omega from the nominal state: in the ball, beyond the box.
-    let c = prs.steps[k].det.center().to_vec();
+    let c = prs.steps()[k].det.center().to_vec();
     let x = [c[0], c[1] + 1.5 * cut.1];
     assert!(ball.contains_at(k, &x) && !prs.contains_at(k, &x));
     assert!(prs.contains_at(k, &c));
@@ -327,7 +333,7 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
 /// (tests/tests/linearised.rs) and the box cuts the ball.
 #[test]
 fn the_box_is_computed_only_where_first_order_sets_lose_their_shape() {
-    let roles = |p: &Prs| p.also.iter().map(|m| m.role).collect::<Vec<_>>();
+    let roles = |p: &Prs| p.also().iter().map(|m| m.role()).collect::<Vec<_>>();
     let (sys, info) = shipped("pendulum.sde");
     let prs = Reach::new(&sys, &info, "contraction")
         .unwrap()
@@ -367,7 +373,7 @@ fn first_order_sets_are_on_by_default_and_can_be_turned_off() {
         Reach::new(&sys, &info, "a").unwrap().run().unwrap()
     };
     let (on, written, off) = (run(""), run("first_order = on"), run("first_order = off"));
-    let roles = |p: &Prs| p.also.iter().map(|m| m.role).collect::<Vec<_>>();
+    let roles = |p: &Prs| p.also().iter().map(|m| m.role()).collect::<Vec<_>>();
     // The first-order sets keep the flow's shape (remainder at most a tenth of the linear
     // part), so the run computes no interval box (method.md 8.7), and the noise is constant:
     // the linearised Gaussian set (8.10) comes with the first-order one. Without them the
@@ -375,7 +381,7 @@ fn first_order_sets_are_on_by_default_and_can_be_turned_off() {
     assert_eq!(roles(&on), [Role::FirstOrder, Role::Linearised]);
     assert_eq!(roles(&written), roles(&on));
     assert_eq!(roles(&off), [Role::Box]);
-    assert_eq!(on.role, Role::Own);
+    assert_eq!(on.role(), Role::Own);
     let (h_on, h_off) = (on.hull(2.0).unwrap(), off.hull(2.0).unwrap());
     eprintln!("omega at t = 2: on {:?}, off {:?}", h_on[1], h_off[1]);
     // Every bound of the cut set inside the ball's, omega's at least a fifth tighter.
@@ -401,15 +407,15 @@ fn a_point_start_keeps_its_interval_box_within_the_floor() {
     );
     let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
     let boxes = prs
-        .also
+        .also()
         .iter()
-        .find(|m| m.role == Role::Box)
+        .find(|m| m.role() == Role::Box)
         .expect("the box is kept");
-    let reports = prs.steps.len() - 1;
+    let reports = prs.steps().len() - 1;
     assert!(
-        boxes.internal_steps > reports && boxes.internal_steps <= 64 * reports,
+        boxes.internal_steps() > reports && boxes.internal_steps() <= 64 * reports,
         "{} internal steps over {reports} report intervals",
-        boxes.internal_steps
+        boxes.internal_steps()
     );
     // Noise-free solutions for u = -0.01, 0, 0.01: inside the box at every report time and in
     // its span over each report interval.
@@ -417,7 +423,7 @@ fn a_point_start_keeps_its_interval_box_within_the_floor() {
     for u in [-0.01, 0.0, 0.01] {
         let (mut s, mut t, h) = ([0.0f64, 1.0], 0.0f64, 1e-4f64);
         for k in 1..=reports {
-            let end = prs.steps[k].t;
+            let end = prs.steps()[k].t;
             while t < end - 1e-12 {
                 let h = h.min(end - t);
                 let k1 = f(t, s, u);
@@ -438,7 +444,7 @@ fn a_point_start_keeps_its_interval_box_within_the_floor() {
                 t += h;
                 assert!(boxes.span_contains(k, &s), "u = {u}, t = {t}: {s:?}");
             }
-            let (lo, hi) = boxes.steps[k].det.box_hull().expect("a box");
+            let (lo, hi) = boxes.steps()[k].det.box_hull().expect("a box");
             for i in 0..2 {
                 assert!(lo[i] <= s[i] && s[i] <= hi[i], "u = {u}, t = {end}: {s:?}");
             }

@@ -17,7 +17,7 @@ fn contraction_prs_compiled(bencher: divan::Bencher) {
     bencher.bench(|| {
         reachc_runtime::engine::run(&Pendulum, &info, analysis)
             .unwrap()
-            .steps
+            .steps()
             .len()
     });
 }
@@ -43,7 +43,7 @@ fn interval_prs(bencher: divan::Bencher, name: &str, inclusion: &str) {
     bencher.bench(|| {
         reachc_runtime::engine::run(&Pendulum, &info, &analysis)
             .unwrap()
-            .steps
+            .steps()
             .len()
     });
 }

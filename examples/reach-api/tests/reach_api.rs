@@ -41,8 +41,8 @@ fn a_sweep_of_equal_boxes_has_equal_initial_radii() {
     // r1 is the P-radius of the box about its centre: the same for boxes of the same widths
     // (up to the rounding of the widths x0 +- 0.1).
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs();
-    assert!(prs.windows(2).all(|w| close(w[0].r1, w[1].r1)));
-    assert!(prs[0].r1 > 0.0);
+    assert!(prs.windows(2).all(|w| close(w[0].r1(), w[1].r1())));
+    assert!(prs[0].r1() > 0.0);
     // Nominals differ; so do the stochastic radii: local rates are certified around each
     // tube, where the cubic spring's stiffness differs. Each is finite.
     let at5: Vec<_> = prs.iter().map(|p| p.at(5.0).unwrap()).collect();
@@ -56,17 +56,17 @@ fn forced_trajectories_stay_in_the_prs() {
     let reach = Reach::new(&sys, &info, "contraction").unwrap();
     let prs = forced(&reach, 1.0).unwrap();
     let free = reach.from_box(&start(1.0)).unwrap();
-    assert_eq!(prs.r2, 0.0);
+    assert_eq!(prs.r2(), 0.0);
     let corners = [[0.9, -0.1], [0.9, 0.1], [1.1, -0.1], [1.1, 0.1], [1.0, 0.0]];
     for mut x in corners {
         let mut t = 0.0;
-        for (k, st) in prs.steps.iter().enumerate().skip(1) {
+        for (k, st) in prs.steps().iter().enumerate().skip(1) {
             // 20 RK4 steps per report step: far below the PRS radius.
             rk4(&mut x, t, (st.t - t) / 20.0, 20);
             t = st.t;
             assert!(prs.contains_at(k, &x), "t = {t}: {x:?}");
             // Without the input uncertainty the deterministic set is smaller.
-            assert!(st.det.radius() <= free.steps[k].det.radius());
+            assert!(st.det.radius() <= free.steps()[k].det.radius());
         }
     }
 }

@@ -35,7 +35,7 @@ enum LimitJson<'a> {
 
 impl<'a> ProbabilityJson<'a> {
     pub(super) fn of(prs: &'a Prs, p: &'a SafetyProbability) -> ProbabilityJson<'a> {
-        let name = |set: usize| prs.unsafe_sets[set].name.as_str();
+        let name = |set: usize| prs.unsafe_sets()[set].name.as_str();
         ProbabilityJson {
             horizon: p.horizon,
             lower_bound: p.lower_bound(),

@@ -17,9 +17,9 @@ use std::io::{self, Write};
 pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
     let shown = shown_states(prs);
     let zonotopes = zonotopes(prs);
-    if prs.method == Method::Interval || zonotopes {
+    if prs.method() == Method::Interval || zonotopes {
         let mut header = String::from("t");
-        if let Some(first) = prs.steps.first() {
+        if let Some(first) = prs.steps().first() {
             for (label, _, _) in box_columns(prs, first) {
                 let _ = write!(
                     header,
@@ -34,7 +34,7 @@ pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
         }
         header.push_str(",r_t,psi");
         writeln!(w, "{header}")?;
-        for s in &prs.steps {
+        for s in prs.steps() {
             let mut row = format!("{}", s.t);
             for (_, a, b) in box_columns(prs, s) {
                 let _ = write!(row, ",{a},{b}");
@@ -50,15 +50,15 @@ pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
     let mut header = String::from("t");
     for &i in &shown {
         header.push(',');
-        header.push_str(&csv_field(&prs.states[i]));
+        header.push_str(&csv_field(&prs.states()[i]));
     }
     header.push_str(",det_radius,r_t,psi,c,sigma,prs_radius");
     // Several metrics: the radii are the first metric's; the PRS is the intersection, whose
     // bounding box follows.
-    let boxes = !prs.also.is_empty();
+    let boxes = !prs.also().is_empty();
     if boxes {
         for &i in &shown {
-            let name = &prs.states[i];
+            let name = &prs.states()[i];
             let _ = write!(
                 header,
                 ",{},{}",
@@ -68,7 +68,7 @@ pub fn write_csv(prs: &Prs, w: &mut dyn Write) -> io::Result<()> {
         }
     }
     writeln!(w, "{header}")?;
-    for (k, s) in prs.steps.iter().enumerate() {
+    for (k, s) in prs.steps().iter().enumerate() {
         let mut row = format!("{}", s.t);
         for &i in &shown {
             let _ = write!(row, ",{}", s.nominal()[i]);

@@ -39,7 +39,7 @@ pub fn to_json_within(prs: &Prs, probabilities: Probabilities<'_>, budget: usize
     let write = |boxed: bool| {
         let mut json = Json::of(prs);
         if boxed {
-            json.also = prs.also.iter().map(Json::boxed).collect();
+            json.also = prs.also().iter().map(Json::boxed).collect();
         }
         json.safety_probability = probabilities.safety.map(|p| ProbabilityJson::of(prs, p));
         for p in probabilities.goals {
@@ -54,9 +54,9 @@ pub fn to_json_within(prs: &Prs, probabilities: Probabilities<'_>, budget: usize
     // budget is checked on that count before anything is written, rather than on a text of
     // hundreds of megabytes).
     let numbers: usize = prs
-        .also
+        .also()
         .iter()
-        .flat_map(|m| &m.steps)
+        .flat_map(|m| m.steps())
         .map(|st| (st.det.generators().len() + 4) * st.det.center().len())
         .sum();
     write(numbers.saturating_mul(BYTES_PER_NUMBER) > budget)
@@ -194,7 +194,7 @@ impl<'a> PieceJson<'a> {
     fn of(p: &'a Prs) -> PieceJson<'a> {
         PieceJson {
             initial_box: p
-                .initial
+                .initial()
                 .bounding_box()
                 .unwrap_or_default()
                 .iter()
@@ -202,7 +202,7 @@ impl<'a> PieceJson<'a> {
                 .collect(),
             verdict: VerdictJson::of(p),
             steps: p
-                .steps
+                .steps()
                 .iter()
                 .enumerate()
                 .map(|(k, st)| {
@@ -420,7 +420,7 @@ impl<'a> GoalMissJson<'a> {
             GoalMiss::NoReportTime => GoalMissJson::NoReportTime,
             GoalMiss::Unsafe { t, set } => GoalMissJson::Unsafe {
                 t,
-                set: prs.unsafe_sets.get(set).map_or("?", |u| &u.name),
+                set: prs.unsafe_sets().get(set).map_or("?", |u| &u.name),
             },
             GoalMiss::NotInside { t, margin } => GoalMissJson::NotInside { t, margin },
             GoalMiss::Leaves { t } => GoalMissJson::Leaves { t },
@@ -453,7 +453,7 @@ impl<'a> GoalJson<'a> {
                 .map(|parts| {
                     parts
                         .iter()
-                        .map(|p| ShapeJson::of(&prs.states, p))
+                        .map(|p| ShapeJson::of(prs.states(), p))
                         .collect()
                 })
                 .collect(),
@@ -471,13 +471,13 @@ enum VerdictJson<'a> {
 
 impl<'a> VerdictJson<'a> {
     fn of(prs: &'a Prs) -> VerdictJson<'a> {
-        match prs.verdict {
+        match prs.verdict() {
             Verdict::Safe => VerdictJson::Safe,
             Verdict::NoUnsafeSets => VerdictJson::NoUnsafeSets,
             Verdict::NotShownSafe { t, step, set } => VerdictJson::NotShownSafe {
                 t,
                 step,
-                set: &prs.unsafe_sets[set].name,
+                set: &prs.unsafe_sets()[set].name,
             },
         }
     }
@@ -495,53 +495,53 @@ impl<'a> Json<'a> {
         let n = prs.n();
         let rows = |m: &'a [f64]| -> Vec<&'a [f64]> { m.chunks(n.max(1)).collect() };
         Json {
-            model: &prs.model,
-            analysis: &prs.analysis,
-            method: prs.method.name(),
-            inclusion: prs.inclusion.map(|i| i.name()),
-            delta: prs.delta,
-            horizon: prs.horizon,
-            step: prs.step,
-            integrator: prs.integrator.name(),
-            guarantee: prs.guarantee.name(),
-            internal_steps: prs.internal_steps,
-            states: &prs.states,
-            outputs: &prs.outputs,
+            model: prs.model(),
+            analysis: prs.analysis(),
+            method: prs.method().name(),
+            inclusion: prs.inclusion().map(|i| i.name()),
+            delta: prs.delta(),
+            horizon: prs.horizon(),
+            step: prs.step(),
+            integrator: prs.integrator().name(),
+            guarantee: prs.guarantee().name(),
+            internal_steps: prs.internal_steps(),
+            states: prs.states(),
+            outputs: prs.outputs(),
             rate: RateJson {
-                kind: prs.rate.rate.name(),
-                note: match prs.role {
+                kind: prs.rate().rate.name(),
+                note: match prs.role() {
                     Role::Linearised => ALONE_NOTE.to_string(),
-                    _ => rate_note(prs.rate.rate),
+                    _ => rate_note(prs.rate().rate),
                 },
-                paths: match prs.rate.rate {
+                paths: match prs.rate().rate {
                     Rate::Empirical { paths } => Some(paths),
                     Rate::Local | Rate::Global => None,
                 },
-                min_c: prs.rate.min_c,
-                max_c: prs.rate.max_c,
-                global_from: prs.rate.global_from,
+                min_c: prs.rate().min_c,
+                max_c: prs.rate().max_c,
+                global_from: prs.rate().global_from,
             },
             constants: ConstantsJson {
-                c: prs.constants.c,
-                sigma: prs.constants.sigma,
-                rho: prs.constants.rho,
-                how: prs.constants.provenance.to_string(),
-                metric: rows(&prs.constants.metric),
-                metric_from: prs.constants.metric_region.to_string(),
+                c: prs.constants().c,
+                sigma: prs.constants().sigma,
+                rho: prs.constants().rho,
+                how: prs.constants().provenance.to_string(),
+                metric: rows(&prs.constants().metric),
+                metric_from: prs.constants().metric_region.to_string(),
             },
             radius_rule: RuleJson {
-                rule: prs.radius_rule.rule.name(),
-                eps: prs.radius_rule.eps,
-                gaussian: prs.radius_rule.gaussian.map(|g| GaussianJson {
+                rule: prs.radius_rule().rule.name(),
+                eps: prs.radius_rule().eps,
+                gaussian: prs.radius_rule().gaussian.map(|g| GaussianJson {
                     chi2_quantile: g.quantile,
                     uniform: g.uniform.map(uniform_name),
                 }),
             },
-            kappa: prs.kappa,
-            r1: prs.r1,
-            r2: prs.r2,
+            kappa: prs.kappa(),
+            r1: prs.r1(),
+            r2: prs.r2(),
             r1_how: r1_how(prs),
-            transform: prs.transform.as_ref().map(|tr| TransformJson {
+            transform: prs.transform().map(|tr| TransformJson {
                 matrix: rows(&tr.matrix),
                 inverse: rows(&tr.inverse),
                 inverse_error: tr.inverse_error,
@@ -558,27 +558,34 @@ impl<'a> Json<'a> {
                     }
                 },
             }),
-            initial_center: &prs.initial_center,
-            input_center: &prs.input_center,
-            steps: (0..prs.steps.len()).map(|k| StepJson::of(prs, k)).collect(),
-            unsafe_sets: prs
-                .unsafe_sets
-                .iter()
-                .map(|u| UnsafeJson::of(&prs.states, u))
+            initial_center: prs.initial_center(),
+            input_center: prs.input_center(),
+            steps: (0..prs.steps().len())
+                .map(|k| StepJson::of(prs, k))
                 .collect(),
-            goals: prs.goals.iter().map(|g| GoalJson::of(prs, g)).collect(),
+            unsafe_sets: prs
+                .unsafe_sets()
+                .iter()
+                .map(|u| UnsafeJson::of(prs.states(), u))
+                .collect(),
+            goals: prs.goals().iter().map(|g| GoalJson::of(prs, g)).collect(),
             verdict: VerdictJson::of(prs),
             safety_probability: None,
             validated: ValidationJson {
-                rigorous: prs.validation.rigorous.iter().map(proved).collect(),
-                not_validated: prs.validation.not_validated.iter().map(unproved).collect(),
-                conditional_on_domain: prs.validation.conditional_on_domain,
+                rigorous: prs.validation().rigorous.iter().map(proved).collect(),
+                not_validated: prs
+                    .validation()
+                    .not_validated
+                    .iter()
+                    .map(unproved)
+                    .collect(),
+                conditional_on_domain: prs.validation().conditional_on_domain,
             },
-            hints: prs.hints.iter().map(|h| HintJson::of(prs, h)).collect(),
-            also: prs.also.iter().map(Json::of).collect(),
-            role: (prs.role != Role::Own).then(|| prs.role.name()),
+            hints: prs.hints().iter().map(|h| HintJson::of(prs, h)).collect(),
+            also: prs.also().iter().map(Json::of).collect(),
+            role: (prs.role() != Role::Own).then(|| prs.role().name()),
             boxed: false,
-            split: match &prs.split {
+            split: match prs.split() {
                 Split::Off => None,
                 Split::Counts(k) => Some(SplitJson::Counts(k)),
                 Split::Auto { pieces, seconds } => Some(SplitJson::Auto {
@@ -588,7 +595,7 @@ impl<'a> Json<'a> {
                     },
                 }),
             },
-            pieces: prs.pieces.iter().map(PieceJson::of).collect(),
+            pieces: prs.pieces().iter().map(PieceJson::of).collect(),
         }
     }
 }
@@ -598,7 +605,7 @@ impl<'a> Json<'a> {
     /// [`to_json_with`]).
     fn boxed(member: &'a Prs) -> Json<'a> {
         Json {
-            steps: (0..member.steps.len())
+            steps: (0..member.steps().len())
                 .map(|k| StepJson::boxed(member, k))
                 .collect(),
             boxed: true,
@@ -618,7 +625,7 @@ impl<'a> HintJson<'a> {
                 c,
             } => HintJson::Wrapping {
                 t,
-                state: &prs.states[state],
+                state: &prs.states()[state],
                 half_width,
                 ball_half_width,
                 c,
@@ -630,7 +637,7 @@ impl<'a> HintJson<'a> {
                 domain,
             } => HintJson::LeavesDomain {
                 t,
-                state: &prs.states[state],
+                state: &prs.states()[state],
                 range: [range.lo, range.hi],
                 domain: [domain.lo, domain.hi],
             },
@@ -671,7 +678,7 @@ impl<'a> StepJson<'a> {
             })
             .unzip();
         // |d|_P^2 <= sum_ij |P_ij| |d_i| |d_j| over the box, rounded up.
-        let p = &member.constants.metric;
+        let p = &member.constants().metric;
         let n = half.len();
         let mut q = Interval::ZERO;
         if p.len() == n * n {
@@ -705,7 +712,7 @@ impl<'a> StepJson<'a> {
     }
 
     fn of(prs: &'a Prs, k: usize) -> StepJson<'a> {
-        let st = &prs.steps[k];
+        let st = &prs.steps()[k];
         let (prs_lo, prs_hi) = prs
             .hull_at(k)
             .unwrap_or_default()

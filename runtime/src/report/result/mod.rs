@@ -16,17 +16,17 @@ use reachc_core::prs::{DetSet, Prs, Role, Step};
 
 /// State indices the CSV and the summary show: the outputs, or all states if there are none.
 pub(super) fn shown_states(prs: &Prs) -> Vec<usize> {
-    if prs.outputs.is_empty() {
-        (0..prs.states.len()).collect()
+    if prs.outputs().is_empty() {
+        (0..prs.states().len()).collect()
     } else {
-        prs.outputs.clone()
+        prs.outputs().to_vec()
     }
 }
 
 /// Whether a result's own sets are first-order zonotopes (a member of role
 /// [`Role::FirstOrder`] or [`Role::Linearised`]; its set at `t = 0` is the initial box).
 pub(super) fn zonotopes(prs: &Prs) -> bool {
-    matches!(prs.role, Role::FirstOrder | Role::Linearised)
+    matches!(prs.role(), Role::FirstOrder | Role::Linearised)
 }
 
 /// The ranges shown for a box step, `(label, lo, hi)`: the box over the shown states, or with a
@@ -43,8 +43,8 @@ pub(super) fn box_columns(prs: &Prs, st: &Step) -> Vec<(String, f64, f64)> {
             hull_hi,
             ..
         } => {
-            let ys = (0..prs.states.len()).map(|i| (format!("y{}", i + 1), at(lo, i), at(hi, i)));
-            ys.chain(shown.map(|i| (prs.states[i].clone(), at(hull_lo, i), at(hull_hi, i))))
+            let ys = (0..prs.states().len()).map(|i| (format!("y{}", i + 1), at(lo, i), at(hi, i)));
+            ys.chain(shown.map(|i| (prs.states()[i].clone(), at(hull_lo, i), at(hull_hi, i))))
                 .collect()
         }
         DetSet::Box { lo, hi, .. }
@@ -53,7 +53,7 @@ pub(super) fn box_columns(prs: &Prs, st: &Step) -> Vec<(String, f64, f64)> {
             hull_hi: hi,
             ..
         } => shown
-            .map(|i| (prs.states[i].clone(), at(lo, i), at(hi, i)))
+            .map(|i| (prs.states()[i].clone(), at(lo, i), at(hi, i)))
             .collect(),
         DetSet::Ball { .. } => Vec::new(),
     }

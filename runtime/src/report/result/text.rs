@@ -16,7 +16,7 @@ fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
     let what = if g.stay {
         format!(
             "reach within [{lo}, {hi}] and stay until {}",
-            time(prs.horizon)
+            time(prs.horizon())
         )
     } else {
         format!("reach within [{lo}, {hi}]")
@@ -24,8 +24,8 @@ fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
     let status = match &g.outcome {
         GoalOutcome::Reached { t, margin } => {
             let claim = if g.stay {
-                let end = time(prs.horizon);
-                let avoiding = match prs.unsafe_sets.is_empty() {
+                let end = time(prs.horizon());
+                let avoiding = match prs.unsafe_sets().is_empty() {
                     true => String::new(),
                     false => format!(", avoiding every unsafe set on [0, {end}]"),
                 };
@@ -33,7 +33,7 @@ fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
                     "the state is in it at t = {} and stays in it until t = {end}{avoiding}",
                     time(*t)
                 )
-            } else if prs.unsafe_sets.is_empty() {
+            } else if prs.unsafe_sets().is_empty() {
                 format!("the state is in it at t = {}", time(*t))
             } else {
                 format!(
@@ -42,10 +42,10 @@ fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
                     time(*t)
                 )
             };
-            let how = if matches!(prs.rate.rate, Rate::Empirical { .. }) {
+            let how = if matches!(prs.rate().rate, Rate::Empirical { .. }) {
                 "by the EMPIRICAL estimate (not a guarantee)".to_string()
             } else {
-                format!("with probability at least {}", 1.0 - prs.delta)
+                format!("with probability at least {}", 1.0 - prs.delta())
             };
             format!("reached: {how} {claim}; margin {}", num(*margin))
         }
@@ -58,7 +58,7 @@ fn goal_line(prs: &Prs, g: &GoalVerdict) -> String {
                 GoalMiss::Unsafe { t, set } => format!(
                     "the PRS over the interval ending at t = {} meets unsafe set `{}` first",
                     time(t),
-                    prs.unsafe_sets.get(set).map_or("?", |u| &u.name)
+                    prs.unsafe_sets().get(set).map_or("?", |u| &u.name)
                 ),
                 GoalMiss::NotInside { t, margin } => format!(
                     "the PRS is not inside it at any report time in the window (largest margin \
@@ -84,23 +84,23 @@ pub fn summary(prs: &Prs) -> String {
     let _ = writeln!(
         s,
         "analysis `{}` of model `{}` ({} method, delta = {}, {} guarantee)",
-        prs.analysis,
-        prs.model,
-        prs.method.name(),
-        prs.delta,
-        prs.guarantee.name()
+        prs.analysis(),
+        prs.model(),
+        prs.method().name(),
+        prs.delta(),
+        prs.guarantee().name()
     );
     let _ = writeln!(s, "  {}", guarantee_sentence(prs));
-    let k = &prs.constants;
+    let k = prs.constants();
     // The linearised Gaussian set alone (method.md 8.12) uses no rate.
-    let alone = prs.role == Role::Linearised;
-    match prs.rate.rate {
+    let alone = prs.role() == Role::Linearised;
+    match prs.rate().rate {
         _ if alone => {
             let _ = writeln!(
                 s,
                 "  rates: {ALONE_NOTE}: c_t in [{}, {}]",
-                num(prs.rate.min_c),
-                num(prs.rate.max_c)
+                num(prs.rate().min_c),
+                num(prs.rate().max_c)
             );
         }
         Rate::Global => {
@@ -113,22 +113,22 @@ pub fn summary(prs: &Prs) -> String {
         Rate::Local => {
             // (A split result's regions are its pieces'.)
             let sigma = std::iter::once(prs)
-                .chain(&prs.pieces)
-                .flat_map(|p| &p.regions)
+                .chain(prs.pieces())
+                .flat_map(|p| p.regions())
                 .map(|r| r.sigma)
                 .fold(0.0, f64::max);
             let _ = writeln!(
                 s,
                 "  rates: local, c_t in [{}, {}], sigma_t at most {} (global: c = {}, sigma = \
                  {}; {})",
-                num(prs.rate.min_c),
-                num(prs.rate.max_c),
+                num(prs.rate().min_c),
+                num(prs.rate().max_c),
                 num(sigma),
                 num(k.c),
                 num(k.sigma),
                 k.provenance
             );
-            if let Some(t) = prs.rate.global_from {
+            if let Some(t) = prs.rate().global_from {
                 let _ = writeln!(
                     s,
                     "  from t = {}, no region around the tube closed: the global constants over \
@@ -142,15 +142,15 @@ pub fn summary(prs: &Prs) -> String {
                 s,
                 "  constants: c = c_t ({} rate, at most {}), sigma = {:.6}, rho = {:.6} ({})",
                 rate.name(),
-                num(prs.rate.max_c),
+                num(prs.rate().max_c),
                 k.sigma,
                 k.rho,
                 k.provenance
             );
         }
     }
-    if prs.rate.rate != Rate::Global && !alone {
-        let _ = writeln!(s, "  rate: {}", rate_note(prs.rate.rate));
+    if prs.rate().rate != Rate::Global && !alone {
+        let _ = writeln!(s, "  rate: {}", rate_note(prs.rate().rate));
     }
     let _ = writeln!(
         s,
@@ -158,8 +158,8 @@ pub fn summary(prs: &Prs) -> String {
         metric_rows(prs),
         k.metric_region
     );
-    let rule = match (prs.radius_rule.eps, prs.radius_rule.gaussian) {
-        (Some(eps), _) => format!("{} (eps = {eps:.6})", prs.radius_rule.rule.name()),
+    let rule = match (prs.radius_rule().eps, prs.radius_rule().gaussian) {
+        (Some(eps), _) => format!("{} (eps = {eps:.6})", prs.radius_rule().rule.name()),
         (None, Some(g)) => format!(
             "exact Gaussian (affine system: chi2 quantile {:.6}{})",
             g.quantile,
@@ -169,19 +169,19 @@ pub fn summary(prs: &Prs) -> String {
                 None => "",
             },
         ),
-        (None, None) => prs.radius_rule.rule.name().to_string(),
+        (None, None) => prs.radius_rule().rule.name().to_string(),
     };
     // With several metrics each set is at delta / K.
-    let delta_each = prs.delta / metrics(prs) as f64;
+    let delta_each = prs.delta() / metrics(prs) as f64;
     let _ = writeln!(
         s,
         "  radius rule: {rule}, kappa(n = {}, delta = {}) = {:.6}",
-        prs.states.len(),
+        prs.states().len(),
         delta_each,
-        prs.kappa
+        prs.kappa()
     );
     summary_metrics(prs, &mut s);
-    if !prs.pieces.is_empty() {
+    if !prs.pieces().is_empty() {
         summary_split(prs, &mut s);
     } else if alone {
         let _ = writeln!(
@@ -200,17 +200,23 @@ pub fn summary(prs: &Prs) -> String {
              remainder; PRS = zonotope (+) B_P(remainder + r_t); columns: the zonotope's hull"
         );
         box_table(prs, &mut s);
-    } else if prs.method == Method::Interval {
+    } else if prs.method() == Method::Interval {
         summary_boxes(prs, &mut s);
     } else {
-        let _ = writeln!(s, "  r1 = {:.6} ({}), r2 = {}", prs.r1, r1_how(prs), prs.r2);
+        let _ = writeln!(
+            s,
+            "  r1 = {:.6} ({}), r2 = {}",
+            prs.r1(),
+            r1_how(prs),
+            prs.r2()
+        );
         let _ = writeln!(
             s,
             "  {:>10}  {:>12}  {:>12}  {:>12}  {:>12}",
             "t", "R_t", "r_t", "PRS radius", "pointwise r"
         );
-        for i in summary_indices(prs.steps.len()) {
-            let st = &prs.steps[i];
+        for i in summary_indices(prs.steps().len()) {
+            let st = &prs.steps()[i];
             let _ = writeln!(
                 s,
                 "  {:>10.4}  {:>12}  {:>12}  {:>12}  {:>12}",
@@ -222,10 +228,10 @@ pub fn summary(prs: &Prs) -> String {
             );
         }
     }
-    if prs.unsafe_sets.is_empty() {
+    if prs.unsafe_sets().is_empty() {
         let _ = writeln!(s, "  safety: no unsafe sets");
     } else {
-        for u in &prs.unsafe_sets {
+        for u in prs.unsafe_sets() {
             let status = if u.safe {
                 "safe".to_string()
             } else {
@@ -245,27 +251,27 @@ pub fn summary(prs: &Prs) -> String {
             );
         }
     }
-    for g in &prs.goals {
+    for g in prs.goals() {
         let _ = writeln!(s, "{}", goal_line(prs, g));
     }
-    let verdict = match &prs.verdict {
-        Verdict::Safe if matches!(prs.rate.rate, Rate::Empirical { .. }) => {
+    let verdict = match &prs.verdict() {
+        Verdict::Safe if matches!(prs.rate().rate, Rate::Empirical { .. }) => {
             "safe by the EMPIRICAL estimate (every estimated PRS misses every unsafe set; not a \
              guarantee)"
                 .to_string()
         }
-        Verdict::Safe => match prs.guarantee {
+        Verdict::Safe => match prs.guarantee() {
             Guarantee::Uniform => format!(
                 "safe: with probability at least {} the state avoids every unsafe set for all t \
                  in [0, {}] (every PRS over every interval misses every unsafe set)",
-                1.0 - prs.delta,
-                prs.horizon
+                1.0 - prs.delta(),
+                prs.horizon()
             ),
             Guarantee::Pointwise => format!(
                 "safe at each time separately: for every t in [0, {}], the state is in no \
                  unsafe set with probability at least {} (every PRS misses every unsafe set)",
-                prs.horizon,
-                1.0 - prs.delta
+                prs.horizon(),
+                1.0 - prs.delta()
             ),
         },
         Verdict::NoUnsafeSets => "no unsafe sets to check".to_string(),
@@ -273,25 +279,30 @@ pub fn summary(prs: &Prs) -> String {
             "not shown safe: the PRS over the interval ending at t = {} meets `{}` (this \
              does not prove a violation)",
             time(*t),
-            prs.unsafe_sets[*set].name
+            prs.unsafe_sets()[*set].name
         ),
     };
     let _ = writeln!(s, "  verdict: {verdict}");
-    if prs.validation.conditional_on_domain {
+    if prs.validation().conditional_on_domain {
         let _ = writeln!(
             s,
             "  condition: the constants hold only in the domain; the result assumes the state \
              does not leave it"
         );
     }
-    let not_validated: Vec<String> = prs.validation.not_validated.iter().map(unproved).collect();
+    let not_validated: Vec<String> = prs
+        .validation()
+        .not_validated
+        .iter()
+        .map(unproved)
+        .collect();
     let not_validated = if not_validated.is_empty() {
         "nothing (every bound above is proved)".to_string()
     } else {
         not_validated.join("; ")
     };
     let _ = writeln!(s, "  not validated: {not_validated}");
-    for hint in &prs.hints {
+    for hint in prs.hints() {
         let _ = writeln!(s, "  hint: {}", hint_sentence(prs, hint));
     }
     s
@@ -322,8 +333,7 @@ fn transform_source(tr: &TransformUsed) -> String {
 /// A hint, in words, with what to try.
 fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
     let already_auto = prs
-        .transform
-        .as_ref()
+        .transform()
         .is_some_and(|tr| matches!(tr.source, TransformSource::Auto(_)));
     let try_this = if already_auto {
         "try `method = contraction`"
@@ -343,7 +353,7 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
                 "the box grows (wrapping): the PRS's half-width in `{}` is {} by t = {} while \
                  the contraction rate c = {} {ball} P-balls (half-width {} from the same initial \
                  set and r_t): {try_this}",
-                prs.states[state],
+                prs.states()[state],
                 num(half_width),
                 time(t),
                 num(c),
@@ -358,7 +368,7 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
         } => format!(
             "the box leaves the domain in `{}` at t = {} ([{}, {}] is not in [{}, {}]; the \
              constants hold only in the domain): {try_this}",
-            prs.states[state],
+            prs.states()[state],
             time(t),
             num(range.lo),
             num(range.hi),
@@ -397,17 +407,17 @@ fn hint_sentence(prs: &Prs, hint: &Hint) -> String {
 
 /// What the probability level is about, in words.
 fn guarantee_sentence(prs: &Prs) -> String {
-    match prs.guarantee {
+    match prs.guarantee() {
         Guarantee::Uniform => format!(
             "guarantee: one event of probability at least {}: X_t lies in the tube for all t in \
              [0, {}] at once",
-            1.0 - prs.delta,
-            prs.horizon
+            1.0 - prs.delta(),
+            prs.horizon()
         ),
         Guarantee::Pointwise => format!(
             "guarantee: for each t separately, X_t lies in its PRS with probability at least {} \
              (not uniformly in time)",
-            1.0 - prs.delta
+            1.0 - prs.delta()
         ),
     }
 }
@@ -415,12 +425,16 @@ fn guarantee_sentence(prs: &Prs) -> String {
 /// The number of metrics of a result: its own and its members that are further metrics (the
 /// others are the interval boxes and first-order zonotopes it is cut by).
 fn metrics(prs: &Prs) -> usize {
-    1 + prs.also.iter().filter(|m| m.role == Role::Metric).count()
+    1 + prs
+        .also()
+        .iter()
+        .filter(|m| m.role() == Role::Metric)
+        .count()
 }
 
 /// The further metrics of an intersection result, and its bounding boxes.
 fn summary_metrics(prs: &Prs, s: &mut String) {
-    if prs.also.is_empty() {
+    if prs.also().is_empty() {
         return;
     }
     let k = metrics(prs);
@@ -430,10 +444,10 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             "  several metrics: the PRS is the intersection of the sets of {k} metrics, each at \
              delta / {k} = {:e} (the tables below the first metric's; the boxes, margins and \
              verdicts the intersection's)",
-            prs.delta / k as f64
+            prs.delta() / k as f64
         );
     }
-    let boxes = prs.also.iter().filter(|m| m.role == Role::Box).count();
+    let boxes = prs.also().iter().filter(|m| m.role() == Role::Box).count();
     if boxes > 0 {
         let _ = writeln!(
             s,
@@ -443,8 +457,8 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             if boxes == 1 { "" } else { "es" }
         );
     }
-    for m in prs.also.iter().filter(|m| m.role == Role::FirstOrder) {
-        let last = m.steps.last();
+    for m in prs.also().iter().filter(|m| m.role() == Role::FirstOrder) {
+        let last = m.steps().last();
         let _ = writeln!(
             s,
             "  cut by the first-order zonotope: the PRS also lies in Z_t (+) B_P(remainder_t + \
@@ -459,7 +473,7 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
             num(last.map_or(f64::NAN, |st| st.det.radius()))
         );
     }
-    for m in prs.also.iter().filter(|m| m.role == Role::Linearised) {
+    for m in prs.also().iter().filter(|m| m.role() == Role::Linearised) {
         let _ = writeln!(
             s,
             "  cut by the linearised Gaussian set (delta = {} of it; the other sets at the \
@@ -467,24 +481,24 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
              linearisation, the linearisation's error and its Gaussian part, for all t at once \
              (P-radius {} at the horizon); the boxes, margins and verdicts below are the \
              intersection's",
-            num(m.delta),
-            num(m.steps.last().map_or(f64::NAN, |st| st.det.radius()))
+            num(m.delta()),
+            num(m.steps().last().map_or(f64::NAN, |st| st.det.radius()))
         );
     }
     for (j, m) in prs
-        .also
+        .also()
         .iter()
-        .filter(|m| m.role == Role::Metric)
+        .filter(|m| m.role() == Role::Metric)
         .enumerate()
     {
-        let last = m.steps.last().map_or(f64::NAN, |st| st.prs_radius);
+        let last = m.steps().last().map_or(f64::NAN, |st| st.prs_radius);
         let _ = writeln!(
             s,
             "  metric {}: P = [{}], c = {:.6}, sigma = {:.6}; PRS radius at the horizon {}",
             j + 2,
             metric_rows(m),
-            m.constants.c,
-            m.constants.sigma,
+            m.constants().c,
+            m.constants().sigma,
             num(last)
         );
     }
@@ -494,7 +508,7 @@ fn summary_metrics(prs: &Prs, s: &mut String) {
 /// A result's metric `P`, row by row: `[p11, p12], [p21, p22]`.
 fn metric_rows(prs: &Prs) -> String {
     let rows: Vec<String> = prs
-        .constants
+        .constants()
         .metric
         .chunks(prs.n().max(1))
         .map(|r| {
@@ -507,10 +521,14 @@ fn metric_rows(prs: &Prs) -> String {
 
 /// The table of the PRS's bounding boxes (of an intersection or a union) per report time.
 fn hull_table(prs: &Prs, s: &mut String) {
-    let names: Vec<String> = prs.states.iter().map(|x| format!("{x} [lo, hi]")).collect();
+    let names: Vec<String> = prs
+        .states()
+        .iter()
+        .map(|x| format!("{x} [lo, hi]"))
+        .collect();
     let header: Vec<String> = names.iter().map(|x| format!("{x:>28}")).collect();
     let _ = writeln!(s, "  {:>10}  {}", "t", header.join("  "));
-    for i in summary_indices(prs.steps.len()) {
+    for i in summary_indices(prs.steps().len()) {
         let Some(hull) = prs.hull_at(i) else {
             continue;
         };
@@ -518,26 +536,26 @@ fn hull_table(prs: &Prs, s: &mut String) {
             .iter()
             .map(|b| format!("[{:>12}, {:>12}]", num(b.lo), num(b.hi)))
             .collect();
-        let _ = writeln!(s, "  {:>10.4}  {}", prs.steps[i].t, cells.join("  "));
+        let _ = writeln!(s, "  {:>10.4}  {}", prs.steps()[i].t, cells.join("  "));
     }
 }
 
 /// A split result (method.md 8.11) in words: the pieces, the union's bounding boxes, and which
 /// pieces are not shown safe.
 fn summary_split(prs: &Prs, s: &mut String) {
-    let how = match &prs.split {
+    let how = match prs.split() {
         Split::Counts(k) => {
             let counts: Vec<String> = k.iter().map(|k| k.to_string()).collect();
             format!(
                 "cut into {} = {} pieces",
                 counts.join(" x "),
-                prs.pieces.len()
+                prs.pieces().len()
             )
         }
         Split::Auto { pieces, seconds } => format!(
             "cut automatically into {} pieces (at most {pieces}{}: the pieces with the largest \
              sets halved along their widest state, while that shrank them)",
-            prs.pieces.len(),
+            prs.pieces().len(),
             seconds.map_or(String::new(), |s| format!(", no round started after {s} s"))
         ),
         Split::Off => String::new(),
@@ -548,39 +566,39 @@ fn summary_split(prs: &Prs, s: &mut String) {
          their union (a path starts in one piece and stays in that piece's PRS with probability \
          at least {}); the boxes below are the union's bounding boxes, the margins and verdicts \
          the union's",
-        prs.delta,
-        1.0 - prs.delta
+        prs.delta(),
+        1.0 - prs.delta()
     );
-    let cut: usize = prs.pieces.iter().filter(|p| !p.also.is_empty()).count();
+    let cut: usize = prs.pieces().iter().filter(|p| !p.also().is_empty()).count();
     if cut > 0 {
         let _ = writeln!(
             s,
             "  pieces cut by further sets of their own run (interval box, first-order or \
              linearised sets): {cut} of {}",
-            prs.pieces.len()
+            prs.pieces().len()
         );
     }
     hull_table(prs, s);
     let unsafe_pieces: Vec<(usize, &Prs)> = prs
-        .pieces
+        .pieces()
         .iter()
         .enumerate()
-        .filter(|(_, p)| matches!(p.verdict, Verdict::NotShownSafe { .. }))
+        .filter(|(_, p)| matches!(p.verdict(), Verdict::NotShownSafe { .. }))
         .collect();
     if let Some((j, p)) = unsafe_pieces.first() {
         let range: Vec<String> = p
-            .initial
+            .initial()
             .bounding_box()
             .unwrap_or_default()
             .iter()
-            .zip(&prs.states)
+            .zip(prs.states())
             .map(|(b, x)| format!("{x} in [{}, {}]", num(b.lo), num(b.hi)))
             .collect();
         let _ = writeln!(
             s,
             "  pieces not shown safe: {} of {} (the first, piece {}: {})",
             unsafe_pieces.len(),
-            prs.pieces.len(),
+            prs.pieces().len(),
             j + 1,
             range.join(", ")
         );
@@ -590,8 +608,8 @@ fn summary_split(prs: &Prs, s: &mut String) {
 /// The deterministic sets of an interval result (boxes or parallelotopes) in words, and their
 /// table.
 fn summary_boxes(prs: &Prs, s: &mut String) {
-    let inclusion = prs.inclusion.map_or("?", |i| i.name());
-    match &prs.transform {
+    let inclusion = prs.inclusion().map_or("?", |i| i.name());
+    match &prs.transform() {
         None => {
             let _ = writeln!(
                 s,
@@ -618,7 +636,7 @@ fn summary_boxes(prs: &Prs, s: &mut String) {
 /// The table of the summary for sets with a box hull: per column of [`box_columns`] the range
 /// `[lo, hi]`, the remainder of first-order zonotopes, and `r_t`.
 fn box_table(prs: &Prs, s: &mut String) {
-    let Some(first) = prs.steps.first() else {
+    let Some(first) = prs.steps().first() else {
         return;
     };
     let zonotopes = zonotopes(prs);
@@ -631,8 +649,8 @@ fn box_table(prs: &Prs, s: &mut String) {
     }
     let _ = write!(head, "  {:>12}", "r_t");
     let _ = writeln!(s, "{head}");
-    for k in summary_indices(prs.steps.len()) {
-        let st = &prs.steps[k];
+    for k in summary_indices(prs.steps().len()) {
+        let st = &prs.steps()[k];
         let mut row = format!("  {:>10.4}", st.t);
         for (_, a, b) in box_columns(prs, st) {
             let _ = write!(row, "  [{a:>12.6}, {b:>12.6}]");

@@ -50,7 +50,7 @@ pub(super) fn rate_note(rate: Rate) -> String {
 
 /// How `r1` was bounded, in words.
 pub(super) fn r1_how(prs: &Prs) -> String {
-    let b = prs.r1_bound;
+    let b = prs.r1_bound();
     let how = match b.balls {
         BallBound::NoBalls => r1_over_box(b.boxes, "the initial box"),
         BallBound::BoundingBoxes => format!(
