@@ -6,7 +6,8 @@
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use super::{doc_attrs, int};
+use super::bake::int;
+use super::docs::doc_attrs;
 use crate::backend::mangle;
 use crate::ir::Names;
 
