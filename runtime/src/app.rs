@@ -281,7 +281,7 @@ fn parse_simulate(args: &[String]) -> Result<Command, String> {
                 }
                 a.delta = Some(d);
             }
-            "--shard" => a.shard = Some(Shard::parse(value()?)?),
+            "--shard" => a.shard = Some(Shard::parse(value()?).map_err(|e| e.to_string())?),
             "--spec-hash" => a.spec_hash = Some(value()?.to_string()),
             "--threads" => {
                 let t: usize = number(flag, value()?)?;
@@ -673,7 +673,11 @@ pub fn report_file(dir: &std::path::Path, sim: &SimReport) -> (PathBuf, Vec<u8>)
 
 /// The name of a shard's part file: `<analysis>.shard-I-of-K.part`.
 pub fn part_file_name(analysis: &str, shard: Shard) -> String {
-    format!("{analysis}.shard-{}-of-{}.part", shard.index, shard.count)
+    format!(
+        "{analysis}.shard-{}-of-{}.part",
+        shard.index(),
+        shard.count()
+    )
 }
 
 /// A progress callback: `(analysis, paths done, paths in all)`.
@@ -882,7 +886,7 @@ mod tests {
             quiet: false,
             progress: true,
             delta: Some(0.1 + 0.2),
-            shard: Some(Shard { index: 3, count: 8 }),
+            shard: Some(Shard::new(3, 8).unwrap()),
             spec_hash: Some("0a1b".into()),
             error_lines: true,
             probability: true,

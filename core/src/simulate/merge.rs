@@ -546,8 +546,15 @@ mod tests {
             paths: 50,
             ..Options::default()
         };
-        let bytes = parts(&sys, &r, &opts, 1).remove(0).1.to_bytes();
+        let mut part = parts(&sys, &r, &opts, 1).remove(0).1;
+        let bytes = part.to_bytes();
         let read = |b: &[u8]| Part::from_bytes(b).unwrap_err();
+        // A shard that cannot be (index 5 of 3), with a good checksum: refused as it is read.
+        part.shard = Shard { index: 5, count: 3 };
+        assert_eq!(
+            read(&part.to_bytes()),
+            "shard 5/3: the index must be below the number of shards (0-based)"
+        );
         assert!(read(b"{\"model\": 1}").starts_with("not a reachc simulate part file"));
         assert!(read(&[]).starts_with("not a reachc simulate part file"));
         for cut in [

@@ -179,10 +179,11 @@ pub fn run_part<S: System + Sync + ?Sized>(
     let plan = make_plan(sys, info, result, opts)?;
     let steps = plan.times.len();
     let n_paths = opts.paths;
-    if shard.count == 0 || shard.index >= shard.count || shard.count > n_paths {
+    // (`index < count` holds by construction.)
+    if shard.count > n_paths {
         return Err(SimError::Usage(format!(
-            "shard {shard} of {n_paths} paths: the index must be below the number of shards, \
-             which must be at most the number of paths"
+            "shard {shard} of {n_paths} paths: the number of shards must be at most the number \
+             of paths"
         )));
     }
     // j-th largest = ceil((1 - delta) N)-th smallest; the slack keeps delta * N = 1000 (say)

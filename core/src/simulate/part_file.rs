@@ -209,10 +209,8 @@ impl Part {
             at: r.at,
         };
         let run = read_run(&mut r)?;
-        let shard = Shard {
-            index: r.u64()?,
-            count: r.u64()?,
-        };
+        let (index, count) = (r.u64()?, r.u64()?);
+        let shard = Shard::new(index, count).map_err(|e| e.to_string())?;
         let stats = PartStats {
             outside: r.u64s()?,
             outside_any: r.u64()?,

@@ -5,43 +5,92 @@
 use std::fmt;
 use std::ops::Range;
 
-/// Shard `index` of `count` (0-based).
+/// Shard `index` of `count` (0-based): always `index < count`, checked where it is made
+/// ([`Shard::new`], [`Shard::parse`], or read from a part file), so no consumer checks again:
+///
+/// ```compile_fail,E0451
+/// let shard = reachc_core::simulate::Shard { index: 9, count: 3 };
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Shard {
     /// Which shard, `0 <= index < count`.
-    pub index: u64,
+    pub(crate) index: u64,
     /// How many shards share the paths (at least 1).
-    pub count: u64,
+    pub(crate) count: u64,
 }
+
+/// Why `I/K` is not a shard.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ShardError {
+    /// `K = 0`.
+    NoShards,
+    /// `I >= K`.
+    IndexTooLarge {
+        /// `I`.
+        index: u64,
+        /// `K`.
+        count: u64,
+    },
+    /// Not `I/K` with whole numbers.
+    Syntax {
+        /// The text given.
+        text: String,
+    },
+}
+
+impl fmt::Display for ShardError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ShardError::NoShards => write!(f, "the number of shards must be at least 1"),
+            ShardError::IndexTooLarge { index, count } => write!(
+                f,
+                "shard {index}/{count}: the index must be below the number of shards (0-based)"
+            ),
+            ShardError::Syntax { text } => {
+                write!(
+                    f,
+                    "shard `{text}`: expected I/K with whole numbers, e.g. 0/8"
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for ShardError {}
 
 impl Shard {
     /// All paths in one shard (an unsharded run).
     pub const WHOLE: Shard = Shard { index: 0, count: 1 };
 
     /// Shard `index` of `count`, or why not (`count` is 0, or `index >= count`).
-    pub fn new(index: u64, count: u64) -> Result<Shard, String> {
+    pub fn new(index: u64, count: u64) -> Result<Shard, ShardError> {
         if count == 0 {
-            return Err("the number of shards must be at least 1".into());
+            return Err(ShardError::NoShards);
         }
         if index >= count {
-            return Err(format!(
-                "shard {index}/{count}: the index must be below the number of shards (0-based)"
-            ));
+            return Err(ShardError::IndexTooLarge { index, count });
         }
         Ok(Shard { index, count })
     }
 
     /// Parses `I/K`, e.g. `3/8`.
-    pub fn parse(s: &str) -> Result<Shard, String> {
-        let number = |v: &str| {
-            v.trim()
-                .parse::<u64>()
-                .map_err(|_| format!("shard `{s}`: expected I/K with whole numbers, e.g. 0/8"))
+    pub fn parse(s: &str) -> Result<Shard, ShardError> {
+        let syntax = || ShardError::Syntax {
+            text: s.to_string(),
         };
-        let (i, k) = s
-            .split_once('/')
-            .ok_or_else(|| format!("shard `{s}`: expected I/K, e.g. 0/8"))?;
+        let number = |v: &str| v.trim().parse::<u64>().map_err(|_| syntax());
+        let (i, k) = s.split_once('/').ok_or_else(syntax)?;
         Shard::new(number(i)?, number(k)?)
+    }
+
+    /// Which shard, `0 <= index < count`.
+    pub fn index(self) -> u64 {
+        self.index
+    }
+
+    /// How many shards share the paths (at least 1).
+    pub fn count(self) -> u64 {
+        self.count
     }
 
     /// This shard's paths among `paths` (`floor(I N / K) .. floor((I + 1) N / K)`; empty when
@@ -81,15 +130,21 @@ mod tests {
     fn shards_parse_and_print() {
         assert_eq!(Shard::parse("3/8"), Ok(Shard { index: 3, count: 8 }));
         assert_eq!(Shard::parse("3/8").unwrap().to_string(), "3/8");
+        let e = Shard::parse("8/8").unwrap_err();
+        assert_eq!(e, ShardError::IndexTooLarge { index: 8, count: 8 });
         assert_eq!(
-            Shard::parse("8/8").unwrap_err(),
+            e.to_string(),
             "shard 8/8: the index must be below the number of shards (0-based)"
         );
+        assert_eq!(Shard::parse("0/0"), Err(ShardError::NoShards));
         assert_eq!(
-            Shard::parse("0/0").unwrap_err(),
+            ShardError::NoShards.to_string(),
             "the number of shards must be at least 1"
         );
-        assert!(Shard::parse("1-4").unwrap_err().contains("expected I/K"));
-        assert!(Shard::parse("a/4").unwrap_err().contains("whole numbers"));
+        for text in ["1-4", "a/4", "1/"] {
+            let e = Shard::parse(text).unwrap_err();
+            assert_eq!(e, ShardError::Syntax { text: text.into() });
+            assert!(e.to_string().contains("expected I/K with whole numbers"));
+        }
     }
 }
