@@ -526,10 +526,51 @@ impl Default for AnalysisSpec {
 pub struct Analysis {
     /// The analysis as written.
     pub spec: AnalysisSpec,
-    /// The certified constants, or why the compiler could not bound them (e.g. "`d f[omega] /
-    /// d theta` is unbounded over the domain"); an engine refuses to run without them.
-    pub constants: Result<Constants, String>,
+    /// The certified constants, or why the compiler could not bound them; an engine refuses to
+    /// run without them.
+    pub constants: Result<Constants, NoConstants>,
 }
+
+/// Why the compiler could not bound an analysis' constants.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NoConstants {
+    /// An entry of `D_x f`, `G` or `D_u f` has an unbounded range over the domain (no `domain`
+    /// box, or one too large).
+    Unbounded {
+        /// The entry, named: `d f[omega] / d theta`, `the diffusion entry G[x, w]`.
+        entry: String,
+        /// Its expression in the spec's syntax (a prefix, ending in `...` where it was cut).
+        expression: String,
+    },
+    /// The metric is not an `n x n` symmetric positive definite matrix (or could not be
+    /// certified as one).
+    BadMetric {
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// No bound could be certified for a constant (numerically hopeless data, e.g. entries
+    /// near `f64::MAX`).
+    NotCertified {
+        /// `c`, `sigma` or `rho`.
+        constant: String,
+    },
+}
+
+impl fmt::Display for NoConstants {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            NoConstants::Unbounded { entry, expression } => {
+                write!(f, "{entry} = {expression} is unbounded over the domain")
+            }
+            NoConstants::BadMetric { reason } => write!(f, "invalid metric: {reason}"),
+            NoConstants::NotCertified { constant } => {
+                write!(f, "could not certify a bound for {constant}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for NoConstants {}
 
 /// Constants of Assumption 1 for one metric, certified by the compiler over a [`Region`].
 #[derive(Clone, Debug, PartialEq)]

@@ -690,7 +690,13 @@ fn errors() {
     ));
     an.spec.transform = None;
     an.spec.method = Method::Contraction;
-    let constants = std::mem::replace(&mut an.constants, Err("d f[x1]/d x1 is unbounded".into()));
+    let constants = std::mem::replace(
+        &mut an.constants,
+        Err(reachc_core::model::NoConstants::Unbounded {
+            entry: "d f[x1] / d x1".into(),
+            expression: "x1^2".into(),
+        }),
+    );
     match engine::run(&sys, &inf, &an) {
         Err(RunError::NoConstants(m)) => assert!(m.message.contains("unbounded"), "{m}"),
         other => panic!("expected NoConstants, got {other:?}"),

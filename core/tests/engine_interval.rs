@@ -273,7 +273,9 @@ fn refuses_transform_and_missing_constants() {
         Err(RunError::Unsupported(_))
     ));
     let mut a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
-    a.constants = Err("not bounded".into());
+    a.constants = Err(reachc_core::model::NoConstants::NotCertified {
+        constant: "c".into(),
+    });
     assert!(matches!(
         engine::run(&Lin, &lin_info(vec![]), &a),
         Err(RunError::NoConstants(_))

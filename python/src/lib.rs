@@ -364,7 +364,7 @@ impl Spec {
             }
             Err(why) => {
                 d.set_item("constants", py.None())?;
-                d.set_item("constants_error", why)?;
+                d.set_item("constants_error", why.to_string())?;
             }
         }
         Ok(d)

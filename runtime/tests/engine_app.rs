@@ -63,7 +63,9 @@ fn analysis(name: &str, method: Method, constants: bool) -> Analysis {
         constants: if constants {
             Ok(Constants::given(&model(vec![]), vec![1.0], -1.0, 0.5, 0.0))
         } else {
-            Err("not bounded".to_string())
+            Err(reachc_runtime::model::NoConstants::NotCertified {
+                constant: "not bounded c".into(),
+            })
         },
     }
 }

@@ -566,7 +566,9 @@ fn simulate_command_line() {
 
     // An analysis without constants has no PRS: skipped, not a failure.
     let mut none = good.clone();
-    none.analyses[0].constants = Err("not bounded".into());
+    none.analyses[0].constants = Err(reachc_runtime::model::NoConstants::NotCertified {
+        constant: "c".into(),
+    });
     let (code, _, err) = cli(&none, &["simulate", "--paths", "10", "-o", d]);
     assert_eq!(code, EXIT_OK);
     assert!(

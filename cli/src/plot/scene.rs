@@ -513,7 +513,7 @@ pub fn paths_scene(
     let [a, b] = plane.states;
     // The reason can be a long Jacobian entry: the warning printed with the spec shows it.
     let why = match analysis.constants.as_ref().err() {
-        Some(e) if e.chars().count() <= 160 => e.clone(),
+        Some(e) if e.to_string().chars().count() <= 160 => e.to_string(),
         _ => "the analysis' constants (c, sigma, rho) could not be bounded (see the warning)"
             .to_string(),
     };

@@ -14,7 +14,7 @@ use crate::ir::Names;
 const MAX_SHOWN: usize = 200;
 use crate::model::{self, MetricChoice, Model, Rate};
 use reachc_core::interval::Interval;
-use reachc_core::model::{AnalysisSpec, Constants, MetricRegion, Provenance};
+use reachc_core::model::{AnalysisSpec, Constants, MetricRegion, NoConstants, Provenance};
 
 /// A model ready for code generation or interpretation.
 #[derive(Clone, Debug)]
@@ -44,16 +44,16 @@ pub fn prepare(model: &mut Model) -> Prepared {
     for a in model.analyses.clone() {
         let derived = analysis_constants(model, &derivatives, &a.spec);
         let constants = derived.map_err(|e| {
-            let (message, help) = explain(model, &derivatives, &e);
+            let (why, help) = explain(model, &derivatives, &e);
             warnings.push(
                 Diagnostic::warning(
-                    format!("analysis `{}` cannot run: {message}", a.spec.name),
+                    format!("analysis `{}` cannot run: {why}", a.spec.name),
                     a.span.clone(),
                     "its constants are unbounded",
                 )
                 .with_help(help),
             );
-            message
+            why
         });
         // One transformed system per distinct `T` (the checker numbered them).
         if let Some(t) = &a.spec.transform {
@@ -218,7 +218,7 @@ fn for_metric(
                 sigma: f64::INFINITY,
                 rho: f64::INFINITY,
                 provenance: Provenance::Unbounded {
-                    why: explain(model, d, &e).0,
+                    why: explain(model, d, &e).0.to_string(),
                 },
                 also: Vec::new(),
                 alternatives: Vec::new(),
@@ -262,15 +262,23 @@ fn identity(n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The message and help for a constants error, naming the offending entry.
-fn explain(model: &Model, d: &Derivatives, e: &ConstantsError) -> (String, String) {
-    let ConstantsError::Unbounded {
-        matrix,
-        row,
-        column,
-    } = *e
-    else {
-        return (e.to_string(), "check the analysis' metric".to_string());
+/// A constants error with its entry named, and the help for it.
+fn explain(model: &Model, d: &Derivatives, e: &ConstantsError) -> (NoConstants, String) {
+    let metric_help = || "check the analysis' metric".to_string();
+    let (matrix, row, column) = match e {
+        ConstantsError::Unbounded {
+            matrix,
+            row,
+            column,
+        } => (*matrix, *row, *column),
+        ConstantsError::BadMetric { reason } => {
+            let reason = reason.clone();
+            return (NoConstants::BadMetric { reason }, metric_help());
+        }
+        ConstantsError::NotCertified { constant } => {
+            let constant = constant.to_string();
+            return (NoConstants::NotCertified { constant }, metric_help());
+        }
     };
     let names = |v: &[model::Variable]| v.iter().map(|x| x.name.clone()).collect::<Vec<_>>();
     let (states, inputs, noises) = (
@@ -305,7 +313,7 @@ fn explain(model: &Model, d: &Derivatives, e: &ConstantsError) -> (String, Strin
         shown.truncate(cut.unwrap_or(0));
         shown.push_str(" ...");
     }
-    let message = format!("{what} = {shown} is unbounded over the domain");
+
     let vars: Vec<String> = model
         .pool
         .vars_of(expr)
@@ -324,5 +332,9 @@ fn explain(model: &Model, d: &Derivatives, e: &ConstantsError) -> (String, Strin
             example.join("  ")
         )
     };
-    (message, help)
+    let why = NoConstants::Unbounded {
+        entry: what,
+        expression: shown,
+    };
+    (why, help)
 }

@@ -58,8 +58,8 @@ pub use tighten::{tighten, Constraint, TightStep, TightenError, Tightening};
 
 use crate::interval::Interval;
 use crate::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, RadiusRule, Split,
-    MAX_PIECES,
+    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, NoConstants,
+    RadiusRule, Split, MAX_PIECES,
 };
 use crate::prs::Prs;
 use crate::reach::InputPlan;
@@ -171,7 +171,7 @@ impl<'a> Setup<'a> {
         sys: &dyn System,
         info: &ModelInfo,
         spec: &AnalysisSpec,
-        constants: &'a Result<Constants, String>,
+        constants: &'a Result<Constants, NoConstants>,
         needs: Needs,
     ) -> Result<Setup<'a>, RunError> {
         let consts = constants.as_ref().map_err(|why| {

@@ -319,7 +319,7 @@ pub(super) fn info_doc(info: &ModelInfo) -> TokenStream {
                 short(c.rho),
                 one_line(&c.provenance.to_string())
             ),
-            Err(e) => format!("no constants\n    {}", one_line(e)),
+            Err(e) => format!("no constants\n    {}", one_line(&e.to_string())),
         };
         list.push(format!("{} ({method}): {what}", one_line(&a.spec.name)));
     }

@@ -6,8 +6,8 @@ use proc_macro2::TokenStream;
 use quote::quote;
 use reachc_core::model::{
     Analysis, AnalysisSpec, AutoFit, Constants, Guarantee, Inclusion, InputGain, Integrator,
-    MatrixBound, Method, MetricChoice, MetricRegion, Provenance, RadiusRule, Rate, Region, Split,
-    Transform, TransformSource,
+    MatrixBound, Method, MetricChoice, MetricRegion, NoConstants, Provenance, RadiusRule, Rate,
+    Region, Split, Transform, TransformSource,
 };
 
 use super::{variant, Bake, Baker};
@@ -186,6 +186,24 @@ impl Bake for Provenance {
             }
             Provenance::Given => quote!(Provenance::Given),
             Provenance::Unbounded { why } => bake_fields!(baker, Provenance::Unbounded { why }),
+        }
+    }
+}
+
+/// `NoConstants::Unbounded { .. }`, `NoConstants::BadMetric { .. }` or
+/// `NoConstants::NotCertified { .. }`.
+impl Bake for NoConstants {
+    fn bake(&self, baker: &mut Baker<'_>) -> TokenStream {
+        match self {
+            NoConstants::Unbounded { entry, expression } => {
+                bake_fields!(baker, NoConstants::Unbounded { entry, expression })
+            }
+            NoConstants::BadMetric { reason } => {
+                bake_fields!(baker, NoConstants::BadMetric { reason })
+            }
+            NoConstants::NotCertified { constant } => {
+                bake_fields!(baker, NoConstants::NotCertified { constant })
+            }
         }
     }
 }
