@@ -524,7 +524,7 @@ fn run_analyses<S: System + Sync>(
                     let _ = writeln!(out, "  {}", report::probability::line(&info.unsafe_sets, p));
                 }
                 Some(Err(why)) => {
-                    let _ = writeln!(out, "  probability of safety: not computed: {why}");
+                    let _ = writeln!(out, "  {}", report::probability::not_computed(why));
                 }
                 None => {}
             }
@@ -542,8 +542,8 @@ fn run_analyses<S: System + Sync>(
                     ),
                     Err(why) => writeln!(
                         out,
-                        "  probability of reaching `{}`: not computed: {why}",
-                        info.goals[g].name
+                        "  {}",
+                        report::probability::goal_not_computed(&info.goals[g], why)
                     ),
                 };
             }
@@ -552,7 +552,7 @@ fn run_analyses<S: System + Sync>(
                     let _ = writeln!(out, "  {}", report::tightening::line(&info.unsafe_sets, t));
                 }
                 Some(Err(why)) => {
-                    let _ = writeln!(out, "  tightening: not computed: {why}");
+                    let _ = writeln!(out, "  {}", report::tightening::not_computed(why));
                 }
                 None => {}
             }

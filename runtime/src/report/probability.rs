@@ -238,6 +238,19 @@ pub fn lower_bound_text(delta: f64) -> String {
     format!("0.{rest:0>width$} ({short})", width = digits as usize)
 }
 
+/// The summary's line where the probability of safety could not be computed, and why.
+pub fn not_computed(why: &dyn std::fmt::Display) -> String {
+    format!("probability of safety: not computed: {why}")
+}
+
+/// The summary's line where the probability of reaching `goal` could not be computed, and why.
+pub fn goal_not_computed(goal: &GoalSet, why: &dyn std::fmt::Display) -> String {
+    format!(
+        "probability of reaching `{}`: not computed: {why}",
+        goal.name
+    )
+}
+
 /// The summary's line: the bound and what limits it (`sets`: the model's unsafe sets).
 pub fn line(sets: &[UnsafeSet], p: &SafetyProbability) -> String {
     let name = |set: usize| &sets[set].name;

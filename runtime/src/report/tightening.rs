@@ -81,6 +81,11 @@ pub fn write_csv(t: &Tightening, states: &[String], w: &mut dyn Write) -> io::Re
     Ok(())
 }
 
+/// The summary's line where the tightening could not be computed, and why.
+pub fn not_computed(why: &dyn std::fmt::Display) -> String {
+    format!("tightening: not computed: {why}")
+}
+
 /// The summary's line: per unsafe set of `original` (the model's), how far the tightening moves
 /// it at most over the horizon (the largest distance a face, an offset or a radius moves).
 pub fn line(original: &[reachc_core::model::UnsafeSet], t: &Tightening) -> String {
