@@ -68,11 +68,19 @@ pub fn metric_for_result(
     objective: Objective,
 ) -> Vec<f64> {
     let n = model.states.len();
+    // The same for every candidate: computed once (its certified series is most of a score).
+    let delta = match objective {
+        Objective::Volume => spec.delta,
+        Objective::Extent { metrics, .. } => spec.delta / metrics as f64,
+    };
+    let kappa = reachc_core::kappa::kappa(n, delta, spec.radius);
     let score = |p: &[f64]| -> f64 {
         if !conditioned(p, n) {
             return f64::INFINITY;
         }
-        constants(model, d, p).map_or(f64::INFINITY, |k| predicted(model, spec, p, &k, objective))
+        constants(model, d, p).map_or(f64::INFINITY, |k| {
+            predicted(model, spec, p, &k, kappa, objective)
+        })
     };
     let mut best = (score(&identity(n)), identity(n));
     let consider = |p: Vec<f64>, best: &mut (f64, Vec<f64>)| {
@@ -105,13 +113,14 @@ pub fn metric_for_result(
 }
 
 /// The log-volume of the P-ball the certified constants predict at the horizon, or the log of
-/// its extent in one state (see the module documentation); infinite when the constants are not
-/// finite.
+/// its extent in one state (see the module documentation), for the radius rule's `kappa` at the
+/// objective's delta; infinite when the constants are not finite.
 fn predicted(
     model: &Model,
     spec: &AnalysisSpec,
     p: &[f64],
     k: &Constants,
+    kappa: f64,
     objective: Objective,
 ) -> f64 {
     let n = model.states.len();
@@ -121,11 +130,6 @@ fn predicted(
     }
     // (e^(x) - 1) / x, continuous at 0.
     let growth = |x: f64| if x.abs() < 1e-12 { 1.0 } else { x.exp_m1() / x };
-    let delta = match objective {
-        Objective::Volume => spec.delta,
-        Objective::Extent { metrics, .. } => spec.delta / metrics as f64,
-    };
-    let kappa = reachc_core::kappa::kappa(n, delta, spec.radius);
     let psi = k.sigma * k.sigma * t * growth(2.0 * c * t);
     let r_t = (kappa * psi).sqrt();
     let det = match spec.method {

@@ -76,27 +76,31 @@ pub(crate) fn inline_scalar_arrays(pretty: &str) -> String {
     while i < lines.len() {
         let line = lines[i];
         if line.ends_with('[') {
-            // The items up to the closing bracket at this line's indentation, if all scalars.
+            // The items up to the closing bracket at this line's indentation, if all scalars:
+            // the search stops at the first item that is not one (an array of objects or
+            // arrays is left as it is without reading it to its end, so a file is read once).
             let indent = line.len() - line.trim_start().len();
-            let end = lines[i + 1..].iter().position(|l| {
-                let t = l.trim_start();
-                l.len() - t.len() == indent && (t == "]" || t == "],")
-            });
+            let end = lines[i + 1..]
+                .iter()
+                .map(|l| {
+                    let t = l.trim_start();
+                    let close = l.len() - t.len() == indent && (t == "]" || t == "],");
+                    (close, close || scalar(t.trim_end().trim_end_matches(',')))
+                })
+                .take_while(|&(_, scalar)| scalar)
+                .position(|(close, _)| close);
             if let Some(end) = end {
-                let items = &lines[i + 1..i + 1 + end];
-                if items.iter().all(|l| scalar(l.trim().trim_end_matches(','))) {
-                    out.push_str(line);
-                    for (j, item) in items.iter().enumerate() {
-                        if j > 0 {
-                            out.push(' ');
-                        }
-                        out.push_str(item.trim());
+                out.push_str(line);
+                for (j, item) in lines[i + 1..i + 1 + end].iter().enumerate() {
+                    if j > 0 {
+                        out.push(' ');
                     }
-                    out.push_str(lines[i + 1 + end].trim_start());
-                    out.push('\n');
-                    i += end + 2;
-                    continue;
+                    out.push_str(item.trim());
                 }
+                out.push_str(lines[i + 1 + end].trim_start());
+                out.push('\n');
+                i += end + 2;
+                continue;
             }
         }
         out.push_str(line);
