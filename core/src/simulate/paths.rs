@@ -1283,88 +1283,17 @@ mod tests {
     use crate::engine;
     use crate::interval::Interval;
     use crate::model::*;
+    use crate::test_support::models::{pendulum_model, PENDULUM_METRIC};
+    use crate::test_support::systems::Pendulum;
 
     /// The pendulum of specs/pendulum.sde: one noise channel on the second state (constant
     /// `G` that is not diagonal), a drift with `sin`.
-    struct Pendulum;
-
-    impl System for Pendulum {
-        fn n(&self) -> usize {
-            2
-        }
-        fn p(&self) -> usize {
-            0
-        }
-        fn m(&self) -> usize {
-            1
-        }
-        fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-            out[0] = x[1];
-            out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-        }
-        fn drift_interval(
-            &self,
-            x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            o: &mut [Interval],
-        ) {
-            let p = Interval::point;
-            o[0] = x[1];
-            o[1] = p(10.0) * x[0].sin() - p(20.0) * x[0] - p(20.0) * x[1];
-        }
-        fn jac_x(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-            out.copy_from_slice(&[0.0, 1.0, 10.0 * x[0].cos() - 20.0, -20.0]);
-        }
-        fn jac_x_interval(
-            &self,
-            x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            o: &mut [Interval],
-        ) {
-            let p = Interval::point;
-            o.copy_from_slice(&[p(0.0), p(1.0), p(10.0) * x[0].cos() - p(20.0), p(-20.0)]);
-        }
-        fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-        fn jac_u_interval(
-            &self,
-            _x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            _o: &mut [Interval],
-        ) {
-        }
-        fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-            out.copy_from_slice(&[0.0, 0.1]);
-        }
-        fn diffusion_interval(&self, _x: &[Interval], _t: Interval, o: &mut [Interval]) {
-            o.copy_from_slice(&[Interval::ZERO, Interval::point(0.1)]);
-        }
-    }
+    const PENDULUM: Pendulum = Pendulum::PAPER;
 
     /// The pendulum's model; its analysis `method` with the paper's (full) metric.
     fn pendulum(method: Method) -> ModelInfo {
-        let a = std::f64::consts::PI / 10.0;
-        let mut info = ModelInfo {
-            goals: Vec::new(),
-            name: "pendulum".into(),
-            states: vec!["theta".into(), "omega".into()],
-            inputs: vec![],
-            noises: vec!["w".into()],
-            input_box: vec![],
-            initial: InitialSet {
-                boxes: vec![Some(Bounds::new(-a, a)), Some(Bounds::new(-0.2, 0.2))],
-                balls: vec![],
-            },
-            domain: vec![Bounds::ENTIRE; 2],
-            has_domain: false,
-            affine: false,
-            constant_diffusion: false,
-            unsafe_sets: vec![],
-            analyses: vec![],
-        };
-        let constants = Constants::given(&info, vec![35.68, 2.21, 2.21, 1.27], -0.5, 0.12, 0.0);
+        let mut info = pendulum_model();
+        let constants = Constants::given(&info, PENDULUM_METRIC.to_vec(), -0.5, 0.12, 0.0);
         info.analyses.push(Analysis {
             spec: AnalysisSpec {
                 name: "a".into(),
@@ -1399,7 +1328,7 @@ mod tests {
         for method in [Method::Contraction, Method::Interval] {
             for guarantee in [Guarantee::Uniform, Guarantee::Pointwise] {
                 let info = pendulum(method);
-                let mut r = engine::run(&Pendulum, &info, &info.analyses[0]).unwrap();
+                let mut r = engine::run(&PENDULUM, &info, &info.analyses[0]).unwrap();
                 r.guarantee = guarantee;
                 if method == Method::Contraction {
                     assert!(!r.also.is_empty(), "an intersection");
@@ -1419,7 +1348,7 @@ mod tests {
                     let forced = with_input(&regions);
                     let modes = [InputMode::Random, InputMode::Corners, InputMode::Centre];
                     let systems = [
-                        (&Pendulum as &dyn System, &regions, InputMode::Random, true),
+                        (&PENDULUM as &dyn System, &regions, InputMode::Random, true),
                         (&MULTIPLICATIVE, &regions, InputMode::Random, false),
                     ]
                     .into_iter()
@@ -1489,22 +1418,22 @@ mod tests {
             1
         }
         fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
-            Pendulum.drift(x, u, t, out);
+            PENDULUM.drift(x, u, t, out);
             if self.forced {
                 out[1] += u[0];
             }
         }
         fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, o: &mut [Interval]) {
-            Pendulum.drift_interval(x, u, t, o);
+            PENDULUM.drift_interval(x, u, t, o);
             if self.forced {
                 o[1] += u[0];
             }
         }
         fn jac_x(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
-            Pendulum.jac_x(x, u, t, out);
+            PENDULUM.jac_x(x, u, t, out);
         }
         fn jac_x_interval(&self, x: &[Interval], u: &[Interval], t: Interval, o: &mut [Interval]) {
-            Pendulum.jac_x_interval(x, u, t, o);
+            PENDULUM.jac_x_interval(x, u, t, o);
         }
         fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
             if self.forced {
@@ -1520,7 +1449,7 @@ mod tests {
             if self.multiplicative {
                 out.copy_from_slice(&[0.0, 0.1 + 0.05 * x[0].sin()]);
             } else {
-                Pendulum.diffusion(x, t, out);
+                PENDULUM.diffusion(x, t, out);
             }
         }
         fn diffusion_interval(&self, x: &[Interval], t: Interval, o: &mut [Interval]) {
@@ -1528,7 +1457,7 @@ mod tests {
                 let p = Interval::point;
                 o.copy_from_slice(&[Interval::ZERO, p(0.1) + p(0.05) * x[0].sin()]);
             } else {
-                Pendulum.diffusion_interval(x, t, o);
+                PENDULUM.diffusion_interval(x, t, o);
             }
         }
     }
