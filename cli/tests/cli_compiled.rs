@@ -7,7 +7,6 @@
 //! `tests/tests/build_crates.rs` and `tests/relocation.sh`.
 #![cfg(unix)]
 
-#[allow(dead_code)] // `reachc` without an environment is not used here
 mod common;
 
 use std::path::{Path, PathBuf};
@@ -15,24 +14,7 @@ use std::process::{Command, Output};
 use std::time::SystemTime;
 
 use common::spec;
-
-/// A scratch directory (removed on drop).
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("reachc-cli-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
+use reachc_test_support::files::Scratch;
 
 /// The stand-in for cargo: appends its arguments to `$FAKE_CARGO_LOG`, writes
 /// `$CARGO_TARGET_DIR/release/<package>` (a script printing `fake binary ARGS`) and reports it
@@ -63,7 +45,7 @@ struct World {
 
 impl World {
     fn new(name: &str) -> World {
-        let scratch = Scratch::new(name);
+        let scratch = Scratch::new(&format!("cli-{name}"));
         std::fs::copy(spec("pendulum.sde"), scratch.0.join("pendulum.sde")).unwrap();
         let cargo = scratch.0.join("fake-cargo");
         std::fs::write(&cargo, FAKE_CARGO).unwrap();

@@ -8,7 +8,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use common::reachc;
+use common::{file_names, reachc, text};
 
 /// `x' = 400 x` from 0 with a global rate: analysis `short` runs, `long`'s radius overflows.
 const GROWING: &str = "radius_overflow.sde";
@@ -37,24 +37,6 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
 fn run_interp(dir: &Path, extra: &[&str]) -> Output {
     let spec = dir.join("spec.sde");
     let mut args = vec!["run", s(&spec), "--backend", "interp"];
@@ -69,7 +51,7 @@ fn a_failed_analysis_keeps_the_others() {
     let o = run_interp(&dir, &["-o", s(&out)]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     // `short` ran and is written, whole; `long` did not, and says so.
-    assert_eq!(names(&out), ["short.csv", "short.json"]);
+    assert_eq!(file_names(&out), ["short.csv", "short.json"]);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("short.json")).unwrap()).unwrap();
     assert_eq!(json["analysis"], "short");
@@ -80,7 +62,7 @@ fn a_failed_analysis_keeps_the_others() {
     std::fs::write(out.join("short.json"), "old").unwrap();
     let o = run_interp(&dir, &["-o", s(&out)]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert_eq!(names(&out), ["short.csv", "short.json"]);
+    assert_eq!(file_names(&out), ["short.csv", "short.json"]);
     assert!(std::fs::read_to_string(out.join("short.json"))
         .unwrap()
         .contains("\"analysis\": \"short\""));
@@ -99,7 +81,7 @@ fn a_failed_analysis_keeps_the_others() {
     // The analysis that runs alone: exit 0.
     let o = run_interp(&dir, &["-o", s(&out), "--analysis", "short"]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o));
-    assert_eq!(names(&out), ["short.csv", "short.json"]);
+    assert_eq!(file_names(&out), ["short.csv", "short.json"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -127,7 +109,7 @@ fn a_result_that_is_not_finite_is_an_error_of_its_analysis() {
     // simulate without --analysis: `short`'s report is written.
     let o = simulate_interp(&dir, &["--paths", "10", "-o", s(&out)]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert_eq!(names(&out), ["short.sim.json"]);
+    assert_eq!(file_names(&out), ["short.sim.json"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -157,7 +139,7 @@ fn write_errors_exit_2_and_write_nothing() {
         );
     }
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "mine");
-    assert_eq!(names(&dir), ["a-file", "spec.sde"]);
+    assert_eq!(file_names(&dir), ["a-file", "spec.sde"]);
     // An analysis the spec does not have is a usage error.
     let o = run_interp(&dir, &["--analysis", "nope", "-o", s(&dir.join("out"))]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
@@ -183,7 +165,7 @@ fn deny_unsafe_fails_on_not_shown_safe_and_writes_the_results() {
     let o = run_interp(&dir, &["-o", s(&out), "--deny-unsafe"]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
     assert!(text(&o).contains("error: not shown safe (--deny-unsafe)"));
-    assert_eq!(names(&out), ["contraction.csv", "contraction.json"]);
+    assert_eq!(file_names(&out), ["contraction.csv", "contraction.json"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

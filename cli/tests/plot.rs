@@ -17,7 +17,7 @@ use reachc_runtime::model::{Bounds, UnsafeShape};
 use reachc_runtime::report;
 use reachc_runtime::simulate::{self, Options};
 
-use common::{reachc, spec};
+use common::{file_names, reachc, spec, text};
 
 /// A fresh directory for one test.
 fn temp_dir(name: &str) -> PathBuf {
@@ -25,24 +25,6 @@ fn temp_dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
-/// The files in `dir` (names, sorted).
-fn files(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 /// A complete SVG document; its text.
@@ -110,7 +92,7 @@ fn run_plot_writes_both_figures_for_each_analysis() {
         .collect();
     expected.sort();
     // Exactly the pictures: no temporary files left behind.
-    assert_eq!(files(&plots), expected);
+    assert_eq!(file_names(&plots), expected);
     for a in analyses {
         let sets = svg(&plots.join(format!("{a}_sets.svg")));
         assert!(sets.contains(&format!("pendulum / {a}")), "{a}");
@@ -351,11 +333,11 @@ fn plot_errors_are_usage_errors_and_write_nothing() {
     assert!(text(&o).contains("(nothing written)"), "{}", text(&o));
     // None of the failures wrote a picture (nor a temporary file).
     assert!(
-        files(&dir)
+        file_names(&dir)
             .iter()
             .all(|f| f.ends_with(".json") || f.ends_with(".csv")),
         "{:?}",
-        files(&dir)
+        file_names(&dir)
     );
 
     // run --plot checks the state names before running anything.
@@ -415,7 +397,7 @@ fn an_analysis_without_a_prs_gets_paths_and_unsafe_sets() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("has no PRS: plotting its sample paths and unsafe sets only"));
     assert_eq!(
-        files(&plots),
+        file_names(&plots),
         ["contraction_sets.png", "contraction_sets.svg"]
     );
     let sets = svg(&plots.join("contraction_sets.svg"));

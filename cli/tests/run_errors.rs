@@ -2,22 +2,17 @@
 //! `reachc run` (and `simulate`) exits 1 with a diagnostic at the place its first line names
 //! (`// expect: LINE:COL CULPRIT`): the setting to change, the state, or the analysis.
 
-#[allow(dead_code)] // `spec` (the shipped specs) is not used here
 mod common;
 
 use std::path::{Path, PathBuf};
 
 use common::reachc;
+use reachc_test_support::files::with_extension;
 
 /// The specs of tests/run_errors/, sorted.
 fn specs() -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/run_errors");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "sde"))
-        .collect();
-    v.sort();
+    let v = with_extension(&dir, "sde");
     assert!(v.len() >= 5, "{v:?}");
     v
 }

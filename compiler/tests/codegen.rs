@@ -8,15 +8,11 @@ use reachc_compiler::backend::codegen::{
 };
 use reachc_compiler::backend::{mangle, prepare};
 use reachc_compiler::model::Model;
+use reachc_test_support::files::with_extension;
 
 fn specs() -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../specs");
-    let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "sde"))
-        .collect();
-    out.sort();
+    let out = with_extension(&dir, "sde");
     assert!(!out.is_empty());
     out
 }

@@ -82,19 +82,7 @@ pub fn dsinc_interval(x: Interval) -> Interval {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    struct Rng(u64);
-    impl Rng {
-        fn next_f64(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.next_f64()
-        }
-    }
+    use crate::test_support::rng::Rng;
 
     #[test]
     fn point_values() {
@@ -118,7 +106,7 @@ mod tests {
         let mut rng = Rng(99);
         for _ in 0..2000 {
             let c = rng.range(-12.0, 12.0);
-            let r = rng.range(0.0, 3.0) * rng.next_f64();
+            let r = rng.range(0.0, 3.0) * rng.uniform();
             let x = Interval::new(c - r, c + r);
             let enc = dsinc_interval(x);
             for k in 0..=20 {

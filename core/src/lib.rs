@@ -18,6 +18,8 @@ pub mod simulate;
 pub mod sweep;
 pub mod system;
 pub mod table;
+#[cfg(test)]
+mod test_support;
 mod workers;
 
 pub use interval::Interval;

@@ -97,6 +97,7 @@ pub fn eval_interval(times: &[f64], values: &[f64], t: Interval) -> Interval {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::rng::XorShift64;
 
     const TIMES: [f64; 5] = [0.0, 0.1, 0.3, 1.0, 2.5];
     const A: [f64; 5] = [1.0, 3.0, -1.0, 0.7, 0.7];
@@ -137,11 +138,9 @@ mod tests {
     fn ranges_contain_sampled_values() {
         let times = [0.0, 0.3, 0.7, 1.1];
         let values = [0.1, -2.7, 1e-3, 123.456];
-        let mut s: u64 = 12345;
+        let mut rng = XorShift64(12345);
         for _ in 0..20000 {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
+            let s = rng.next_u64();
             let a = (s % 1_000_000) as f64 / 1_000_000.0 * 1.2 - 0.05;
             let b = a + ((s >> 20) % 1000) as f64 / 3000.0;
             let (lo, hi) = eval_range(&times, &values, a, b);

@@ -2,7 +2,6 @@
 //! check of the probability level, safety margins, and the paper's pendulum.
 
 use reachc_core::engine::{self, Culprit, RunError, Setting};
-use reachc_core::interval::Interval;
 use reachc_core::kappa::kappa;
 use reachc_core::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
@@ -11,117 +10,9 @@ use reachc_core::model::{
 use reachc_core::prs::{BallBound, DetSet, Prs, Span, Unproved, UnsafeKind, Verdict};
 use reachc_core::{InputPlan, Reach, System};
 
-mod common;
-use common::Pend;
-
-// ---------------------------------------------------------------------------------------------
-// Systems
-// ---------------------------------------------------------------------------------------------
-
-/// `dX = a X dt + s dW` in `R^n` (one noise channel per state).
-struct Linear {
-    n: usize,
-    a: f64,
-    s: f64,
-}
-
-impl System for Linear {
-    fn n(&self) -> usize {
-        self.n
-    }
-    fn p(&self) -> usize {
-        0
-    }
-    fn m(&self) -> usize {
-        self.n
-    }
-    fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        for (o, xi) in out.iter_mut().zip(x) {
-            *o = self.a * xi;
-        }
-    }
-    fn drift_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        for (o, xi) in out.iter_mut().zip(x) {
-            *o = self.a * *xi;
-        }
-    }
-    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        for i in 0..self.n {
-            for j in 0..self.n {
-                out[i * self.n + j] = if i == j { self.a } else { 0.0 };
-            }
-        }
-    }
-    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        for i in 0..self.n {
-            for j in 0..self.n {
-                out[i * self.n + j] = Interval::point(if i == j { self.a } else { 0.0 });
-            }
-        }
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-    fn jac_u_interval(
-        &self,
-        _x: &[Interval],
-        _u: &[Interval],
-        _t: Interval,
-        _out: &mut [Interval],
-    ) {
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        for i in 0..self.n {
-            for j in 0..self.n {
-                out[i * self.n + j] = if i == j { self.s } else { 0.0 };
-            }
-        }
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        for i in 0..self.n {
-            for j in 0..self.n {
-                out[i * self.n + j] = Interval::point(if i == j { self.s } else { 0.0 });
-            }
-        }
-    }
-}
-
-/// `dx = (-x + u) dt + 0.1 dW`, `u` in `[-1, 1]`.
-struct WithInput;
-
-impl System for WithInput {
-    fn n(&self) -> usize {
-        1
-    }
-    fn p(&self) -> usize {
-        1
-    }
-    fn m(&self) -> usize {
-        1
-    }
-    fn drift(&self, x: &[f64], u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = -x[0] + u[0];
-    }
-    fn drift_interval(&self, x: &[Interval], u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = u[0] - x[0];
-    }
-    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = -1.0;
-    }
-    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::point(-1.0);
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = 1.0;
-    }
-    fn jac_u_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ONE;
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = 0.1;
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::point(0.1);
-    }
-}
+use reachc_test_support::models::{model, pendulum_constants, pendulum_model, PENDULUM_METRIC};
+use reachc_test_support::rng::Rng;
+use reachc_test_support::systems::{Linear, Pendulum};
 
 // ---------------------------------------------------------------------------------------------
 // Model data
@@ -152,36 +43,21 @@ fn analysis(delta: f64, horizon: f64, step: f64, constants: Constants) -> Analys
     }
 }
 
+/// The model `name` of `states` from the box `boxes`, one noise channel `w`, and an input
+/// `u<j>` per range of `input_box`.
 fn info(
     name: &str,
     states: &[&str],
     boxes: Vec<(f64, f64)>,
     input_box: Vec<(f64, f64)>,
 ) -> ModelInfo {
-    let n = states.len();
     ModelInfo {
-        goals: Vec::new(),
-        name: name.into(),
-        states: states.iter().map(|s| s.to_string()).collect(),
         inputs: (0..input_box.len()).map(|j| format!("u{j}")).collect(),
-        noises: vec!["w".into()],
         input_box: input_box
             .into_iter()
             .map(|(a, b)| Bounds::new(a, b))
             .collect(),
-        initial: InitialSet {
-            boxes: boxes
-                .into_iter()
-                .map(|(a, b)| Some(Bounds::new(a, b)))
-                .collect(),
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE; n],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
-        unsafe_sets: vec![],
-        analyses: vec![],
+        ..model(name, states, &["w"], &boxes)
     }
 }
 
@@ -190,6 +66,7 @@ fn linear_setup(delta: f64, horizon: f64, step: f64) -> (Linear, ModelInfo, Anal
     let sys = Linear {
         n: 2,
         a: -0.4,
+        b: 0.0,
         s: 2f64.sqrt(),
     };
     let inf = info("linear", &["x1", "x2"], vec![(0.0, 0.0); 2], vec![]);
@@ -198,26 +75,17 @@ fn linear_setup(delta: f64, horizon: f64, step: f64) -> (Linear, ModelInfo, Anal
 }
 
 /// System (b): `x' = -x + u`, `u` in `[-1, 1]`, X0 = [0.5, 1.5].
-fn input_setup() -> (WithInput, ModelInfo, Analysis) {
+fn input_setup() -> (Linear, ModelInfo, Analysis) {
     let inf = info("input", &["x"], vec![(0.5, 1.5)], vec![(-1.0, 1.0)]);
     let constants = Constants::given(&inf, vec![1.0], -1.0, 0.1, 1.0);
-    (WithInput, inf, analysis(0.01, 2.0, 0.1, constants))
+    (Linear::WITH_INPUT, inf, analysis(0.01, 2.0, 0.1, constants))
 }
 
-const PENDULUM_P: [f64; 4] = [35.68, 2.21, 2.21, 1.27];
-
 /// System (e): the pendulum with the paper's constants.
-fn pendulum_setup() -> (Pend, ModelInfo, Analysis) {
-    let pi10 = std::f64::consts::PI / 10.0;
-    let inf = info(
-        "pendulum",
-        &["theta", "omega"],
-        vec![(-pi10, pi10), (-0.2, 0.2)],
-        vec![],
-    );
-    // The paper's constants (Sec. VIII-B).
-    let constants = Constants::given(&inf, PENDULUM_P.to_vec(), -0.5, 0.1130, 0.0);
-    (Pend::PAPER, inf, analysis(1e-3, 4.0, 0.01, constants))
+fn pendulum_setup() -> (Pendulum, ModelInfo, Analysis) {
+    let inf = pendulum_model();
+    let constants = pendulum_constants(&inf);
+    (Pendulum::PAPER, inf, analysis(1e-3, 4.0, 0.01, constants))
 }
 
 /// A result and the results it is intersected with.
@@ -345,9 +213,9 @@ fn membership() {
     let k = step_at(&res, 2.0);
     let st = &res.steps()[k];
     let d = [1.0, -0.5];
-    let norm = (PENDULUM_P[0] * d[0] * d[0]
-        + 2.0 * PENDULUM_P[1] * d[0] * d[1]
-        + PENDULUM_P[3] * d[1] * d[1])
+    let norm = (PENDULUM_METRIC[0] * d[0] * d[0]
+        + 2.0 * PENDULUM_METRIC[1] * d[0] * d[1]
+        + PENDULUM_METRIC[3] * d[1] * d[1])
         .sqrt();
     let at = |s: f64| {
         let f = s * st.prs_radius / norm;
@@ -360,29 +228,6 @@ fn membership() {
 // ---------------------------------------------------------------------------------------------
 // (c) Monte Carlo
 // ---------------------------------------------------------------------------------------------
-
-/// xorshift64* with Box-Muller normals (the runtime has no `rand` dependency).
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    /// Uniform in (0, 1).
-    fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    /// Two independent standard normals.
-    fn normal2(&mut self) -> (f64, f64) {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        let r = (-2.0 * u1.ln()).sqrt();
-        let th = std::f64::consts::TAU * u2;
-        (r * th.cos(), r * th.sin())
-    }
-}
 
 #[test]
 fn monte_carlo_probability_level() {
@@ -403,7 +248,7 @@ fn monte_carlo_probability_level() {
     for _ in 0..paths {
         let (mut x1, mut x2) = (0.0f64, 0.0f64);
         for _ in 0..nsteps {
-            let (z1, z2) = rng.normal2();
+            let (z1, z2) = rng.normal_pair();
             x1 += -0.4 * x1 * dt + sq * z1;
             x2 += -0.4 * x2 * dt + sq * z2;
         }
@@ -557,12 +402,12 @@ fn pendulum_half_space_uses_inverse_metric() {
         },
     ];
     let res = engine::run(&sys, &inf, &an).unwrap();
-    let det = PENDULUM_P[0] * PENDULUM_P[3] - PENDULUM_P[1] * PENDULUM_P[2];
+    let det = PENDULUM_METRIC[0] * PENDULUM_METRIC[3] - PENDULUM_METRIC[1] * PENDULUM_METRIC[2];
     let pinv = [
-        PENDULUM_P[3] / det,
-        -PENDULUM_P[1] / det,
-        -PENDULUM_P[2] / det,
-        PENDULUM_P[0] / det,
+        PENDULUM_METRIC[3] / det,
+        -PENDULUM_METRIC[1] / det,
+        -PENDULUM_METRIC[2] / det,
+        PENDULUM_METRIC[0] / det,
     ];
     // lambda_max of the 2x2 inverse.
     let (tr, dt) = (pinv[0] + pinv[3], pinv[0] * pinv[3] - pinv[1] * pinv[2]);
@@ -613,9 +458,9 @@ fn pendulum_half_space_uses_inverse_metric() {
             .map(|k| {
                 // |d|_P = r on the ellipse: d = r L^-T (cos, sin) with P = L L'.
                 let a = f64::from(k) * std::f64::consts::PI / 360.0;
-                let l11 = PENDULUM_P[0].sqrt();
-                let l21 = PENDULUM_P[2] / l11;
-                let l22 = (PENDULUM_P[3] - l21 * l21).sqrt();
+                let l11 = PENDULUM_METRIC[0].sqrt();
+                let l21 = PENDULUM_METRIC[2] / l11;
+                let l22 = (PENDULUM_METRIC[3] - l21 * l21).sqrt();
                 let (u, v) = (a.cos(), a.sin());
                 let d1 = v / l22;
                 let d0 = (u - l21 * d1) / l11;
@@ -638,9 +483,9 @@ fn pendulum_radii_finite_and_decreasing() {
     assert_eq!(res.steps().len(), 401);
     // r1 = |(pi/10, 0.2)|_P (the vertex maximising d'Pd, both signs agree with P_12 > 0).
     let d = [std::f64::consts::PI / 10.0, 0.2];
-    let r1 = (PENDULUM_P[0] * d[0] * d[0]
-        + 2.0 * PENDULUM_P[1] * d[0] * d[1]
-        + PENDULUM_P[3] * d[1] * d[1])
+    let r1 = (PENDULUM_METRIC[0] * d[0] * d[0]
+        + 2.0 * PENDULUM_METRIC[1] * d[0] * d[1]
+        + PENDULUM_METRIC[3] * d[1] * d[1])
         .sqrt();
     assert!(res.r1() >= r1 && res.r1() - r1 < 1e-14);
     for st in res.steps() {
@@ -851,8 +696,8 @@ fn reach_from_a_box_is_the_run_from_that_box() {
     assert!(prs.at(0.305).is_none() && prs.contains(&[0.0, 0.0], 0.305).is_none());
     assert_eq!(prs.contains(st.nominal(), 0.3), Some(true));
     // The hull: the P-ball's extent along each axis, r sqrt((P^-1)_ii), rounded outward.
-    let det = PENDULUM_P[0] * PENDULUM_P[3] - PENDULUM_P[1] * PENDULUM_P[2];
-    let spread = [PENDULUM_P[3] / det, PENDULUM_P[0] / det].map(f64::sqrt);
+    let det = PENDULUM_METRIC[0] * PENDULUM_METRIC[3] - PENDULUM_METRIC[1] * PENDULUM_METRIC[2];
+    let spread = [PENDULUM_METRIC[3] / det, PENDULUM_METRIC[0] / det].map(f64::sqrt);
     let hull = prs.hull(0.3).unwrap();
     for i in 0..2 {
         let (c, e) = (st.nominal()[i], st.prs_radius * spread[i]);
@@ -867,8 +712,8 @@ fn reach_from_a_box_is_the_run_from_that_box() {
         // The hull is tight: the P-ball's extreme point along axis i, c + r P^-1 e_i /
         // sqrt((P^-1)_ii), is in the PRS when pulled in slightly, not when pushed out.
         let pinv_col = [
-            [PENDULUM_P[3] / det, -PENDULUM_P[2] / det],
-            [-PENDULUM_P[1] / det, PENDULUM_P[0] / det],
+            [PENDULUM_METRIC[3] / det, -PENDULUM_METRIC[2] / det],
+            [-PENDULUM_METRIC[1] / det, PENDULUM_METRIC[0] / det],
         ][i];
         for (s, inside) in [(0.999, true), (1.001, false)] {
             let x: Vec<f64> = (0..2)
@@ -987,7 +832,12 @@ fn reach_at_another_delta() {
 
 /// `dX = a X dt + dW` in `R^1` from `X0 = x0`, with the certified rate `c = a`.
 fn growing(a: f64, x0: f64, horizon: f64, guarantee: Guarantee) -> (Linear, ModelInfo) {
-    let sys = Linear { n: 1, a, s: 1.0 };
+    let sys = Linear {
+        n: 1,
+        a,
+        b: 0.0,
+        s: 1.0,
+    };
     let mut inf = info("growing", &["x"], vec![(x0, x0)], vec![]);
     let constants = Constants::given(&inf, vec![1.0], a, 1.0, 0.0);
     let mut an = analysis(1e-2, horizon, 0.1, constants);

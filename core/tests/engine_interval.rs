@@ -3,59 +3,24 @@
 //! paper's pendulum against sampled trajectories, safety margins, renderings.
 
 use reachc_core::engine::{self, RunError};
-use reachc_core::interval::Interval;
 use reachc_core::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, Inclusion, InitialSet, Integrator, Method,
-    ModelInfo, Transform, TransformSource, UnsafeSet, UnsafeShape,
+    Analysis, AnalysisSpec, Bounds, Constants, Inclusion, Integrator, Method, ModelInfo, Transform,
+    TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_core::prs::{DetSet, Prs, Unproved, Verdict};
 use reachc_core::{Reach, System};
 
-mod common;
-use common::Pend;
+use reachc_test_support::flow::rk4_step;
+use reachc_test_support::models::{model, pendulum_constants, pendulum_model};
+use reachc_test_support::rng::Rng;
+use reachc_test_support::systems::{Linear, Pendulum};
 
 // ---------------------------------------------------------------------------------------------
 // Systems
 // ---------------------------------------------------------------------------------------------
 
-/// `dX = (-X + u) dt + 0.1 dW`, `u in [-1, 1]`.
-struct Lin;
-
-impl System for Lin {
-    fn n(&self) -> usize {
-        1
-    }
-    fn p(&self) -> usize {
-        1
-    }
-    fn m(&self) -> usize {
-        1
-    }
-    fn drift(&self, x: &[f64], u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = -x[0] + u[0];
-    }
-    fn drift_interval(&self, x: &[Interval], u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = -x[0] + u[0];
-    }
-    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = -1.0;
-    }
-    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::point(-1.0);
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = 1.0;
-    }
-    fn jac_u_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::ONE;
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = 0.1;
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::point(0.1);
-    }
-}
+/// `dX = (-X + u) dt + 0.1 dW`, `u in [-1, 1]` ([`lin_info`]).
+const LIN: Linear = Linear::WITH_INPUT;
 
 // ---------------------------------------------------------------------------------------------
 // Model data
@@ -90,60 +55,15 @@ fn run_with(
 
 fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
     ModelInfo {
-        goals: Vec::new(),
-        name: "lin".into(),
-        states: vec!["x".into()],
         inputs: vec!["u".into()],
-        noises: vec!["w".into()],
         input_box: vec![Bounds::new(-1.0, 1.0)],
-        initial: InitialSet {
-            boxes: vec![Some(Bounds::new(0.5, 1.5))],
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
         unsafe_sets,
-        analyses: vec![],
+        ..model("lin", &["x"], &["w"], &[(0.5, 1.5)])
     }
 }
 
 fn lin_constants() -> Constants {
     Constants::given(&lin_info(vec![]), vec![1.0], -1.0, 0.1, 1.0)
-}
-
-fn pendulum_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
-    let th = std::f64::consts::PI / 10.0;
-    ModelInfo {
-        goals: Vec::new(),
-        name: "pendulum".into(),
-        states: vec!["theta".into(), "omega".into()],
-        inputs: vec![],
-        noises: vec!["w".into()],
-        input_box: vec![],
-        initial: InitialSet {
-            boxes: vec![Some(Bounds::new(-th, th)), Some(Bounds::new(-0.2, 0.2))],
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE; 2],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
-        unsafe_sets,
-        analyses: vec![],
-    }
-}
-
-/// The paper's constants.
-fn pendulum_constants() -> Constants {
-    Constants::given(
-        &pendulum_info(vec![]),
-        vec![35.68, 2.21, 2.21, 1.27],
-        -0.5,
-        0.1130,
-        0.0,
-    )
 }
 
 /// The box `(lo, hi)` of a box step.
@@ -164,37 +84,6 @@ fn half_widths(res: &Prs, k: usize) -> Vec<f64> {
     lo.iter().zip(hi).map(|(a, b)| 0.5 * (b - a)).collect()
 }
 
-/// A small deterministic generator (xorshift64*), uniform in `[0, 1)`.
-struct Rng(u64);
-
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-fn rk4_step(sys: &dyn System, x: &mut [f64], h: f64) {
-    let n = x.len();
-    let f = |y: &[f64]| {
-        let mut o = vec![0.0; n];
-        sys.drift(y, &[], 0.0, &mut o);
-        o
-    };
-    let k1 = f(x);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k1[i]).collect();
-    let k2 = f(&y);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k2[i]).collect();
-    let k3 = f(&y);
-    let y: Vec<f64> = (0..n).map(|i| x[i] + h * k3[i]).collect();
-    let k4 = f(&y);
-    for i in 0..n {
-        x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-    }
-}
-
 // ---------------------------------------------------------------------------------------------
 // (a) Linear system with an input: closed-form reachable set
 // ---------------------------------------------------------------------------------------------
@@ -204,7 +93,7 @@ fn linear_box_matches_exact_reachable_set() {
     for inclusion in [Inclusion::Jacobian, Inclusion::Natural, Inclusion::Mixed] {
         for (integrator, tol) in [(Integrator::Rk4, 1e-9), (Integrator::Euler, 1e-2)] {
             let a = analysis(2.0, 0.01, integrator, lin_constants());
-            let res = run_with(&Lin, &lin_info(vec![]), &a, inclusion).unwrap();
+            let res = run_with(&LIN, &lin_info(vec![]), &a, inclusion).unwrap();
             for st in res.steps() {
                 let e = (-st.t).exp();
                 let (xlo, xhi) = (0.5 * e - (1.0 - e), 1.5 * e + (1.0 - e));
@@ -234,7 +123,7 @@ fn linear_box_matches_exact_reachable_set() {
 fn linear_runs_through_dispatch() {
     let a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
     let info = lin_info(vec![]);
-    let res = engine::run(&Lin, &info, &a).unwrap();
+    let res = engine::run(&LIN, &info, &a).unwrap();
     assert_eq!(res.method(), Method::Interval);
     assert_eq!(res.inclusion(), Some(Inclusion::Jacobian));
     assert_eq!(res.steps().len(), 11);
@@ -248,7 +137,7 @@ fn linear_runs_through_dispatch() {
     // r_t agrees with the contraction engine's (same Psi_t, kappa).
     let mut c = a.clone();
     c.spec.method = Method::Contraction;
-    let rc = engine::run(&Lin, &info, &c).unwrap();
+    let rc = engine::run(&LIN, &info, &c).unwrap();
     for (s, t) in res.steps().iter().zip(rc.steps()) {
         assert_eq!(s.r_t, t.r_t);
         assert_eq!(s.psi, t.psi);
@@ -269,7 +158,7 @@ fn refuses_transform_and_missing_constants() {
         source: TransformSource::Given,
     });
     assert!(matches!(
-        engine::run(&Lin, &lin_info(vec![]), &a),
+        engine::run(&LIN, &lin_info(vec![]), &a),
         Err(RunError::Unsupported(_))
     ));
     let mut a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
@@ -277,7 +166,7 @@ fn refuses_transform_and_missing_constants() {
         constant: "c".into(),
     });
     assert!(matches!(
-        engine::run(&Lin, &lin_info(vec![]), &a),
+        engine::run(&LIN, &lin_info(vec![]), &a),
         Err(RunError::NoConstants(_))
     ));
 }
@@ -318,7 +207,7 @@ fn linear_safety_and_membership() {
         },
     ];
     let a = analysis(2.0, 0.01, Integrator::Rk4, lin_constants());
-    let res = engine::run(&Lin, &lin_info(sets), &a).unwrap();
+    let res = engine::run(&LIN, &lin_info(sets), &a).unwrap();
     assert!(res.unsafe_sets()[0].safe && res.unsafe_sets()[1].safe && res.unsafe_sets()[2].safe);
     assert!(!res.unsafe_sets()[3].safe);
     assert_eq!(
@@ -360,11 +249,11 @@ fn linear_safety_and_membership() {
 
 #[test]
 fn pendulum_boxes_contain_sampled_trajectories() {
-    let info = pendulum_info(vec![]);
-    let a = analysis(4.0, 0.01, Integrator::Rk4, pendulum_constants());
-    let jac = run_with(&Pend::PAPER, &info, &a, Inclusion::Jacobian).unwrap();
-    let nat = run_with(&Pend::PAPER, &info, &a, Inclusion::Natural);
-    let mixed = run_with(&Pend::PAPER, &info, &a, Inclusion::Mixed).unwrap();
+    let info = pendulum_model();
+    let a = analysis(4.0, 0.01, Integrator::Rk4, pendulum_constants(&info));
+    let jac = run_with(&Pendulum::PAPER, &info, &a, Inclusion::Jacobian).unwrap();
+    let nat = run_with(&Pendulum::PAPER, &info, &a, Inclusion::Natural);
+    let mixed = run_with(&Pendulum::PAPER, &info, &a, Inclusion::Mixed).unwrap();
     let th = std::f64::consts::PI / 10.0;
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let sub = 20; // fine step 0.0005
@@ -379,7 +268,7 @@ fn pendulum_boxes_contain_sampled_trajectories() {
             if k > 0 {
                 let h = (st.t - jac.steps()[k - 1].t) / sub as f64;
                 for _ in 0..sub {
-                    rk4_step(&Pend::PAPER, &mut x, h);
+                    rk4_step(&Pendulum::PAPER, &mut x, &[], 0.0, h);
                 }
             }
             let mut results = vec![&jac, &mixed];

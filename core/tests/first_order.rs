@@ -4,41 +4,24 @@
 //! closed-form `exp(A t)` image of the initial box with a remainder at rounding level.
 
 use reachc_core::engine;
-use reachc_core::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo,
-};
+use reachc_core::model::{Analysis, AnalysisSpec, Method, ModelInfo};
 use reachc_core::prs::{DetSet, Prs};
-use reachc_core::System;
 
-mod common;
+use reachc_test_support::flow::rk4_step;
+use reachc_test_support::models::{pendulum_constants, pendulum_model};
+use reachc_test_support::systems::Pendulum;
 
-use common::Pend;
-
-const P: [f64; 4] = [35.68, 2.21, 2.21, 1.27];
+/// The half-widths of the pendulum's initial box (centred at 0).
 const HALF: [f64; 2] = [std::f64::consts::PI / 10.0, 0.2];
 
 /// The model with the initial box `[-HALF, HALF]` and the paper's constants, and one analysis
 /// of `method` with the defaults (validated steps, time-uniform tube, local rates).
 fn setup(method: Method) -> (ModelInfo, Analysis) {
     let info = ModelInfo {
-        goals: Vec::new(),
         name: "pend".into(),
-        states: vec!["theta".into(), "omega".into()],
-        inputs: vec![],
-        noises: vec!["w".into()],
-        input_box: vec![],
-        initial: InitialSet {
-            boxes: HALF.iter().map(|&h| Some(Bounds::new(-h, h))).collect(),
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE; 2],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
-        unsafe_sets: vec![],
-        analyses: vec![],
+        ..pendulum_model()
     };
-    let constants = Constants::given(&info, P.to_vec(), -0.5, 0.1130, 0.0);
+    let constants = pendulum_constants(&info);
     let analysis = Analysis {
         spec: AnalysisSpec {
             name: "main".into(),
@@ -62,23 +45,12 @@ fn zonotope_member(prs: &Prs) -> &Prs {
 }
 
 /// The noise-free flow from `x` over `[0, t]` (RK4, step 1e-4).
-fn flow(sys: &Pend, x: [f64; 2], t: f64) -> [f64; 2] {
-    let f = |x: [f64; 2]| {
-        let mut d = [0.0; 2];
-        sys.drift(&x, &[], 0.0, &mut d);
-        d
-    };
+fn flow(sys: &Pendulum, x: [f64; 2], t: f64) -> [f64; 2] {
     let steps = (t / 1e-4).round() as usize;
     let h = t / steps as f64;
     let mut x = x;
     for _ in 0..steps {
-        let k1 = f(x);
-        let k2 = f([x[0] + 0.5 * h * k1[0], x[1] + 0.5 * h * k1[1]]);
-        let k3 = f([x[0] + 0.5 * h * k2[0], x[1] + 0.5 * h * k2[1]]);
-        let k4 = f([x[0] + h * k3[0], x[1] + h * k3[1]]);
-        for i in 0..2 {
-            x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
+        rk4_step(sys, &mut x, &[], 0.0, h);
     }
     x
 }
@@ -97,7 +69,7 @@ fn starts() -> Vec<[f64; 2]> {
 
 /// For each report time in `times`: the largest sampled `|x - y|_P` (`y = c + G eta` for the
 /// start's own `eta`) against the remainder, and the sampled hull against the zonotope's.
-fn check(sys: &Pend, prs: &Prs, times: &[f64]) -> Vec<(f64, f64, [f64; 2], [f64; 2])> {
+fn check(sys: &Pendulum, prs: &Prs, times: &[f64]) -> Vec<(f64, f64, [f64; 2], [f64; 2])> {
     let member = zonotope_member(prs);
     let p = &member.constants().metric;
     times
@@ -146,7 +118,7 @@ fn check(sys: &Pend, prs: &Prs, times: &[f64]) -> Vec<(f64, f64, [f64; 2], [f64;
 
 #[test]
 fn pendulum_first_order_sets_hold_the_sampled_flows_both_methods() {
-    let sys = Pend::PAPER;
+    let sys = Pendulum::PAPER;
     for method in [Method::Contraction, Method::Interval] {
         let (info, analysis) = setup(method);
         let prs = engine::run(&sys, &info, &analysis).expect("runs");
@@ -178,7 +150,7 @@ fn pendulum_first_order_sets_hold_the_sampled_flows_both_methods() {
 #[test]
 fn linear_first_order_set_is_the_closed_form_image() {
     // A = [[0, 1], [-20, -20]]: eigenvalues l = -10 +- sqrt(80), exp(A t) in closed form.
-    let sys = Pend { k: 0.0 };
+    let sys = Pendulum { k: 0.0 };
     let (info, analysis) = setup(Method::Contraction);
     let prs = engine::run(&sys, &info, &analysis).expect("runs");
     let member = zonotope_member(&prs);

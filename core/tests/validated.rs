@@ -6,11 +6,11 @@
 
 use reachc_core::interval::Interval;
 use reachc_core::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
-    ModelInfo, Rate,
+    Analysis, AnalysisSpec, Constants, Guarantee, Integrator, Method, ModelInfo, Rate,
 };
 use reachc_core::prs::Prs;
 use reachc_core::{Reach, System};
+use reachc_test_support::models;
 
 /// `x' = -20 x + y`, `y' = -0.1 y` (with `a = 20`, `b = 0.1`): stiff, no noise.
 struct Stiff;
@@ -108,23 +108,8 @@ fn forced_exact(x0: f64, t: f64) -> f64 {
 fn model(name: &str, x0: &[(f64, f64)], c: f64) -> ModelInfo {
     let n = x0.len();
     let mut info = ModelInfo {
-        goals: Vec::new(),
-        name: name.into(),
         states: (0..n).map(|i| format!("x{i}")).collect(),
-        inputs: vec![],
-        noises: vec!["w".into()],
-        input_box: vec![],
-        initial: InitialSet::from_box(
-            &x0.iter()
-                .map(|&(a, b)| Bounds::new(a, b))
-                .collect::<Vec<_>>(),
-        ),
-        domain: vec![Bounds::ENTIRE; n],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
-        unsafe_sets: vec![],
-        analyses: vec![],
+        ..models::model(name, &[], &["w"], x0)
     };
     let identity = (0..n * n)
         .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })

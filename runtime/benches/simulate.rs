@@ -13,6 +13,7 @@ use reachc_runtime::model::*;
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::System;
 use reachc_runtime::X8;
+use reachc_test_support::models::model;
 
 /// Paths per iteration.
 const PATHS: u64 = 100_000;
@@ -76,24 +77,7 @@ impl System for Linear {
 
 /// The `amgf_rule` analysis of specs/linear.sde with the compiler's constants.
 fn info() -> ModelInfo {
-    let mut info = ModelInfo {
-        goals: Vec::new(),
-        name: "linear".into(),
-        states: vec!["x1".into(), "x2".into()],
-        inputs: vec![],
-        noises: vec!["w1".into(), "w2".into()],
-        input_box: vec![],
-        initial: InitialSet {
-            boxes: vec![Some(Bounds::new(0.0, 0.0)); 2],
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE; 2],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
-        unsafe_sets: vec![],
-        analyses: vec![],
-    };
+    let mut info = model("linear", &["x1", "x2"], &["w1", "w2"], &[(0.0, 0.0); 2]);
     let constants = Constants::given(
         &info,
         vec![1.0, 0.0, 0.0, 1.0],

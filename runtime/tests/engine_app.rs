@@ -1,93 +1,39 @@
 //! The generated binaries' `main`: argument parsing, exit codes, skipped analyses, output files.
 
-use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
-use reachc_runtime::interval::Interval;
+mod common;
+
+use reachc_runtime::app::{EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, GoalSet, InitialSet, Method, ModelInfo, Transform,
-    TransformSource, UnsafeSet, UnsafeShape,
+    Analysis, Bounds, Constants, GoalSet, Method, ModelInfo, Transform, TransformSource, UnsafeSet,
+    UnsafeShape,
 };
-use reachc_runtime::{report, Reach, System};
+use reachc_runtime::{report, Reach};
+use reachc_test_support::models;
+use reachc_test_support::systems::Linear;
 
 /// `dx = -x dt + 0.5 dW` in one dimension.
-struct Decay;
-
-impl System for Decay {
-    fn n(&self) -> usize {
-        1
-    }
-    fn p(&self) -> usize {
-        0
-    }
-    fn m(&self) -> usize {
-        1
-    }
-    fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = -x[0];
-    }
-    fn drift_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = -x[0];
-    }
-    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = -1.0;
-    }
-    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::point(-1.0);
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-    fn jac_u_interval(
-        &self,
-        _x: &[Interval],
-        _u: &[Interval],
-        _t: Interval,
-        _out: &mut [Interval],
-    ) {
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = 0.5;
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = Interval::point(0.5);
-    }
-}
+const DECAY: Linear = Linear {
+    n: 1,
+    a: -1.0,
+    b: 0.0,
+    s: 0.5,
+};
 
 fn analysis(name: &str, method: Method, constants: bool) -> Analysis {
-    Analysis {
-        spec: AnalysisSpec {
-            name: name.into(),
-            method,
-            delta: 0.01,
-            horizon: 1.0,
-            step: 0.1,
-            ..AnalysisSpec::default()
-        },
-        constants: if constants {
-            Ok(Constants::given(&model(vec![]), vec![1.0], -1.0, 0.5, 0.0))
-        } else {
-            Err(reachc_runtime::model::NoConstants::NotCertified {
-                constant: "not bounded c".into(),
-            })
-        },
-    }
+    let constants = if constants {
+        Ok(Constants::given(&model(vec![]), vec![1.0], -1.0, 0.5, 0.0))
+    } else {
+        Err(reachc_runtime::model::NoConstants::NotCertified {
+            constant: "not bounded c".into(),
+        })
+    };
+    common::decay_analysis(name, method, constants)
 }
 
 fn model(analyses: Vec<Analysis>) -> ModelInfo {
     ModelInfo {
-        goals: Vec::new(),
-        name: "decay".into(),
-        states: vec!["x".into()],
-        inputs: vec![],
-        noises: vec!["w".into()],
-        input_box: vec![],
-        initial: InitialSet {
-            boxes: vec![Some(Bounds::new(0.9, 1.1))],
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
-        unsafe_sets: vec![],
         analyses,
+        ..models::model("decay", &["x"], &["w"], &[(0.9, 1.1)])
     }
 }
 
@@ -98,14 +44,7 @@ fn tmp_dir(tag: &str) -> std::path::PathBuf {
 }
 
 fn cli(info: &ModelInfo, args: &[&str]) -> (u8, String, String) {
-    let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = run_cli(&Decay, info, &args, &mut out, &mut err);
-    (
-        code,
-        String::from_utf8(out).unwrap(),
-        String::from_utf8(err).unwrap(),
-    )
+    common::run_main(&DECAY, info, args)
 }
 
 #[test]
@@ -186,8 +125,8 @@ fn results_render() {
         analysis("ball", Method::Contraction, true),
         analysis("boxes", Method::Interval, true),
     ]);
-    let ball = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
-    let boxes = Reach::new(&Decay, &info, "boxes").unwrap().run().unwrap();
+    let ball = Reach::new(&DECAY, &info, "ball").unwrap().run().unwrap();
+    let boxes = Reach::new(&DECAY, &info, "boxes").unwrap().run().unwrap();
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&ball)).unwrap();
     assert_eq!(v["method"], "contraction");
     assert!(v.get("inclusion").is_none());
@@ -223,7 +162,7 @@ fn results_render() {
     // An integrator the user asked for is labelled.
     let mut euler = info.clone();
     euler.analyses[1].spec.integrator = reachc_runtime::model::Integrator::Euler;
-    let unvalidated = Reach::new(&Decay, &euler, "boxes").unwrap().run().unwrap();
+    let unvalidated = Reach::new(&DECAY, &euler, "boxes").unwrap().run().unwrap();
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&unvalidated)).unwrap();
     assert!(v["validated"]["not_validated"][0]
         .as_str()
@@ -289,7 +228,7 @@ fn moving_sets_are_written_with_their_positions() {
         window: None,
         stay: false,
     }];
-    let mut prs = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
+    let mut prs = Reach::new(&DECAY, &info, "ball").unwrap().run().unwrap();
     let steps = prs.steps().len();
     assert!(steps > 2);
     // The wall moves out by 0.25 per report interval, the goal's centre by 0.125.
@@ -330,6 +269,6 @@ fn moving_sets_are_written_with_their_positions() {
         u.swept.clear();
     }
     prs.goals_mut()[0].swept.clear();
-    let fixed = Reach::new(&Decay, &info, "ball").unwrap().run().unwrap();
+    let fixed = Reach::new(&DECAY, &info, "ball").unwrap().run().unwrap();
     assert_eq!(report::to_json(&prs), report::to_json(&fixed));
 }

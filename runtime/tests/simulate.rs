@@ -2,76 +2,17 @@
 //! the linear example, independence of the thread count, a wrong PRS caught by the coverage
 //! check, and the `simulate` command line of generated binaries.
 
-use reachc_runtime::app::{run_cli, EXIT_FAILED, EXIT_OK, EXIT_USAGE};
+mod common;
+
+use reachc_runtime::app::{EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::engine;
-use reachc_runtime::interval::Interval;
 use reachc_runtime::merge::merge_files;
 use reachc_runtime::model::*;
 use reachc_runtime::report::simulation::{summary, to_json};
 use reachc_runtime::simulate::{self, InputMode, Options, SimReport};
-use reachc_runtime::{Prs, System};
-
-/// `dx = (a x + b u) dt + s dW` per state, `n` states, one input shared by all (`b = 0`: none).
-struct Linear {
-    n: usize,
-    a: f64,
-    b: f64,
-    s: f64,
-}
-
-impl System for Linear {
-    fn n(&self) -> usize {
-        self.n
-    }
-    fn p(&self) -> usize {
-        usize::from(self.b != 0.0)
-    }
-    fn m(&self) -> usize {
-        self.n
-    }
-    fn drift(&self, x: &[f64], u: &[f64], _t: f64, out: &mut [f64]) {
-        for i in 0..self.n {
-            out[i] = self.a * x[i] + u.first().map_or(0.0, |u| self.b * u);
-        }
-    }
-    fn drift_interval(&self, x: &[Interval], u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        for i in 0..self.n {
-            out[i] = Interval::point(self.a) * x[i]
-                + u.first()
-                    .map_or(Interval::ZERO, |&u| Interval::point(self.b) * u);
-        }
-    }
-    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out.fill(0.0);
-        for i in 0..self.n {
-            out[i * self.n + i] = self.a;
-        }
-    }
-    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out.fill(Interval::ZERO);
-        for i in 0..self.n {
-            out[i * self.n + i] = Interval::point(self.a);
-        }
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out.fill(self.b);
-    }
-    fn jac_u_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out.fill(Interval::point(self.b));
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out.fill(0.0);
-        for i in 0..self.n {
-            out[i * self.n + i] = self.s;
-        }
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out.fill(Interval::ZERO);
-        for i in 0..self.n {
-            out[i * self.n + i] = Interval::point(self.s);
-        }
-    }
-}
+use reachc_runtime::Prs;
+use reachc_test_support::models::model;
+use reachc_test_support::systems::Linear;
 
 /// The paper's linear example (specs/linear.sde): n = 2, a = -0.4, s = sqrt(2), X0 = 0.
 const LINEAR: Linear = Linear {
@@ -98,28 +39,8 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
         metric[i * n + i] = 1.0;
     }
     let mut info = ModelInfo {
-        goals: Vec::new(),
-        name: "linear".into(),
         states: (1..=n).map(|i| format!("x{i}")).collect(),
-        inputs: if sys.b != 0.0 {
-            vec!["u".into()]
-        } else {
-            vec![]
-        },
         noises: (1..=n).map(|i| format!("w{i}")).collect(),
-        input_box: if sys.b != 0.0 {
-            vec![Bounds::new(-h, h)]
-        } else {
-            vec![]
-        },
-        initial: InitialSet {
-            boxes: vec![Some(Bounds::new(x0 - w, x0 + w)); n],
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE; n],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
         unsafe_sets: vec![UnsafeSet {
             name: "far".into(),
             shape: UnsafeShape::HalfSpace {
@@ -128,8 +49,12 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
             },
             moving: Vec::new(),
         }],
-        analyses: vec![],
+        ..model("linear", &[], &[], &vec![(x0 - w, x0 + w); n])
     };
+    if sys.b != 0.0 {
+        info.inputs = vec!["u".into()];
+        info.input_box = vec![Bounds::new(-h, h)];
+    }
     let constants = Constants::given(
         &info,
         metric,
@@ -511,14 +436,7 @@ fn reports_say_what_was_checked() {
 }
 
 fn cli(info: &ModelInfo, args: &[&str]) -> (u8, String, String) {
-    let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
-    let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = run_cli(&LINEAR, info, &args, &mut out, &mut err);
-    (
-        code,
-        String::from_utf8(out).unwrap(),
-        String::from_utf8(err).unwrap(),
-    )
+    common::run_main(&LINEAR, info, args)
 }
 
 #[test]

@@ -2,58 +2,23 @@
 //! of an intersection: the JSON shape and its fields, the CSV and summary, the bounding boxes
 //! and membership.
 
-use reachc_runtime::interval::Interval;
+mod common;
+
 use reachc_runtime::model::*;
 use reachc_runtime::prs::{DetSet, Role};
-use reachc_runtime::{report, Prs, Reach, System};
+use reachc_runtime::{report, Prs, Reach};
+use reachc_test_support::models;
+use reachc_test_support::rng::Lcg64;
+use reachc_test_support::sets::zonotope_in_box;
+use reachc_test_support::systems::Linear;
 
 /// `dx = -x dt + 0.2 dW` in two states.
-struct Decay;
-
-impl System for Decay {
-    fn n(&self) -> usize {
-        2
-    }
-    fn p(&self) -> usize {
-        0
-    }
-    fn m(&self) -> usize {
-        2
-    }
-    fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out[0] = -x[0];
-        out[1] = -x[1];
-    }
-    fn drift_interval(&self, x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        out[0] = -x[0];
-        out[1] = -x[1];
-    }
-    fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[-1.0, 0.0, 0.0, -1.0]);
-    }
-    fn jac_x_interval(&self, _x: &[Interval], _u: &[Interval], _t: Interval, out: &mut [Interval]) {
-        for (o, v) in out.iter_mut().zip([-1.0, 0.0, 0.0, -1.0]) {
-            *o = Interval::point(v);
-        }
-    }
-    fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-    fn jac_u_interval(
-        &self,
-        _x: &[Interval],
-        _u: &[Interval],
-        _t: Interval,
-        _out: &mut [Interval],
-    ) {
-    }
-    fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-        out.copy_from_slice(&[0.2, 0.0, 0.0, 0.2]);
-    }
-    fn diffusion_interval(&self, _x: &[Interval], _t: Interval, out: &mut [Interval]) {
-        for (o, v) in out.iter_mut().zip([0.2, 0.0, 0.0, 0.2]) {
-            *o = Interval::point(v);
-        }
-    }
-}
+const DECAY: Linear = Linear {
+    n: 2,
+    a: -1.0,
+    b: 0.0,
+    s: 0.2,
+};
 
 /// The metric `P` and its inverse.
 const P: [f64; 4] = [2.0, 0.5, 0.5, 1.0];
@@ -71,37 +36,16 @@ fn dual_norm(a: &[f64]) -> f64 {
 }
 
 fn model() -> ModelInfo {
-    let mut info = ModelInfo {
-        goals: Vec::new(),
-        name: "decay".into(),
-        states: vec!["x".into(), "y".into()],
-        inputs: vec![],
-        noises: vec!["w1".into(), "w2".into()],
-        input_box: vec![],
-        initial: InitialSet {
-            boxes: vec![Some(Bounds::new(0.9, 1.1)), Some(Bounds::new(-0.2, 0.2))],
-            balls: vec![],
-        },
-        domain: vec![Bounds::ENTIRE; 2],
-        has_domain: false,
-        affine: false,
-        constant_diffusion: false,
-        unsafe_sets: vec![],
-        analyses: vec![],
-    };
+    let mut info = models::model(
+        "decay",
+        &["x", "y"],
+        &["w1", "w2"],
+        &[(0.9, 1.1), (-0.2, 0.2)],
+    );
     for (name, method) in [("ball", Method::Contraction), ("boxes", Method::Interval)] {
         let constants = Constants::given(&info, P.to_vec(), -1.0, 0.3, 0.0);
-        info.analyses.push(Analysis {
-            spec: AnalysisSpec {
-                name: name.into(),
-                method,
-                delta: 0.01,
-                horizon: 1.0,
-                step: 0.1,
-                ..AnalysisSpec::default()
-            },
-            constants: Ok(constants),
-        });
+        info.analyses
+            .push(common::decay_analysis(name, method, Ok(constants)));
     }
     info
 }
@@ -109,18 +53,13 @@ fn model() -> ModelInfo {
 /// The interval run with each box replaced by the zonotope of [`GENS`] around its centre plus
 /// a remainder of `0.5 r_t`.
 fn zonotopes() -> Prs {
-    let mut r = Reach::new(&Decay, &model(), "boxes")
+    let mut r = Reach::new(&DECAY, &model(), "boxes")
         .unwrap()
         .run()
         .unwrap();
     for st in r.steps_mut() {
         let (lo, hi) = st.det.box_hull().unwrap();
-        let center: Vec<f64> = (0..2).map(|i| 0.5 * (lo[i] + hi[i])).collect();
-        let half: Vec<f64> = (0..2).map(|i| 0.5 * (hi[i] - lo[i])).collect();
-        let generators: Vec<f64> = GENS
-            .iter()
-            .flat_map(|g| [g[0] * half[0], g[1] * half[1]])
-            .collect();
+        let (center, generators) = zonotope_in_box(lo, hi, &GENS);
         let reach: Vec<f64> = (0..2)
             .map(|i| (generators[i].abs() + generators[2 + i].abs()) * 1.000_000_1)
             .collect();
@@ -144,7 +83,7 @@ fn zonotopes() -> Prs {
 
 /// The contraction run's ball alone (without the interval box it may be cut by).
 fn ball() -> Prs {
-    let mut r = Reach::new(&Decay, &model(), "ball").unwrap().run().unwrap();
+    let mut r = Reach::new(&DECAY, &model(), "ball").unwrap().run().unwrap();
     r.also_mut().clear();
     r
 }
@@ -253,13 +192,8 @@ fn zonotopes_render() {
 #[test]
 fn zonotope_hulls_and_membership() {
     let (z, ball, cut) = (zonotopes(), ball(), ball_cut_by_zonotopes());
-    let mut s = 7u64;
-    let mut rnd = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut rng = Lcg64(7);
+    let mut rnd = move || rng.range(-1.0, 1.0);
     let (mut inside, mut outside) = (0, 0);
     for (k, st) in z.steps().iter().enumerate() {
         let DetSet::Zonotope {

@@ -88,7 +88,7 @@ fn main() {
 /// README line for each.
 fn save_findings(records: &[Record], dir: &std::path::Path, runs: usize) {
     let mut seen = std::collections::BTreeSet::new();
-    let scratch = Scratch::new("minimise");
+    let scratch = Scratch::new("fuzz-minimise");
     std::fs::create_dir_all(dir).expect("the findings folder can be created");
     println!("\n| reproducer | command | outcome | from |\n|---|---|---|---|");
     for r in records.iter().filter(|r| r.outcome.is_failure()) {

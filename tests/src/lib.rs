@@ -101,13 +101,7 @@ pub fn benchmark_specs() -> Vec<PathBuf> {
 
 /// The `.sde` files of the workspace folder `dir`, sorted by name.
 fn specs_in(dir: &str) -> Vec<PathBuf> {
-    let mut specs: Vec<PathBuf> = std::fs::read_dir(workspace().join(dir))
-        .unwrap_or_else(|e| panic!("{dir}: {e}"))
-        .map(|e| e.expect("readable entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "sde"))
-        .collect();
-    specs.sort();
-    specs
+    reachc_test_support::files::with_extension(&workspace().join(dir), "sde")
 }
 
 /// The path of `p` relative to the workspace, with `/` separators (for snapshot stability).
@@ -116,78 +110,6 @@ pub fn relative(p: &Path) -> String {
         .unwrap_or(p)
         .to_string_lossy()
         .replace('\\', "/")
-}
-
-/// A small deterministic generator (xorshift64*), so failing samples reproduce.
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// Uniform in `[0, 1)`.
-    #[allow(clippy::should_implement_trait)] // not an iterator: it never ends
-    pub fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in `[lo, hi)`.
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-
-    /// Standard normal (Box-Muller; the first uniform is kept away from 0).
-    pub fn normal(&mut self) -> f64 {
-        let (u, v) = (1.0 - self.next(), self.next());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
-
-/// Advances `x` from time `*t` to `until` by Euler-Maruyama steps of `dt` of the SDE of `sys`
-/// (no inputs), drawing one normal per noise channel and step from `rng`.
-pub fn euler_maruyama(
-    sys: &dyn reachc_runtime::System,
-    x: &mut [f64],
-    t: &mut f64,
-    until: f64,
-    dt: f64,
-    rng: &mut Rng,
-) {
-    let (n, m) = (sys.n(), sys.m());
-    let (mut f, mut g) = (vec![0.0; n], vec![0.0; n * m]);
-    while *t < until - 1e-12 {
-        sys.drift(x, &[], *t, &mut f);
-        sys.diffusion(x, *t, &mut g);
-        let dw: Vec<f64> = (0..m).map(|_| rng.normal() * dt.sqrt()).collect();
-        for i in 0..n {
-            x[i] += f[i] * dt + (0..m).map(|j| g[i * m + j] * dw[j]).sum::<f64>();
-        }
-        *t += dt;
-    }
-}
-
-/// Advances `x` from time `*t` to `until` by classical RK4 steps of `h` of the noise-free
-/// drift of `sys` (no inputs): the reference flow for sets of noise-free models.
-pub fn rk4(sys: &dyn reachc_runtime::System, x: &mut [f64], t: &mut f64, until: f64, h: f64) {
-    let n = sys.n();
-    let f = |x: &[f64], t: f64| {
-        let mut out = vec![0.0; n];
-        sys.drift(x, &[], t, &mut out);
-        out
-    };
-    let along = |x: &[f64], k: &[f64], s: f64| -> Vec<f64> {
-        x.iter().zip(k).map(|(a, b)| a + s * b).collect()
-    };
-    while *t < until - 1e-12 {
-        let k1 = f(x, *t);
-        let k2 = f(&along(x, &k1, 0.5 * h), *t + 0.5 * h);
-        let k3 = f(&along(x, &k2, 0.5 * h), *t + 0.5 * h);
-        let k4 = f(&along(x, &k3, h), *t + h);
-        for i in 0..n {
-            x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
-        *t += h;
-    }
 }
 
 #[cfg(test)]

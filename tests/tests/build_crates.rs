@@ -22,8 +22,10 @@ use reachc_compiler::package::{
     compile_crate_in, install_runtime, write_crate, BuildError, Cache, CrateOptions,
     InstalledRuntime, Profile, RuntimeDep, WrittenCrate,
 };
-use reachc_e2e::{relative, shipped_specs, workspace, Rng};
+use reachc_e2e::{relative, shipped_specs, workspace};
 use reachc_runtime::{Interval, System};
+use reachc_test_support::files::{with_extension, Scratch};
+use reachc_test_support::rng::Rng;
 
 /// Held by each test that runs cargo: the tests share one target directory, and crates of the
 /// same spec (the probe and the real binary of `pendulum`) would overwrite each other's binary.
@@ -59,24 +61,6 @@ fn runtime() -> &'static InstalledRuntime {
 /// Compiles the crate at `dir` (dev profile) in the shared target directory.
 fn compile(dir: &Path) -> Result<PathBuf, BuildError> {
     compile_crate_in(dir, Profile::Dev, &target_dir(), &mut |_| {})
-}
-
-/// A fresh scratch directory for one test (removed by [`Scratch`]'s drop).
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("reachc-e2e-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 fn spec(name: &str) -> PathBuf {
@@ -125,7 +109,7 @@ fn tree(dir: &Path) -> Vec<(String, Vec<u8>)> {
 
 #[test]
 fn every_shipped_spec_generates_the_same_bytes_twice() {
-    let scratch = Scratch::new("bytes");
+    let scratch = Scratch::new("e2e-bytes");
     for spec in shipped_specs() {
         let name = spec.file_stem().unwrap().to_string_lossy().into_owned();
         let a = scratch.0.join(format!("{name}-a"));
@@ -211,7 +195,7 @@ fn absolute_paths(scratch: &Path) -> Vec<String> {
 
 #[test]
 fn no_generated_file_names_an_absolute_path() {
-    let scratch = Scratch::new("absolute");
+    let scratch = Scratch::new("e2e-absolute");
     let needles = absolute_paths(&scratch.0);
     // The spec by absolute path: the README names its file name only.
     let pendulum = spec("pendulum.sde");
@@ -243,7 +227,7 @@ fn no_generated_file_names_an_absolute_path() {
 #[test]
 fn a_vendored_crate_moves_and_builds_with_plain_cargo() {
     let _cargo = cargo_lock();
-    let scratch = Scratch::new("vendored");
+    let scratch = Scratch::new("e2e-vendored");
     let written_at = scratch.0.join("written").join("pendulum");
     std::fs::create_dir_all(written_at.parent().unwrap()).unwrap();
     let mut loaded = load(&spec("pendulum.sde")).unwrap();
@@ -303,7 +287,7 @@ fn mtimes(dir: &Path) -> Vec<(String, std::time::SystemTime)> {
 #[test]
 fn the_cache_runs_an_unchanged_spec_without_cargo() {
     let _cargo = cargo_lock();
-    let scratch = Scratch::new("cache");
+    let scratch = Scratch::new("e2e-cache");
     // A model name of its own: its crate and binary are this test's alone.
     let text = std::fs::read_to_string(spec("pendulum.sde"))
         .unwrap()
@@ -404,7 +388,7 @@ fn cargo(subcommand: &str, manifest: &Path, args: &[&str]) -> std::process::Outp
 #[test]
 fn small_crates_compile_clippy_clean_and_run() {
     let _cargo = cargo_lock();
-    let scratch = Scratch::new("compile");
+    let scratch = Scratch::new("e2e-compile");
     // The pendulum also with its methods split into helper functions (clippy-clean too).
     let chunked = codegen::Options {
         split_above: 3,
@@ -457,12 +441,7 @@ fn small_crates_compile_clippy_clean_and_run() {
             run.status,
             String::from_utf8_lossy(&run.stderr)
         );
-        let mut json: Vec<PathBuf> = std::fs::read_dir(&results)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "json"))
-            .collect();
-        json.sort();
+        let json = with_extension(&results, "json");
         assert!(!json.is_empty(), "{name}: no JSON in {}", results.display());
         for file in json {
             let text = std::fs::read_to_string(&file).unwrap();
@@ -633,8 +612,8 @@ struct Sample {
 fn sample(model: &Model, rng: &mut Rng) -> Sample {
     // A box of width up to 1e-2 holding `v` (min/max: rounding cannot push `v` out).
     let around = |v: f64, rng: &mut Rng| {
-        let r = rng.uniform(0.0, 1e-2);
-        let lo = v - r * rng.next();
+        let r = rng.range(0.0, 1e-2);
+        let lo = v - r * rng.uniform();
         Interval::new(lo.min(v), (lo + r).max(v))
     };
     let state = |rng: &mut Rng| -> Vec<f64> {
@@ -644,7 +623,7 @@ fn sample(model: &Model, rng: &mut Rng) -> Sample {
             .iter()
             .map(|b| {
                 let (lo, hi) = b.map_or((-2.0, 2.0), |b| (b.lo - 2.0, b.hi + 2.0));
-                rng.uniform(lo, hi)
+                rng.range(lo, hi)
             })
             .collect()
     };
@@ -653,11 +632,11 @@ fn sample(model: &Model, rng: &mut Rng) -> Sample {
         model
             .input_box
             .iter()
-            .map(|b| rng.uniform(b.lo, b.hi))
+            .map(|b| rng.range(b.lo, b.hi))
             .collect()
     };
     let u = input(rng);
-    let t = rng.uniform(0.0, 6.0);
+    let t = rng.range(0.0, 6.0);
     let n = model.states.len();
     // The sample's own state and input, signed zeros, a wide one and states near the initial
     // set with inputs in the box, so the lanes differ from each other.
@@ -666,7 +645,7 @@ fn sample(model: &Model, rng: &mut Rng) -> Sample {
         (x.clone(), u.clone()),
         (vec![0.0; n], vec![0.0; p]),
         (vec![-0.0; n], vec![-0.0; p]),
-        ((0..n).map(|_| rng.uniform(-1e3, 1e3)).collect(), input(rng)),
+        ((0..n).map(|_| rng.range(-1e3, 1e3)).collect(), input(rng)),
     ];
     lanes.extend((0..4).map(|_| (state(rng), input(rng))));
     Sample {
@@ -692,7 +671,7 @@ fn same(a: f64, b: f64) -> bool {
 #[test]
 fn generated_code_agrees_with_the_interpreter() {
     let _cargo = cargo_lock();
-    let scratch = Scratch::new("interp");
+    let scratch = Scratch::new("e2e-interp");
     // Every shipped spec but chain1000 (chain10 has the same equations; the big crate alone
     // takes a minute to compile).
     // Plus a spec whose names are Rust keywords (`fn`, `type`, `impl`, `self`, ...).

@@ -23,6 +23,7 @@ use reachc_compiler::driver::check_source;
 use reachc_runtime::model::{Method, ModelInfo};
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::{Prs, Reach, System};
+use reachc_test_support::flow::rk4_step;
 
 /// The four factors of one spec.
 #[derive(Clone, Copy, Debug)]
@@ -136,11 +137,6 @@ fn first_escape(sys: &dyn System, info: &ModelInfo, prs: &Prs) -> Option<String>
             hi.clone()
         }
     }];
-    let rhs = |x: &[f64], u: &[f64], t: f64| {
-        let mut out = vec![0.0; n];
-        sys.drift(x, u, t, &mut out);
-        out
-    };
     for (s, start) in starts.iter().enumerate() {
         for (p, plan) in plans.iter().enumerate() {
             let mut x = start.clone();
@@ -153,16 +149,7 @@ fn first_escape(sys: &dyn System, info: &ModelInfo, prs: &Prs) -> Option<String>
                 let h = (prs.steps()[k].t - t0) / SUB as f64;
                 for j in 0..SUB {
                     let t = t0 + j as f64 * h;
-                    let k1 = rhs(&x, &u, t);
-                    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k1[i]).collect();
-                    let k2 = rhs(&y, &u, t + 0.5 * h);
-                    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k2[i]).collect();
-                    let k3 = rhs(&y, &u, t + 0.5 * h);
-                    let y: Vec<f64> = (0..n).map(|i| x[i] + h * k3[i]).collect();
-                    let k4 = rhs(&y, &u, t + h);
-                    for i in 0..n {
-                        x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                    }
+                    rk4_step(sys, &mut x, &u, t, h);
                     if !prs.span_contains(k, &x) {
                         return Some(format!(
                             "start {s}, input plan {p}: {x:?} at t = {} is outside the span \

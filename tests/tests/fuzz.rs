@@ -44,7 +44,7 @@ fn helper() {
 
 /// Runs [`helper`] doing `what` under `budget`; the outcome of a spec error.
 fn helper_outcome(what: &str, budget: Budget) -> Outcome {
-    let scratch = Scratch::new(&format!("helper-{what}"));
+    let scratch = Scratch::new(&format!("fuzz-helper-{what}"));
     let mut cmd = Command::new(std::env::current_exe().unwrap());
     cmd.args([
         "helper",

@@ -2,10 +2,12 @@
 //! probabilities, against closed forms (a noise-free flow's containment margins, the exact
 //! Gaussian law of an Ornstein-Uhlenbeck process at the reach time) and sample paths.
 
-use reachc_e2e::{euler_maruyama, inline, normal_tail, Rng};
+use reachc_e2e::{inline, normal_tail};
 use reachc_runtime::probability::GoalLimit;
 use reachc_runtime::prs::{GoalMiss, GoalOutcome, Prs};
 use reachc_runtime::Reach;
+use reachc_test_support::flow::euler_maruyama;
+use reachc_test_support::rng::Rng;
 
 fn run(src: &str, analysis: &str) -> Prs {
     let (sys, info) = inline(src);

@@ -8,7 +8,7 @@ use reachc_compiler::analysis::{choose_transform, jacobian_at};
 use reachc_compiler::backend::{interp::Interpreter, prepare};
 use reachc_compiler::driver::load;
 use reachc_compiler::model::Model;
-use reachc_e2e::{euler_maruyama, shipped_specs, workspace, Rng};
+use reachc_e2e::{shipped_specs, workspace};
 use reachc_runtime::engine::{self, RunError, WRAPPING_FACTOR};
 use reachc_runtime::model::{
     Analysis, AutoFit, Bounds, Constants, Inclusion, Integrator, Method, ModelInfo, Rate,
@@ -16,6 +16,8 @@ use reachc_runtime::model::{
 };
 use reachc_runtime::prs::{DetSet, Hint, Role};
 use reachc_runtime::{Prs, Reach, System};
+use reachc_test_support::flow::{euler_maruyama, rk4_step};
+use reachc_test_support::rng::Rng;
 
 /// The shipped spec's model with the interpreter and its info.
 fn interpreter(path: &std::path::Path) -> (Interpreter, ModelInfo) {
@@ -48,7 +50,7 @@ fn initial_state(info: &ModelInfo, rng: &mut Rng) -> Vec<f64> {
         .initial
         .boxes
         .iter()
-        .map(|b| b.map_or(0.0, |b| rng.uniform(b.lo, b.hi)))
+        .map(|b| b.map_or(0.0, |b| rng.range(b.lo, b.hi)))
         .collect();
     for ball in &info.initial.balls {
         let k = ball.states.len();
@@ -63,7 +65,7 @@ fn initial_state(info: &ModelInfo, rng: &mut Rng) -> Vec<f64> {
             .map(|(a, b)| z[a] * m(a, b) * z[b])
             .sum::<f64>()
             .sqrt();
-        let scale = ball.radius * rng.next().powf(1.0 / k as f64) / norm;
+        let scale = ball.radius * rng.uniform().powf(1.0 / k as f64) / norm;
         for (a, &s) in ball.states.iter().enumerate() {
             x[s] = ball.center[a] + scale * z[a];
         }
@@ -89,30 +91,16 @@ fn first_escape(
     // A genuine under-approximation (a wrong inclusion, face or step) misses by far more.
     let tol = |v: f64| if validated { 1e-9 } else { 1e-6 } * (1.0 + v.abs());
     let mut rng = Rng(seed);
-    let rhs = |x: &[f64], u: &[f64], t: f64| {
-        let mut out = vec![0.0; n];
-        sys.drift(x, u, t, &mut out);
-        out
-    };
     for s in 0..samples {
         let mut x = initial_state(info, &mut rng);
-        let hold = 1 + (rng.next() * 20.0) as usize;
+        let hold = 1 + (rng.uniform() * 20.0) as usize;
         let mut u = vec![0.0; p];
         for (k, st) in r.steps().iter().enumerate() {
             if k > 0 {
                 let (t0, h) = (r.steps()[k - 1].t, (st.t - r.steps()[k - 1].t) / 20.0);
                 for j in 0..20 {
                     let t = t0 + j as f64 * h;
-                    let k1 = rhs(&x, &u, t);
-                    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k1[i]).collect();
-                    let k2 = rhs(&y, &u, t + 0.5 * h);
-                    let y: Vec<f64> = (0..n).map(|i| x[i] + 0.5 * h * k2[i]).collect();
-                    let k3 = rhs(&y, &u, t + 0.5 * h);
-                    let y: Vec<f64> = (0..n).map(|i| x[i] + h * k3[i]).collect();
-                    let k4 = rhs(&y, &u, t + h);
-                    for i in 0..n {
-                        x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                    }
+                    rk4_step(sys, &mut x, &u, t, h);
                     let span = &st.span;
                     let outside = (0..n).find(|&i| {
                         !(span.lo[i] - tol(span.lo[i]) <= x[i]
@@ -135,10 +123,10 @@ fn first_escape(
                 for (j, uj) in u.iter_mut().enumerate() {
                     let Bounds { lo, hi } = info.input_box[j];
                     // Corners half of the time: extreme inputs push the boxes' faces.
-                    *uj = match rng.next() {
+                    *uj = match rng.uniform() {
                         v if v < 0.25 => lo,
                         v if v < 0.5 => hi,
-                        _ => rng.uniform(lo, hi),
+                        _ => rng.range(lo, hi),
                     };
                 }
             }

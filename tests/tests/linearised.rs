@@ -7,12 +7,13 @@
 
 use reachc_compiler::driver::load;
 use reachc_e2e::{
-    inline, interpreter_of, linearised_member, reflection_factor, rk4, shipped, workspace,
+    inline, interpreter_of, linearised_member, reflection_factor, shipped, workspace,
 };
 use reachc_runtime::prs::{Hint, Proved, Role, Verdict};
 use reachc_runtime::report::simulation::summary;
 use reachc_runtime::simulate::{self, Options};
 use reachc_runtime::Reach;
+use reachc_test_support::flow::rk4;
 
 /// `x'' = -2 x - 3 x' + 0.2 w` (eigenvalues -1, -2) from the box `[0.9, 1.1] x [-0.1, 0.1]`:
 /// the member's box at each report time is `|e^(A t)| h + sqrt(factor Sigma_ii(t))` (`factor`
@@ -165,7 +166,7 @@ fn sampled_paths_stay_in_the_member_between_report_times() {
     let decay = (-rate * dt).exp();
     let sd = ((1.0 - decay * decay) / (2.0 * rate)).sqrt();
     let paths = 4000;
-    let mut rng = reachc_e2e::Rng(0x05ee_d0f0);
+    let mut rng = reachc_test_support::rng::Rng(0x05ee_d0f0);
     let (mut left_member, mut left_pointwise) = (0usize, 0usize);
     // In one dimension the member's span and set are intervals (its zonotope's hull is exact).
     let bounds: Vec<((f64, f64), (f64, f64))> = (1..m.steps().len())

@@ -13,6 +13,7 @@ use reachc_e2e::{interpreter_of, workspace};
 use reachc_runtime::app::{run_cli, EXIT_FAILED};
 use reachc_runtime::engine::{Culprit, Setting};
 use reachc_runtime::failure::Failure;
+use reachc_test_support::files::with_extension;
 
 /// `x' = x^2` from [0.5, 0.6]: `good` (horizon 0.2) runs, `blows_up` (horizon 3) cannot.
 fn spec() -> PathBuf {
@@ -153,13 +154,7 @@ fn a_failing_analysis_keeps_the_other_on_both_backends() {
 
 #[test]
 fn every_run_error_spec_names_its_culprit() {
-    let dir = workspace().join("tests/run_errors");
-    let mut specs: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "sde"))
-        .collect();
-    specs.sort();
+    let specs = with_extension(&workspace().join("tests/run_errors"), "sde");
     assert!(specs.len() >= 5);
     let out = scratch("culprits");
     for spec in specs {

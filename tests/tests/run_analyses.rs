@@ -3,8 +3,10 @@
 
 use reachc_compiler::backend::{interp::Interpreter, prepare};
 use reachc_compiler::driver::load;
-use reachc_e2e::{euler_maruyama, workspace, Rng};
+use reachc_e2e::workspace;
 use reachc_runtime::{ModelInfo, Prs, Reach, System};
+use reachc_test_support::flow::euler_maruyama;
+use reachc_test_support::rng::Rng;
 
 /// Runs analysis `name` of the shipped spec `spec` with the interpreter.
 fn run(spec: &str, name: &str) -> (Prs, Interpreter, ModelInfo) {
@@ -101,7 +103,7 @@ fn pendulum_prs_covers_monte_carlo_paths() {
             .iter()
             .map(|b| {
                 let b = b.unwrap();
-                rng.uniform(b.lo, b.hi)
+                rng.range(b.lo, b.hi)
             })
             .collect();
         let mut t = 0.0;

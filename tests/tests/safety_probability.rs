@@ -3,12 +3,14 @@
 //! nonlinear system, and what limits a bound.
 
 use reachc_compiler::backend::interp::Interpreter;
-use reachc_e2e::{euler_maruyama, inline, Rng};
+use reachc_e2e::inline;
 use reachc_runtime::engine::RunError;
 use reachc_runtime::model::ModelInfo;
 use reachc_runtime::probability::{SafetyLimit, DELTA_FLOOR, RESOLUTION};
 use reachc_runtime::simulate::clopper_pearson_lower;
 use reachc_runtime::{Reach, System};
+use reachc_test_support::flow::euler_maruyama;
+use reachc_test_support::rng::Rng;
 
 /// `x' = mu` with noise `0.5 dW` from 0, unsafe `x >= 2`, horizon 1.
 fn brownian(mu: f64) -> (Interpreter, ModelInfo) {

@@ -8,7 +8,8 @@ use reachc_compiler::analysis::Derivatives;
 use reachc_compiler::driver::{check_source, load};
 use reachc_compiler::ir::{ExprId, Names, VarValues};
 use reachc_compiler::model::Model;
-use reachc_e2e::{benchmark_specs, relative, shipped_specs, Rng};
+use reachc_e2e::{benchmark_specs, relative, shipped_specs};
+use reachc_test_support::rng::Rng;
 
 /// A random point: states in the domain (or within 3 of the initial set where unbounded),
 /// inputs in their box, time in [0, 5].
@@ -26,18 +27,18 @@ fn random_point(model: &Model, rng: &mut Rng) -> Point {
         .zip(&model.initial.boxes)
         .map(|((_, d), b)| {
             let (lo, hi) = b.map_or((-2.0, 2.0), |b| (b.lo - 3.0, b.hi + 3.0));
-            rng.uniform(lo.max(d.lo), hi.min(d.hi))
+            rng.range(lo.max(d.lo), hi.min(d.hi))
         })
         .collect();
     let inputs = model
         .input_box
         .iter()
-        .map(|b| rng.uniform(b.lo, b.hi))
+        .map(|b| rng.range(b.lo, b.hi))
         .collect();
     Point {
         states,
         inputs,
-        time: rng.uniform(0.0, 5.0),
+        time: rng.range(0.0, 5.0),
     }
 }
 

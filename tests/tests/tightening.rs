@@ -3,12 +3,13 @@
 //! driven by an input signal, a union against its pieces, the refusals, and `--tighten`'s CSV
 //! against the API.
 
-use reachc_e2e::{inline, upper_quantile, Rng};
+use reachc_e2e::{inline, upper_quantile};
 use reachc_runtime::app::run_cli;
 use reachc_runtime::engine::{Constraint, TightenError, Tightening};
 use reachc_runtime::model::{Bounds, Guarantee, UnsafeShape};
 use reachc_runtime::prs::Role;
 use reachc_runtime::{Reach, System};
+use reachc_test_support::rng::Rng;
 
 /// `x' = -2 x + u`, `u` in `[-1, 1]`, noise `0.3 dW`, from 0.5; one unsafe half-space and one
 /// unsafe box; a pointwise and a uniform analysis at `delta = 0.05`.

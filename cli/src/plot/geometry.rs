@@ -283,21 +283,7 @@ pub fn rectangle(x: (f64, f64), y: (f64, f64)) -> [(Point, f64); 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A small deterministic generator (xorshift) for test points.
-    struct Rng(u64);
-
-    impl Rng {
-        fn uniform(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn sym(&mut self) -> f64 {
-            2.0 * self.uniform() - 1.0
-        }
-    }
+    use reachc_test_support::rng::XorShift64 as Rng;
 
     fn mat_vec(m: &[Vec<f64>], v: &[f64]) -> Vec<f64> {
         m.iter().map(|r| dot_n(r, v)).collect()
@@ -336,7 +322,7 @@ mod tests {
         let set = plane.parallelotope(&lo, &hi, &t_inv());
         let mut rng = Rng(7);
         for _ in 0..200 {
-            let d = [rng.sym(), rng.sym()];
+            let d = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
             // Brute force: every vertex y of the box, x = T^-1 y, projected.
             let brute = (0..8)
                 .map(|mask: u32| {
@@ -362,7 +348,7 @@ mod tests {
         let ball = plane.p_ball(&c, r);
         let mut rng = Rng(3);
         for _ in 0..100 {
-            let d = [rng.sym(), rng.sym()];
+            let d = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
             let lift = DVector::from_vec(vec![d[1], 0.0, d[0]]);
             let w = &pinv * &lift;
             let x: Vec<f64> = (0..3)
@@ -396,7 +382,11 @@ mod tests {
         let mut rng = Rng(11);
         for _ in 0..20_000 {
             let y = sample(&mut rng);
-            let mut z = DVector::from_vec(vec![rng.sym(), rng.sym(), rng.sym()]);
+            let mut z = DVector::from_vec(vec![
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            ]);
             let scale = if rng.uniform() < 0.5 {
                 r
             } else {
@@ -511,7 +501,7 @@ mod tests {
             let prs = det.plus_ellipse(plane.shape, r_t);
             let mut rng = Rng(5);
             for _ in 0..200 {
-                let d = [rng.sym(), rng.sym()];
+                let d = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
                 let zonogon = vertices
                     .iter()
                     .map(|v| dot(plane.point(v), d))
@@ -526,7 +516,7 @@ mod tests {
                 assert!((det.support(d) - exact).abs() < 1e-12, "{d:?}");
             }
             check_polygon(&plane, &p, &prs, &vertices, remainder + r_t, &mut |rng| {
-                let xi: Vec<f64> = (0..4).map(|_| rng.sym()).collect();
+                let xi: Vec<f64> = (0..4).map(|_| rng.range(-1.0, 1.0)).collect();
                 zonotope_point(&c, &g, &xi)
             });
             let zonogon = plane.zonotope(&c, &g, 0.0).polygon();

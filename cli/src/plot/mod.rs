@@ -384,9 +384,8 @@ pub fn plot_without_result(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use reachc_runtime::model::{
-        Bounds, GoalSet, InitialSet, Moving, Slot, UnsafeSet, UnsafeShape,
-    };
+    use reachc_runtime::model::{Bounds, GoalSet, Moving, Slot, UnsafeSet, UnsafeShape};
+    use reachc_test_support::models::model;
 
     /// The spec's sets: fixed ones by name, a moving one the result does not give at its
     /// shape of `t = 0`, labelled so; those the result gives are left to it.
@@ -404,16 +403,6 @@ mod tests {
             moving: moving.clone(),
         };
         let info = ModelInfo {
-            name: "m".into(),
-            states: vec!["x".into(), "y".into()],
-            inputs: vec![],
-            noises: vec![],
-            input_box: vec![],
-            initial: InitialSet::from_box(&[Bounds::new(0.0, 0.0); 2]),
-            domain: vec![Bounds::ENTIRE; 2],
-            has_domain: false,
-            affine: false,
-            constant_diffusion: false,
             unsafe_sets: vec![
                 set("fixed", &vec![]),
                 set("slides", &moves),
@@ -426,7 +415,7 @@ mod tests {
                 window: None,
                 stay: false,
             }],
-            analyses: vec![],
+            ..model("m", &["x", "y"], &[], &[(0.0, 0.0); 2])
         };
         let from_result = [MovingSet {
             name: "given".into(),

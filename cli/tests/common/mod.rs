@@ -1,5 +1,7 @@
 //! Helpers shared by the tests of the `reachc` binary (`mod common;` in each test file).
 
+#![allow(dead_code)] // each test file uses some of them
+
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -18,4 +20,23 @@ pub fn spec(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
+}
+
+/// A command's stdout and stderr, one after the other (for assertions and their messages).
+pub fn text(o: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// The names of the entries of `dir`, sorted.
+pub fn file_names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
 }

@@ -160,6 +160,7 @@ mod tests {
     use super::*;
     use crate::driver::check_source;
     use crate::ir::Names;
+    use reachc_test_support::rng::XorShift64;
 
     fn pendulum() -> Model {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../specs");
@@ -196,13 +197,8 @@ mod tests {
             .any(|&id| matches!(model.pool.node(id), crate::ir::Node::Enclosure { .. })));
         let mut roots = frame.drift.clone();
         roots.extend(frame.derivatives.jac_x.iter().flatten());
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
-        };
+        let mut rng = XorShift64(0x2545_f491_4f6c_dd1d);
+        let mut next = || rng.range(-2.0, 2.0);
         for _ in 0..200 {
             let y = [next(), next()];
             let ys = [Interval::point(y[0]), Interval::point(y[1])];
@@ -292,13 +288,8 @@ mod tests {
             let order = model.pool.reachable(roots);
             model.pool.eval_ordered(&order, roots, &vars, &model.tables)
         };
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
-        };
+        let mut rng = XorShift64(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.range(-2.0, 2.0);
         for _ in 0..50 {
             let y = [next(), next()];
             let x: Vec<f64> = t

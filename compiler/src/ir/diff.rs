@@ -193,25 +193,10 @@ impl Pool {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_exprs::sin_chain;
     use super::super::{Names, Table, VarValues};
     use super::*;
-
-    /// xorshift64*: deterministic, dependency-free randomness for tests.
-    pub(crate) struct Rng(u64);
-    impl Rng {
-        pub(crate) fn new(seed: u64) -> Self {
-            Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
-        }
-        pub(crate) fn next_f64(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        }
-        pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.next_f64()
-        }
-    }
+    use reachc_test_support::rng::Rng;
 
     const X: Var = Var::State(0);
     const Y: Var = Var::State(1);
@@ -318,7 +303,8 @@ mod tests {
         let mut p = Pool::new();
         let exprs = battery(&mut p);
         let tables = [table()];
-        let mut rng = Rng::new(7);
+        // The seed 7, spread by the golden-ratio multiplier.
+        let mut rng = Rng(7u64.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
         let vars = [X, Y, U, W];
         for (name, e) in exprs {
             let ds: Vec<ExprId> = vars.iter().map(|&v| p.diff(e, v)).collect();
@@ -491,17 +477,7 @@ mod tests {
 
         // A long let-style chain: deep DAG, no stack overflow, linear derivative.
         let mut p = Pool::new();
-        let x = p.var(X);
-        let y = p.var(Y);
-        let mut e = x;
-        for i in 0..20_000 {
-            e = if i % 2 == 0 {
-                p.call1(Func1::Sin, e)
-            } else {
-                let m = p.mul(e, y);
-                p.add(m, x)
-            };
-        }
+        let e = sin_chain(&mut p, 20_000);
         let input = p.count_nodes(&[e]);
         let d = p.diff(e, X);
         assert!(p.count_nodes(&[d]) < 10 * input);

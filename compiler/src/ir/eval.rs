@@ -268,20 +268,9 @@ impl Arith for Interval {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_exprs::FUNC1;
     use super::*;
-
-    struct Rng(u64);
-    impl Rng {
-        fn next_f64(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.next_f64()
-        }
-    }
+    use reachc_test_support::rng::Rng;
 
     fn table() -> Table {
         Table {
@@ -305,22 +294,7 @@ mod tests {
         let c = p.call1(Func1::Cos, x);
         let sc = p.mul(s, c);
         out.push(p.add(sc, u));
-        for f in [
-            Func1::Sin,
-            Func1::Cos,
-            Func1::Tan,
-            Func1::Exp,
-            Func1::Log,
-            Func1::Sqrt,
-            Func1::Abs,
-            Func1::Atan,
-            Func1::Sinh,
-            Func1::Cosh,
-            Func1::Tanh,
-            Func1::Sinc,
-            Func1::Sign,
-            Func1::DSinc,
-        ] {
+        for f in FUNC1 {
             let arg = if matches!(f, Func1::Log | Func1::Sqrt) {
                 let x2 = p.powi(x, 2);
                 p.add(x2, two)

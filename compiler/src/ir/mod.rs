@@ -16,6 +16,8 @@ mod pool;
 mod print;
 mod shared;
 mod table;
+#[cfg(test)]
+mod test_exprs;
 
 pub use eval::{Arith, VarValues};
 pub use node::{ExprId, Func1, Func2, Node, Var, F64};

@@ -738,15 +738,11 @@ mod tests {
     #[test]
     fn folds_enclose_the_exact_coefficients() {
         use num_rational::BigRational;
+        use reachc_test_support::rng::XorShift64;
         let q = |v: f64| BigRational::from_float(v).unwrap();
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            // decimals like 0.3, 1.7: most are not floats, so their products are inexact
-            ((seed >> 11) % 41) as f64 / 10.0 - 2.0
-        };
+        let mut rng = XorShift64(0x9e37_79b9_7f4a_7c15);
+        // decimals like 0.3, 1.7: most are not floats, so their products are inexact
+        let mut next = || ((rng.next_u64() >> 11) % 41) as f64 / 10.0 - 2.0;
         let mut inexact = 0;
         for _ in 0..2000 {
             let mut f = fx();

@@ -399,6 +399,7 @@ pub(crate) fn lambda_max(s: &[Interval], n: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::rng::XorShift64;
 
     /// `product_point` against the exact ranges: entries on a grid of `2^-8` of moderate size,
     /// so every product and sum below is exact in `f64` and the exact range of each entry of
@@ -407,13 +408,9 @@ mod tests {
     /// [`product`] (the reference it replaces).
     #[test]
     fn product_point_holds_the_exact_ranges() {
-        let mut state = 0x2545_f491_u64;
-        let mut grid = |lo: i64, hi: i64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (lo + (state % (hi - lo + 1) as u64) as i64) as f64 / 256.0
-        };
+        let mut rng = XorShift64(0x2545_f491);
+        let mut grid =
+            |lo: i64, hi: i64| (lo + rng.below((hi - lo + 1) as u64) as i64) as f64 / 256.0;
         for (r, k, c) in [(1, 1, 1), (2, 2, 2), (3, 5, 4), (10, 10, 40)] {
             let a: Vec<Interval> = (0..r * k)
                 .map(|_| {

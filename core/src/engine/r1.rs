@@ -555,19 +555,7 @@ mod tests {
     use super::super::radius::initial_center_and_halfwidths;
     use super::*;
     use crate::model::{Ball, Bounds};
-
-    /// xorshift64*, so failures reproduce.
-    struct Rng(u64);
-
-    impl Rng {
-        fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            let u = (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
-            lo + (hi - lo) * u
-        }
-    }
+    use crate::test_support::rng::Rng;
 
     /// `r1` and how, with the bounding-box bound of the same set.
     fn r1_and_boxes(p: &[f64], init: &InitialSet) -> (f64, R1Bound, f64) {
@@ -759,7 +747,7 @@ mod tests {
     fn never_above_the_bounding_box_bound_and_sound() {
         let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
         let spd = |rng: &mut Rng, k: usize| {
-            let a: Vec<f64> = (0..k * k).map(|_| rng.uniform(-1.0, 1.0)).collect();
+            let a: Vec<f64> = (0..k * k).map(|_| rng.range(-1.0, 1.0)).collect();
             let mut s = vec![0.0; k * k];
             for i in 0..k {
                 for j in 0..k {
@@ -774,19 +762,15 @@ mod tests {
             let n = 1 + case % 6;
             let p = spd(&mut rng, n);
             // Each state: 0 box, 1 point, 2 ball A, 3 ball B.
-            let kinds: Vec<usize> = (0..n).map(|_| (rng.uniform(0.0, 4.0)) as usize).collect();
+            let kinds: Vec<usize> = (0..n).map(|_| (rng.range(0.0, 4.0)) as usize).collect();
             let mut init = InitialSet {
                 boxes: vec![None; n],
                 balls: Vec::new(),
             };
             for (i, &kind) in kinds.iter().enumerate() {
                 if kind < 2 {
-                    let lo = rng.uniform(-1.0, 1.0);
-                    let w = if kind == 1 {
-                        0.0
-                    } else {
-                        rng.uniform(0.0, 0.5)
-                    };
+                    let lo = rng.range(-1.0, 1.0);
+                    let w = if kind == 1 { 0.0 } else { rng.range(0.0, 0.5) };
                     init.boxes[i] = Some(Bounds::new(lo, lo + w));
                 }
             }
@@ -794,11 +778,11 @@ mod tests {
                 let states: Vec<usize> = (0..n).filter(|&i| kinds[i] == ball).collect();
                 let k = states.len();
                 if k > 0 {
-                    let metric = (rng.uniform(0.0, 1.0) < 0.7).then(|| spd(&mut rng, k));
+                    let metric = (rng.range(0.0, 1.0) < 0.7).then(|| spd(&mut rng, k));
                     init.balls.push(Ball {
                         states,
-                        center: (0..k).map(|_| rng.uniform(-1.0, 1.0)).collect(),
-                        radius: rng.uniform(0.0, 0.6),
+                        center: (0..k).map(|_| rng.range(-1.0, 1.0)).collect(),
+                        radius: rng.range(0.0, 0.6),
                         metric,
                     });
                 }
@@ -810,11 +794,11 @@ mod tests {
             for _ in 0..200 {
                 let mut d = vec![0.0; n];
                 for i in (0..n).filter(|&i| kinds[i] < 2) {
-                    d[i] = half[i] * [-1.0, 1.0, rng.uniform(-1.0, 1.0)][case % 3];
+                    d[i] = half[i] * [-1.0, 1.0, rng.range(-1.0, 1.0)][case % 3];
                 }
                 for ball in &init.balls {
                     let k = ball.states.len();
-                    let u: Vec<f64> = (0..k).map(|_| rng.uniform(-1.0, 1.0)).collect();
+                    let u: Vec<f64> = (0..k).map(|_| rng.range(-1.0, 1.0)).collect();
                     let identity: Vec<f64> = (0..k * k)
                         .map(|i| if i % (k + 1) == 0 { 1.0 } else { 0.0 })
                         .collect();

@@ -304,6 +304,7 @@ pub(crate) fn quad_form_at_most(p: &[Vec<f64>], d: &[Interval], r: f64) -> bool 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::rng::Rng;
 
     fn pendulum() -> Frame {
         Frame::new(
@@ -385,19 +386,10 @@ mod tests {
         a.iter().flat_map(|row| row[n..].to_vec()).collect()
     }
 
-    /// A fixed stream of values in `[-1, 1)` (xorshift64*).
-    fn stream(mut s: u64) -> impl FnMut() -> f64 {
-        move || {
-            s ^= s >> 12;
-            s ^= s << 25;
-            s ^= s >> 27;
-            (s.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        }
-    }
-
     #[test]
     fn clearly_within_implies_certify_and_is_nearly_as_tight() {
-        let mut rnd = stream(7);
+        let mut rng = Rng(7);
+        let mut rnd = || rng.range(-1.0, 1.0);
         let (mut settled, mut cases) = (0, 0);
         for case in 0..2000 {
             let n = 1 + case % 4;
@@ -460,7 +452,8 @@ mod tests {
 
     #[test]
     fn inside_answers_as_its_enclosure_does() {
-        let mut rnd = stream(11);
+        let mut rng = Rng(11);
+        let mut rnd = || rng.range(-1.0, 1.0);
         let mut near = 0;
         for case in 0..20000 {
             let n = 1 + case % 4;

@@ -529,6 +529,7 @@ fn cholesky_solve(a: &mut [f64], m: usize, rhs: &mut [f64]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::rng::{Lcg64, Rng};
 
     /// A parallelogram: centre (1, 0), generators (1, 0.5) and (0, 0.2).
     fn set() -> (Vec<f64>, Vec<f64>) {
@@ -557,13 +558,8 @@ mod tests {
         assert!(!contains(&p, &[2.1, 0.7], &c, &g, 0.05));
         assert!(contains(&p, &[2.1, 0.7], &c, &g, 0.1 + 1e-9));
         // Against sampling: every sampled point of Z (+) B(r) is reported inside.
-        let mut s = 1u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rng = Lcg64(1);
+        let mut next = || rng.range(-1.0, 1.0);
         for _ in 0..2000 {
             let (a, b) = (next(), next());
             let ang = std::f64::consts::PI * next();
@@ -585,16 +581,6 @@ mod tests {
             let v = [a * g[0] + b * g[2], a * g[1] + b * g[3]];
             let q = p[0] * v[0] * v[0] + 2.0 * p[1] * v[0] * v[1] + p[3] * v[1] * v[1];
             assert!(q.sqrt() <= r);
-        }
-    }
-
-    /// A fixed stream of values in `[-1, 1)` (xorshift64*).
-    fn stream(mut s: u64) -> impl FnMut() -> f64 {
-        move || {
-            s ^= s >> 12;
-            s ^= s << 25;
-            s ^= s >> 27;
-            (s.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 52) as f64 - 1.0
         }
     }
 
@@ -622,7 +608,8 @@ mod tests {
     #[test]
     fn excess_is_zero_inside_the_basis_and_bounds_the_distance_outside() {
         use crate::lanes::X8;
-        let mut rnd = stream(11);
+        let mut rng = Rng(11);
+        let mut rnd = || rng.range(-1.0, 1.0);
         let (mut inexact, mut outside) = (0, 0);
         for case in 0..240 {
             let (n, extra) = (1 + case % 12, case / 12 % 3);
@@ -707,7 +694,8 @@ mod tests {
     /// interval one's smallest by a relative 1e-9.
     #[test]
     fn clearly_within_implies_the_interval_test_and_is_nearly_as_tight() {
-        let mut rnd = stream(5);
+        let mut rng = Rng(5);
+        let mut rnd = || rng.range(-1.0, 1.0);
         for case in 0..600 {
             let (n, k) = (1 + case % 6, 1 + case % 8);
             let [p, c, g] = random(&mut rnd, n, k);
@@ -748,7 +736,8 @@ mod tests {
     /// positive definite problems of 1 to 12 generators with minimisers on many faces.
     #[test]
     fn the_active_set_steps_find_the_minimiser() {
-        let mut rnd = stream(3);
+        let mut rng = Rng(3);
+        let mut rnd = || rng.range(-1.0, 1.0);
         for case in 0..300 {
             let k = 1 + case % 12;
             let [q, _, _] = random(&mut rnd, k, 0);

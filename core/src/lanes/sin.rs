@@ -164,6 +164,7 @@ fn probe() -> impl Iterator<Item = f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::rng::XorShift64;
 
     /// Lanes against `f64::sin` over and around the polynomial's range, and the special values.
     #[test]
@@ -173,13 +174,8 @@ mod tests {
             "this platform's sin is not glibc's __sin_fma: the lanes call the library (correct, \
              but the vector path this test is for is not exercised)"
         );
-        let mut s = 12345u64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut rng = XorShift64(12345);
+        let mut next = move || rng.next_u64();
         let specials = [
             0.0,
             -0.0,

@@ -18,6 +18,19 @@ pub(crate) fn available() -> bool {
     is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512dq")
 }
 
+/// For the tests of the lanes: panics, saying why, when the processor has not the extensions.
+/// Those tests are ignored where the machine that builds them has none (`core/build.rs` sets
+/// `reachc_avx512`), so this fails only when they were built to run here regardless
+/// (`REACHC_REQUIRE_AVX512=1`) or on another machine: never a silent pass.
+#[cfg(test)]
+pub(crate) fn require() {
+    assert!(
+        available(),
+        "this processor has no AVX-512 (F and DQ): the lanes cannot run (the tests were built \
+         with REACHC_REQUIRE_AVX512=1, or on another machine)"
+    );
+}
+
 /// The streams of eight paths: lane `l` holds the wyrand state of path `l`.
 #[derive(Clone, Copy)]
 pub(crate) struct Rng8(__m512i);
@@ -279,22 +292,24 @@ mod tests {
     use super::*;
 
     /// Every lane draws its path's numbers and normals, including the slow cases (wedges,
-    /// the tail: about 1.5% of the draws, so thousands here).
+    /// the tail: about 1.5% of the draws, so thousands here). Ignored where the machine that
+    /// built the tests has no AVX-512 (see [`require`]).
+    #[cfg_attr(
+        not(reachc_avx512),
+        ignore = "no AVX-512 (F and DQ) on the machine that built the tests: the lanes cannot run"
+    )]
     #[test]
     fn lanes_draw_what_each_path_draws() {
-        if !available() {
-            eprintln!("no AVX-512: nothing to compare");
-            return;
-        }
+        require();
         let zig = Ziggurat::get();
         let paths: [PathRng; 8] = std::array::from_fn(|l| PathRng::new(3, 100 + l as u64));
         let mut scalar = paths;
-        // SAFETY: `available()`.
+        // SAFETY: `require()`: the processor has the extensions.
         let mut lanes = unsafe { Rng8::new(paths) };
         for draw in 0..100_000 {
             // Every third draw, lane 5 is left out: its stream must not move.
             let live = if draw % 3 == 0 { !(1 << 5) } else { 0xff };
-            // SAFETY: `available()`.
+            // SAFETY: `require()`: the processor has the extensions.
             let z = unsafe { lanes.normal(zig, live) };
             for (l, rng) in scalar.iter_mut().enumerate() {
                 if live & (1 << l) != 0 {
@@ -311,14 +326,16 @@ mod tests {
 
     /// The lanes' distance to a box is the scalar `diag_quad_to_box`, and so is the decision
     /// against the bound: random states inside, outside and on the faces of a box, with
-    /// states far away, infinite and NaN, and the bound at the lanes' own values.
+    /// states far away, infinite and NaN, and the bound at the lanes' own values. Ignored where
+    /// the machine that built the tests has no AVX-512 (see [`require`]).
+    #[cfg_attr(
+        not(reachc_avx512),
+        ignore = "no AVX-512 (F and DQ) on the machine that built the tests: the lanes cannot run"
+    )]
     #[test]
     fn lanes_measure_the_distance_to_a_box_as_the_scalar_loop() {
         use super::super::prs::diag_quad_to_box;
-        if !available() {
-            eprintln!("no AVX-512: nothing to compare");
-            return;
-        }
+        require();
         let mut rng = PathRng::new(4, 0);
         let (w, lo, hi) = ([2.0, 0.5, 1.0], [-1.0, 0.0, 0.25], [1.0, 0.0, 0.75]);
         let special = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, -0.0, 0.0, 1e300];
@@ -333,13 +350,13 @@ mod tests {
                 })
                 .collect();
             let paths = [PathRng::new(0, 0); 8];
-            // SAFETY: `available()`.
+            // SAFETY: `require()`: the processor has the extensions.
             let group = unsafe { Group8::new(n, &x, paths) };
             let q: Vec<f64> = (0..8)
                 .map(|l| diag_quad_to_box(&w[..n], &x[l * n..][..n], &lo, &hi))
                 .collect();
             for bound in [q[round % 8], 0.5, f64::INFINITY] {
-                // SAFETY: `available()`.
+                // SAFETY: `require()`: the processor has the extensions.
                 let mask = unsafe { group.outside_box(n, &w, &lo, &hi, bound) };
                 for (l, q) in q.iter().enumerate() {
                     let scalar = q.partial_cmp(&bound) != Some(std::cmp::Ordering::Less);

@@ -378,14 +378,15 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut To
 #[cfg(test)]
 mod tests {
     use super::super::part_file::FORMAT_VERSION;
-    use super::super::tests::{info, narrow, Sys};
+    use super::super::tests::{info, narrow, sys};
     use super::super::{run_part, simulate, Options};
     use super::*;
     use crate::engine;
     use crate::prs::Prs;
+    use crate::test_support::systems::Linear;
 
     /// The parts of `r` for `shards` shards, each through its file's bytes.
-    fn parts(sys: &Sys, r: &Prs, opts: &Options, shards: u64) -> Vec<(String, Part)> {
+    fn parts(sys: &Linear, r: &Prs, opts: &Options, shards: u64) -> Vec<(String, Part)> {
         let info = info(sys.b);
         (0..shards)
             .map(|i| {
@@ -407,7 +408,7 @@ mod tests {
     #[test]
     fn sharded_runs_merge_into_the_unsharded_report() {
         for b in [0.0, 1.0] {
-            let (sys, info) = (Sys { b }, info(b));
+            let (sys, info) = (sys(b), info(b));
             let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
             let mut pointwise = narrow(&r, 0.5);
             pointwise.guarantee = Guarantee::Pointwise;
@@ -441,7 +442,7 @@ mod tests {
     /// result) are refused, naming the parts.
     #[test]
     fn merge_refuses_parts_that_do_not_belong_together() {
-        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let (sys, info) = (sys(0.0), info(0.0));
         let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 200,
@@ -505,7 +506,7 @@ mod tests {
     /// distances out of order or too few.
     #[test]
     fn malformed_parts_are_refused() {
-        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let (sys, info) = (sys(0.0), info(0.0));
         let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 100,
@@ -540,7 +541,7 @@ mod tests {
     /// a message, never a panic.
     #[test]
     fn bad_part_files_are_refused() {
-        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let (sys, info) = (sys(0.0), info(0.0));
         let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 50,

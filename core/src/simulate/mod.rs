@@ -485,67 +485,16 @@ mod tests {
     use crate::engine;
     use crate::interval::Interval;
     use crate::model::*;
+    use crate::test_support::models::model;
+    use crate::test_support::systems::Linear;
 
-    /// `dx = (-x + b u) dt + 0.3 dW` per state, two states and one input (unused if `b = 0`).
-    pub(super) struct Sys {
-        pub(super) b: f64,
-    }
-
-    impl System for Sys {
-        fn n(&self) -> usize {
-            2
-        }
-        fn p(&self) -> usize {
-            usize::from(self.b != 0.0)
-        }
-        fn m(&self) -> usize {
-            2
-        }
-        fn drift(&self, x: &[f64], u: &[f64], _t: f64, out: &mut [f64]) {
-            for i in 0..2 {
-                out[i] = -x[i] + u.first().map_or(0.0, |u| self.b * u);
-            }
-        }
-        fn drift_interval(&self, x: &[Interval], u: &[Interval], _t: Interval, o: &mut [Interval]) {
-            for i in 0..2 {
-                o[i] = -x[i]
-                    + u.first()
-                        .map_or(Interval::ZERO, |&u| Interval::point(self.b) * u);
-            }
-        }
-        fn jac_x(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-            out.copy_from_slice(&[-1.0, 0.0, 0.0, -1.0]);
-        }
-        fn jac_x_interval(
-            &self,
-            _x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            o: &mut [Interval],
-        ) {
-            for (o, v) in o.iter_mut().zip([-1.0, 0.0, 0.0, -1.0]) {
-                *o = Interval::point(v);
-            }
-        }
-        fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-            out.fill(self.b);
-        }
-        fn jac_u_interval(
-            &self,
-            _x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            o: &mut [Interval],
-        ) {
-            o.fill(Interval::point(self.b));
-        }
-        fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-            out.copy_from_slice(&[0.3, 0.0, 0.0, 0.3]);
-        }
-        fn diffusion_interval(&self, _x: &[Interval], _t: Interval, o: &mut [Interval]) {
-            for (o, v) in o.iter_mut().zip([0.3, 0.0, 0.0, 0.3]) {
-                *o = Interval::point(v);
-            }
+    /// `dx = (-x + b u) dt + 0.3 dW` per state, two states and one input (none if `b = 0`).
+    pub(super) fn sys(b: f64) -> Linear {
+        Linear {
+            n: 2,
+            a: -1.0,
+            b,
+            s: 0.3,
         }
     }
 
@@ -558,40 +507,24 @@ mod tests {
     /// [`info`] with the metric `metric` (`2 x 2`, row-major); the analysis is time-uniform
     /// (the default).
     fn info_in(b: f64, metric: Vec<f64>) -> ModelInfo {
-        let inputs = b != 0.0;
-        let mut info = ModelInfo {
-            goals: Vec::new(),
-            name: "m".into(),
-            states: vec!["x1".into(), "x2".into()],
-            inputs: if inputs { vec!["u".into()] } else { vec![] },
-            noises: vec!["w1".into(), "w2".into()],
-            input_box: if inputs {
-                vec![Bounds::new(-0.5, 0.5)]
-            } else {
-                vec![]
-            },
-            initial: InitialSet {
-                boxes: vec![Some(Bounds::new(0.1, 0.3)), Some(Bounds::new(-0.1, 0.1))],
-                balls: vec![],
-            },
-            domain: vec![Bounds::ENTIRE; 2],
-            has_domain: false,
-            affine: false,
-            constant_diffusion: false,
-            unsafe_sets: if inputs {
-                vec![UnsafeSet {
-                    name: "far".into(),
-                    shape: UnsafeShape::HalfSpace {
-                        normal: vec![1.0, 0.0],
-                        offset: 0.4,
-                    },
-                    moving: Vec::new(),
-                }]
-            } else {
-                vec![]
-            },
-            analyses: vec![],
-        };
+        let mut info = model(
+            "m",
+            &["x1", "x2"],
+            &["w1", "w2"],
+            &[(0.1, 0.3), (-0.1, 0.1)],
+        );
+        if b != 0.0 {
+            info.inputs = vec!["u".into()];
+            info.input_box = vec![Bounds::new(-0.5, 0.5)];
+            info.unsafe_sets = vec![UnsafeSet {
+                name: "far".into(),
+                shape: UnsafeShape::HalfSpace {
+                    normal: vec![1.0, 0.0],
+                    offset: 0.4,
+                },
+                moving: Vec::new(),
+            }];
+        }
         // |(b u, b u)| <= sqrt(2) |b| / 2 over the input box; mu_P(-I) = -1 in any metric.
         let constants = Constants::given(&info, metric, -1.0, 0.3, b.abs());
         info.analyses.push(Analysis {
@@ -628,7 +561,7 @@ mod tests {
             (1.0, &identity, f64::NEG_INFINITY, 0.4),
             (0.0, &skewed, 0.05, 0.6),
         ] {
-            let (sys, info) = (Sys { b }, info_in(b, metric.clone()));
+            let (sys, info) = (sys(b), info_in(b, metric.clone()));
             let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
             let mut pointwise = r.clone();
             pointwise.guarantee = Guarantee::Pointwise;
@@ -727,7 +660,7 @@ mod tests {
     /// every report-time check passes; with the tube as computed, the path never leaves.
     #[test]
     fn a_path_leaving_the_tube_between_report_times_is_counted() {
-        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let (sys, info) = (sys(0.0), info(0.0));
         let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 1,
@@ -787,7 +720,7 @@ mod tests {
             (0.0, &skewed, 0.6),
             (1.0, &identity, 0.4),
         ] {
-            let (sys, info) = (Sys { b }, info_in(b, metric.clone()));
+            let (sys, info) = (sys(b), info_in(b, metric.clone()));
             let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
             for (factor, r) in [(1.0, r.clone()), (factor, narrow(&r, factor))] {
                 let opts = Options {
@@ -825,7 +758,7 @@ mod tests {
     /// 2 threads give the same reports.
     #[test]
     fn the_uniform_verdict_is_decided_by_the_tube() {
-        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let (sys, info) = (sys(0.0), info(0.0));
         let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
         let run = |r: &Prs, threads: usize| {
             let opts = Options {
@@ -880,7 +813,7 @@ mod tests {
     fn a_zonotope_member_is_counted_as_contains_at_decides() {
         let sorted = ChunkStats::sorted;
         for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
-            let (sys, info) = (Sys { b: 0.0 }, info_in(0.0, metric.clone()));
+            let (sys, info) = (sys(0.0), info_in(0.0, metric.clone()));
             let mut r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
             r.guarantee = Guarantee::Pointwise;
             let mut boxes = info.clone();
@@ -927,7 +860,7 @@ mod tests {
     /// Malformed spans are refused with a message, not a panic.
     #[test]
     fn malformed_spans_are_refused() {
-        let (sys, info) = (Sys { b: 0.0 }, info(0.0));
+        let (sys, info) = (sys(0.0), info(0.0));
         let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 10,
@@ -1005,21 +938,10 @@ mod tests {
     fn brownian(unsafe_sets: Vec<UnsafeSet>, goals: Vec<GoalSet>) -> ModelInfo {
         let mut info = ModelInfo {
             goals,
-            name: "brownian".into(),
-            states: vec!["x".into()],
-            inputs: vec![],
-            noises: vec!["w".into()],
-            input_box: vec![],
-            initial: InitialSet {
-                boxes: vec![Some(Bounds::new(0.0, 0.0))],
-                balls: vec![],
-            },
-            domain: vec![Bounds::ENTIRE],
-            has_domain: false,
             affine: true,
             constant_diffusion: true,
             unsafe_sets,
-            analyses: vec![],
+            ..model("brownian", &["x"], &["w"], &[(0.0, 0.0)])
         };
         let constants = Constants::given(&info, vec![1.0], 0.0, SIGMA, 0.0);
         info.analyses.push(Analysis {

@@ -1283,88 +1283,17 @@ mod tests {
     use crate::engine;
     use crate::interval::Interval;
     use crate::model::*;
+    use crate::test_support::models::{pendulum_model, PENDULUM_METRIC};
+    use crate::test_support::systems::Pendulum;
 
     /// The pendulum of specs/pendulum.sde: one noise channel on the second state (constant
     /// `G` that is not diagonal), a drift with `sin`.
-    struct Pendulum;
-
-    impl System for Pendulum {
-        fn n(&self) -> usize {
-            2
-        }
-        fn p(&self) -> usize {
-            0
-        }
-        fn m(&self) -> usize {
-            1
-        }
-        fn drift(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-            out[0] = x[1];
-            out[1] = 10.0 * x[0].sin() - 20.0 * x[0] - 20.0 * x[1];
-        }
-        fn drift_interval(
-            &self,
-            x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            o: &mut [Interval],
-        ) {
-            let p = Interval::point;
-            o[0] = x[1];
-            o[1] = p(10.0) * x[0].sin() - p(20.0) * x[0] - p(20.0) * x[1];
-        }
-        fn jac_x(&self, x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
-            out.copy_from_slice(&[0.0, 1.0, 10.0 * x[0].cos() - 20.0, -20.0]);
-        }
-        fn jac_x_interval(
-            &self,
-            x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            o: &mut [Interval],
-        ) {
-            let p = Interval::point;
-            o.copy_from_slice(&[p(0.0), p(1.0), p(10.0) * x[0].cos() - p(20.0), p(-20.0)]);
-        }
-        fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, _out: &mut [f64]) {}
-        fn jac_u_interval(
-            &self,
-            _x: &[Interval],
-            _u: &[Interval],
-            _t: Interval,
-            _o: &mut [Interval],
-        ) {
-        }
-        fn diffusion(&self, _x: &[f64], _t: f64, out: &mut [f64]) {
-            out.copy_from_slice(&[0.0, 0.1]);
-        }
-        fn diffusion_interval(&self, _x: &[Interval], _t: Interval, o: &mut [Interval]) {
-            o.copy_from_slice(&[Interval::ZERO, Interval::point(0.1)]);
-        }
-    }
+    const PENDULUM: Pendulum = Pendulum::PAPER;
 
     /// The pendulum's model; its analysis `method` with the paper's (full) metric.
     fn pendulum(method: Method) -> ModelInfo {
-        let a = std::f64::consts::PI / 10.0;
-        let mut info = ModelInfo {
-            goals: Vec::new(),
-            name: "pendulum".into(),
-            states: vec!["theta".into(), "omega".into()],
-            inputs: vec![],
-            noises: vec!["w".into()],
-            input_box: vec![],
-            initial: InitialSet {
-                boxes: vec![Some(Bounds::new(-a, a)), Some(Bounds::new(-0.2, 0.2))],
-                balls: vec![],
-            },
-            domain: vec![Bounds::ENTIRE; 2],
-            has_domain: false,
-            affine: false,
-            constant_diffusion: false,
-            unsafe_sets: vec![],
-            analyses: vec![],
-        };
-        let constants = Constants::given(&info, vec![35.68, 2.21, 2.21, 1.27], -0.5, 0.12, 0.0);
+        let mut info = pendulum_model();
+        let constants = Constants::given(&info, PENDULUM_METRIC.to_vec(), -0.5, 0.12, 0.0);
         info.analyses.push(Analysis {
             spec: AnalysisSpec {
                 name: "a".into(),
@@ -1379,6 +1308,130 @@ mod tests {
         info
     }
 
+    /// The portable part of `lanes_x8`, on any processor: eight paths stepped with the lane
+    /// kernels (`InputSchedule::update_x8`, `System::drift_x8`, `Noise::apply_x8`,
+    /// `SetRegions::check_x8`), each lane drawing its normals from its own stream as the
+    /// AVX-512 lanes do (that they draw the same numbers is `avx512`'s test), against the same
+    /// paths stepped one by one as `step_lanes` does: the same states to the bit after every
+    /// step, and the same unsafe-set hits, first hit times and domain exits. The pendulum
+    /// (constant `G` that is not diagonal), with state-dependent noise, and forced by an input
+    /// in each input mode, with unsafe sets and a domain the paths enter and leave. What only
+    /// runs on AVX-512 (the registers' streams and loads) is
+    /// [`lanes_do_not_change_the_paths`].
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn lane_kernels_step_as_the_scalar_loop() {
+        use crate::test_support::rng::Rng;
+        let info = pendulum(Method::Interval);
+        let r = engine::run(&PENDULUM, &info, &info.analyses[0]).unwrap();
+        let regions = with_regions(&info, true);
+        let forced = with_input(&regions);
+        let modes = [InputMode::Random, InputMode::Corners, InputMode::Centre];
+        let systems = [
+            (&PENDULUM as &dyn System, &regions, InputMode::Random),
+            (&MULTIPLICATIVE, &regions, InputMode::Random),
+        ]
+        .into_iter()
+        .chain(modes.map(|mode| (&FORCED as &dyn System, &forced, mode)));
+        let mut start = Rng(0x1a4e5);
+        let (mut hits, mut exits) = (0, 0);
+        for (sys, info, mode) in systems {
+            let opts = Options {
+                inputs: mode,
+                hold: Some(0.05),
+                ..Options::default()
+            };
+            let plan = make_plan(sys, info, &r, &opts).unwrap();
+            let (n, m, p, sets) = (sys.n(), sys.m(), sys.p(), plan.sets.unsafe_sets.len());
+            let case = format!("{p} inputs ({mode:?}), G(x): {}", plan.noise.needs_matrix());
+            // Four corners of the initial box (two heading out of the domain) and four inside.
+            let a = std::f64::consts::PI / 10.0;
+            let x: Vec<[f64; 2]> = [[a, 0.2], [-a, -0.2], [a, -0.2], [-a, 0.2]]
+                .into_iter()
+                .chain((0..4).map(|_| [start.range(-a, a), start.range(-0.2, 0.2)]))
+                .collect();
+            // The lanes' and the scalar loop's states, inputs, normals, drift, G, paths, hits.
+            let mut xl: [X8; SMALL] = std::array::from_fn(|i| {
+                X8(std::array::from_fn(|l| if i < n { x[l][i] } else { 0.0 }))
+            });
+            let (mut ul, mut zl) = ([X8::splat(0.0); SMALL], [X8::splat(0.0); SMALL]);
+            let (mut fl, mut gl) = ([X8::splat(0.0); SMALL], [X8::splat(0.0); SMALL * SMALL]);
+            let mut hold = None;
+            let path = |l: usize| Path {
+                rng: PathRng::new(17, l as u64),
+                hold: None,
+                alive: true,
+                outside_any: false,
+                left_tube: false,
+                left_domain: false,
+            };
+            let mut lanes: Vec<Path> = (0..8).map(path).collect();
+            let mut scalar = lanes.clone();
+            let (mut hit_l, mut hit_s) = (vec![false; 8 * sets], vec![false; 8 * sets]);
+            let stats = || ChunkStats::new(plan.times.len(), sets, 0, n);
+            let (mut st_l, mut st_s) = (stats(), stats());
+            let mut xs = x.clone();
+            // Each path holds its own inputs between draws.
+            let mut us = [[0.0; SMALL]; 8];
+            let (mut z, mut f, mut g) = ([0.0; SMALL], [0.0; 2], [0.0; 2]);
+            for span in &plan.spans {
+                for i in 0..span.steps {
+                    let (t, t_end) = span.step_times(i);
+                    if p > 0 {
+                        let next = || std::array::from_fn(|l| lanes[l].rng.next_u64());
+                        plan.inputs.update_x8(t, &mut hold, next, &mut ul[..p]);
+                    }
+                    for zj in &mut zl[..m] {
+                        *zj = X8(std::array::from_fn(|l| plan.zig.sample(&mut lanes[l].rng)));
+                    }
+                    sys.drift_x8(&xl[..n], &ul[..p], t, &mut fl[..n]);
+                    let (h, sqrt_h) = (span.h, span.sqrt_h);
+                    let (xn, fnn) = (&mut xl[..n], &fl[..n]);
+                    plan.noise
+                        .apply_x8(sys, xn, fnn, t, h, sqrt_h, &mut zl[..m], &mut gl[..n * m]);
+                    plan.sets
+                        .check_x8(t_end, &xl[..n], 0xff, &mut hit_l, &mut lanes, &mut st_l);
+                    for (l, (x, path)) in xs.iter_mut().zip(&mut scalar).enumerate() {
+                        let u = &mut us[l];
+                        if p > 0 {
+                            plan.inputs
+                                .update(t, &mut path.hold, &mut path.rng, &mut u[..p]);
+                        }
+                        for zj in &mut z[..m] {
+                            *zj = plan.zig.sample(&mut path.rng);
+                        }
+                        sys.drift(x, &u[..p], t, &mut f);
+                        plan.noise
+                            .apply(sys, x, &f, t, h, sqrt_h, &mut z[..m], &mut g);
+                        let hit = &mut hit_s[l * sets..][..sets];
+                        plan.sets
+                            .check(t_end, x, hit, &mut [], &mut path.left_domain, &mut st_s);
+                        for (j, xj) in x.iter().enumerate() {
+                            let lane = xl[j].0[l];
+                            assert_eq!(lane.to_bits(), xj.to_bits(), "{case}, t = {t}, lane {l}");
+                        }
+                    }
+                }
+            }
+            assert_eq!(hit_l, hit_s, "{case}");
+            assert_eq!(st_l, st_s, "{case}");
+            let flags = |paths: &[Path]| paths.iter().map(|p| p.left_domain).collect::<Vec<_>>();
+            assert_eq!(flags(&lanes), flags(&scalar), "{case}");
+            for (a, b) in lanes.iter().zip(&scalar) {
+                assert_eq!(
+                    a.rng.state(),
+                    b.rng.state(),
+                    "{case}: the streams moved alike"
+                );
+            }
+            hits += hit_s.iter().filter(|&&h| h).count();
+            exits += flags(&scalar).iter().filter(|&&e| e).count();
+        }
+        // Not vacuous: the paths enter unsafe sets and leave the domain.
+        assert!(hits > 10, "{hits}");
+        assert!(exits > 0, "{exits}");
+    }
+
     /// Eight paths in lanes (`lanes_x8`; of 203 paths, the last three in the scalar loops)
     /// against the scalar loops, path by path: a constant `G` that is not diagonal, a full
     /// metric, the contraction method's intersection with its interval box (time-uniform: the
@@ -1387,19 +1440,27 @@ mod tests {
     /// unsafe sets and a domain, checked after every step); the pendulum, the pendulum with
     /// state-dependent noise, and a forced pendulum in each input mode. The records, counts,
     /// tube exits, unsafe-set hits with their first times, and domain exits are the same.
+    ///
+    /// The lanes need AVX-512 (F and DQ). Where the processor that built the tests has none,
+    /// the test is ignored (`cargo test` lists it as such: a skip that shows, not a pass), and
+    /// [`lane_kernels_step_as_the_scalar_loop`] still checks the portable kernels; the build
+    /// script decides (`reachc_avx512`). `REACHC_REQUIRE_AVX512=1` at build time runs it
+    /// regardless, so that a machine meant to test the lanes fails without them.
+    #[cfg(target_arch = "x86_64")]
+    #[cfg_attr(
+        not(reachc_avx512),
+        ignore = "no AVX-512 (F and DQ) on the machine that built the tests: the lanes cannot run"
+    )]
     #[test]
     fn lanes_do_not_change_the_paths() {
-        if !super::super::avx512::available() {
-            eprintln!("no AVX-512: nothing to compare");
-            return;
-        }
+        super::super::avx512::require();
         // The lanes record a group's steps in turn, the scalar loops a step's paths.
         let sorted = ChunkStats::sorted;
         let (mut outside, mut hits, mut late) = (0, 0, 0.0_f64);
         for method in [Method::Contraction, Method::Interval] {
             for guarantee in [Guarantee::Uniform, Guarantee::Pointwise] {
                 let info = pendulum(method);
-                let mut r = engine::run(&Pendulum, &info, &info.analyses[0]).unwrap();
+                let mut r = engine::run(&PENDULUM, &info, &info.analyses[0]).unwrap();
                 r.guarantee = guarantee;
                 if method == Method::Contraction {
                     assert!(!r.also.is_empty(), "an intersection");
@@ -1419,7 +1480,7 @@ mod tests {
                     let forced = with_input(&regions);
                     let modes = [InputMode::Random, InputMode::Corners, InputMode::Centre];
                     let systems = [
-                        (&Pendulum as &dyn System, &regions, InputMode::Random, true),
+                        (&PENDULUM as &dyn System, &regions, InputMode::Random, true),
                         (&MULTIPLICATIVE, &regions, InputMode::Random, false),
                     ]
                     .into_iter()
@@ -1489,22 +1550,22 @@ mod tests {
             1
         }
         fn drift(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
-            Pendulum.drift(x, u, t, out);
+            PENDULUM.drift(x, u, t, out);
             if self.forced {
                 out[1] += u[0];
             }
         }
         fn drift_interval(&self, x: &[Interval], u: &[Interval], t: Interval, o: &mut [Interval]) {
-            Pendulum.drift_interval(x, u, t, o);
+            PENDULUM.drift_interval(x, u, t, o);
             if self.forced {
                 o[1] += u[0];
             }
         }
         fn jac_x(&self, x: &[f64], u: &[f64], t: f64, out: &mut [f64]) {
-            Pendulum.jac_x(x, u, t, out);
+            PENDULUM.jac_x(x, u, t, out);
         }
         fn jac_x_interval(&self, x: &[Interval], u: &[Interval], t: Interval, o: &mut [Interval]) {
-            Pendulum.jac_x_interval(x, u, t, o);
+            PENDULUM.jac_x_interval(x, u, t, o);
         }
         fn jac_u(&self, _x: &[f64], _u: &[f64], _t: f64, out: &mut [f64]) {
             if self.forced {
@@ -1520,7 +1581,7 @@ mod tests {
             if self.multiplicative {
                 out.copy_from_slice(&[0.0, 0.1 + 0.05 * x[0].sin()]);
             } else {
-                Pendulum.diffusion(x, t, out);
+                PENDULUM.diffusion(x, t, out);
             }
         }
         fn diffusion_interval(&self, x: &[Interval], t: Interval, o: &mut [Interval]) {
@@ -1528,7 +1589,7 @@ mod tests {
                 let p = Interval::point;
                 o.copy_from_slice(&[Interval::ZERO, p(0.1) + p(0.05) * x[0].sin()]);
             } else {
-                Pendulum.diffusion_interval(x, t, o);
+                PENDULUM.diffusion_interval(x, t, o);
             }
         }
     }

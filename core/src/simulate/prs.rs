@@ -1187,6 +1187,9 @@ pub(super) mod tests {
     use crate::prs::TransformUsed;
     use crate::simulate::rng::PathRng;
     use crate::system::System;
+    use crate::test_support::models::model;
+    use crate::test_support::rng::box_muller;
+    use crate::test_support::sets::zonotope_in_box;
 
     /// `dx = A x dt + 0.2 dW` with a non-symmetric stable `A`.
     struct Sys;
@@ -1254,24 +1257,7 @@ pub(super) mod tests {
     /// The result of `method` with `metric`; `members`: with the members of its intersection
     /// (a contraction run's interval box, method.md 8.7), else its own set alone.
     fn result(method: Method, metric: Vec<f64>, members: bool) -> Prs {
-        let info = ModelInfo {
-            goals: Vec::new(),
-            name: "m".into(),
-            states: vec!["x".into(), "y".into()],
-            inputs: vec![],
-            noises: vec!["w1".into(), "w2".into()],
-            input_box: vec![],
-            initial: InitialSet {
-                boxes: vec![Some(Bounds::new(0.9, 1.1)), Some(Bounds::new(-0.1, 0.2))],
-                balls: vec![],
-            },
-            domain: vec![Bounds::ENTIRE; 2],
-            has_domain: false,
-            affine: false,
-            constant_diffusion: false,
-            unsafe_sets: vec![],
-            analyses: vec![],
-        };
+        let info = model("m", &["x", "y"], &["w1", "w2"], &[(0.9, 1.1), (-0.1, 0.2)]);
         let analysis = Analysis {
             spec: AnalysisSpec {
                 name: "a".into(),
@@ -1354,12 +1340,7 @@ pub(super) mod tests {
         let p = r.constants.metric.clone();
         for st in &mut r.steps {
             let (lo, hi) = st.det.box_hull().expect("a box");
-            let center: Vec<f64> = (0..2).map(|i| 0.5 * (lo[i] + hi[i])).collect();
-            let half: Vec<f64> = (0..2).map(|i| 0.5 * (hi[i] - lo[i])).collect();
-            let generators: Vec<f64> = gens
-                .iter()
-                .flat_map(|g| [g[0] * half[0], g[1] * half[1]])
-                .collect();
+            let (center, generators) = zonotope_in_box(lo, hi, gens);
             let (hull_lo, hull_hi) = zonotope::hull(&center, &generators);
             let remainder = remainder * st.r_t;
             let up = |a: f64, b: f64| (Interval::point(a) + Interval::point(b)).hi();
@@ -1733,8 +1714,8 @@ pub(super) mod tests {
     fn high_dimensional(n: usize, steps: usize, count: usize) -> (Prs, Vec<(usize, Vec<f64>)>) {
         let mut rng = PathRng::new(n as u64, 0);
         let normal = |rng: &mut PathRng| {
-            let (u, v) = (rng.uniform_open0(), rng.uniform());
-            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+            let u = rng.uniform_open0();
+            box_muller(u, rng.uniform())
         };
         let mut r = result(Method::Interval, vec![1.0, 0.0, 0.0, 1.0], false);
         let a: Vec<f64> = (0..n * n).map(|_| rng.uniform() - 0.5).collect();

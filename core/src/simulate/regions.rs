@@ -225,6 +225,7 @@ impl Region {
 mod tests {
     use super::*;
     use crate::model::{GoalSet, Moving, Slot, UnsafeSet};
+    use crate::test_support::models::model;
 
     #[test]
     fn shapes() {
@@ -272,19 +273,6 @@ mod tests {
             radius,
         };
         let info = ModelInfo {
-            name: "m".into(),
-            states: vec!["x".into(), "y".into()],
-            inputs: vec![],
-            noises: vec![],
-            input_box: vec![],
-            initial: crate::model::InitialSet {
-                boxes: vec![Some(Bounds::new(0.0, 0.0)); 2],
-                balls: vec![],
-            },
-            domain: vec![Bounds::ENTIRE; 2],
-            has_domain: false,
-            affine: false,
-            constant_diffusion: false,
             unsafe_sets: vec![
                 UnsafeSet {
                     name: "half".into(),
@@ -315,7 +303,7 @@ mod tests {
                 window: None,
                 stay: false,
             }],
-            analyses: vec![],
+            ..model("m", &["x", "y"], &[], &[(0.0, 0.0); 2])
         };
         let mut sets = SetRegions::new(&info, 2, 1.0).unwrap();
         let numbers = [

@@ -224,75 +224,21 @@ fn record<S: System + ?Sized>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::interval::Interval;
-    use crate::model::{Bounds, InitialSet, ModelInfo};
+    use crate::model::ModelInfo;
+    use crate::test_support::models::model;
+    use crate::test_support::systems::Linear;
 
-    /// `dx = -x dt + 0.5 dW`, x(0) uniform in [1, 2]; input-free.
-    struct Ou;
+    /// `dx = -x dt + 0.5 dW`; input-free.
+    const OU: Linear = Linear {
+        n: 1,
+        a: -1.0,
+        b: 0.0,
+        s: 0.5,
+    };
 
-    impl System for Ou {
-        fn n(&self) -> usize {
-            1
-        }
-        fn p(&self) -> usize {
-            0
-        }
-        fn m(&self) -> usize {
-            1
-        }
-        fn drift(&self, x: &[f64], _: &[f64], _: f64, out: &mut [f64]) {
-            out[0] = -x[0];
-        }
-        fn drift_interval(
-            &self,
-            x: &[Interval],
-            _: &[Interval],
-            _: Interval,
-            out: &mut [Interval],
-        ) {
-            out[0] = -x[0];
-        }
-        fn jac_x(&self, _: &[f64], _: &[f64], _: f64, out: &mut [f64]) {
-            out[0] = -1.0;
-        }
-        fn jac_x_interval(
-            &self,
-            _: &[Interval],
-            _: &[Interval],
-            _: Interval,
-            out: &mut [Interval],
-        ) {
-            out[0] = Interval::point(-1.0);
-        }
-        fn jac_u(&self, _: &[f64], _: &[f64], _: f64, _: &mut [f64]) {}
-        fn jac_u_interval(&self, _: &[Interval], _: &[Interval], _: Interval, _: &mut [Interval]) {}
-        fn diffusion(&self, _: &[f64], _: f64, out: &mut [f64]) {
-            out[0] = 0.5;
-        }
-        fn diffusion_interval(&self, _: &[Interval], _: Interval, out: &mut [Interval]) {
-            out[0] = Interval::point(0.5);
-        }
-    }
-
+    /// [`OU`] with x(0) uniform in [1, 2].
     fn info() -> ModelInfo {
-        ModelInfo {
-            goals: Vec::new(),
-            name: "ou".into(),
-            states: vec!["x".into()],
-            inputs: vec![],
-            noises: vec!["w".into()],
-            input_box: vec![],
-            initial: InitialSet {
-                boxes: vec![Some(Bounds::new(1.0, 2.0))],
-                balls: vec![],
-            },
-            domain: vec![Bounds::ENTIRE],
-            has_domain: false,
-            affine: false,
-            constant_diffusion: false,
-            unsafe_sets: vec![],
-            analyses: vec![],
-        }
+        model("ou", &["x"], &["w"], &[(1.0, 2.0)])
     }
 
     #[test]
@@ -303,7 +249,7 @@ mod tests {
             dt: Some(0.01),
             ..Options::default()
         };
-        let paths = sample_paths(&Ou, &info(), &times, None, &opts).unwrap();
+        let paths = sample_paths(&OU, &info(), &times, None, &opts).unwrap();
         assert_eq!(paths.len(), 4000);
         assert!(paths.iter().all(|p| p.len() == 11));
         assert!(paths.iter().all(|p| (1.0..=2.0).contains(&p[0])));
@@ -324,11 +270,11 @@ mod tests {
             seed: 9,
             ..Options::default()
         };
-        let a = sample_paths(&Ou, &info(), &times, Some(&[1.5]), &opts).unwrap();
-        let b = sample_paths(&Ou, &info(), &times, None, &opts).unwrap();
+        let a = sample_paths(&OU, &info(), &times, Some(&[1.5]), &opts).unwrap();
+        let b = sample_paths(&OU, &info(), &times, None, &opts).unwrap();
         assert_eq!(a, b);
         assert_ne!(a[0], a[1]);
-        assert!(sample_paths(&Ou, &info(), &[0.5, 1.0], None, &opts).is_err());
-        assert!(sample_paths(&Ou, &info(), &[0.0, 1.0, 1.0], None, &opts).is_err());
+        assert!(sample_paths(&OU, &info(), &[0.5, 1.0], None, &opts).is_err());
+        assert!(sample_paths(&OU, &info(), &[0.0, 1.0, 1.0], None, &opts).is_err());
     }
 }

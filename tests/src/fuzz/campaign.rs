@@ -2,7 +2,7 @@
 //! interp`, on a few threads, each input under its [`Budget`]; the outcome of every input.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Duration;
@@ -13,7 +13,8 @@ use proptest::test_runner::{Config as RunnerConfig, RngAlgorithm, TestRng, TestR
 use super::classify::{classify, Outcome};
 use super::exec::{self, reachc_binary, Budget};
 use super::mutate::{mutant, valid_mutant, Mutant};
-use crate::workspace;
+/// A scratch folder per worker (`fuzz-...`), removed on drop.
+pub use reachc_test_support::files::Scratch;
 
 /// Seeds whose own `run` takes seconds: their mutants go through `check` only, so a timeout of
 /// `run` means the mutation made it slow. (`vanderpol.sde` runs 2 x 64 pieces of its initial
@@ -39,13 +40,7 @@ impl Corpus {
     pub fn load() -> Corpus {
         let (mut names, mut texts) = (Vec::new(), Vec::new());
         for dir in ["tests/fuzz/corpus", "specs", "tests/good", "tests/bad"] {
-            let mut paths: Vec<PathBuf> = std::fs::read_dir(workspace().join(dir))
-                .unwrap_or_else(|e| panic!("{dir}: {e}"))
-                .map(|e| e.expect("readable entry").path())
-                .filter(|p| p.extension().is_some_and(|e| e == "sde"))
-                .collect();
-            paths.sort();
-            for path in paths {
+            for path in crate::specs_in(dir) {
                 // Invalid UTF-8 seeds (tests/bad/not_utf8.sde) are left to the byte mutations.
                 let Ok(text) = std::fs::read_to_string(&path) else {
                     continue;
@@ -185,25 +180,6 @@ pub struct Plan {
     pub threads: usize,
 }
 
-/// A scratch folder per worker, removed on drop.
-pub struct Scratch(pub PathBuf);
-
-impl Scratch {
-    /// A fresh folder named after the process and `tag`.
-    pub fn new(tag: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("reachc-fuzz-{}-{tag}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("the temporary folder is writable");
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 /// Runs `bytes` as a spec through `command` in `dir` (for `run`, `check` first: an exit 1 of
 /// `run` needs a located diagnostic only when the spec does not check). Returns the outcome,
 /// the first lines of stderr and the time taken.
@@ -261,7 +237,7 @@ pub fn run_campaign(
         for worker in 0..plan.threads.max(1) {
             let (jobs, next, done, records, seeds) = (&jobs, &next, &done, &records, &seeds);
             s.spawn(move || {
-                let scratch = Scratch::new(&format!("w{worker}"));
+                let scratch = Scratch::new(&format!("fuzz-w{worker}"));
                 while let Some(&(command, index)) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) {
                     let m = mutant_at(command, plan.seed, index);
                     let candidates = &seeds[usize::from(command == Command::Run)];
