@@ -1,5 +1,5 @@
-//! Renderings of a [`Prs`]: JSON (documented in docs/results.md; [`json`]), CSV ([`csv`]) and a
-//! text summary ([`text`]), with the sentences the JSON and the text share ([`words`]).
+//! Renderings of a [`Prs`]: JSON (documented in docs/results.md; `json.rs`), CSV (`csv.rs`)
+//! and a text summary (`text.rs`), with the sentences the JSON and the text share (`words.rs`).
 
 mod csv;
 mod json;
