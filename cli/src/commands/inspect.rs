@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use reachc_runtime::interval::Interval;
-use reachc_runtime::report::shape::ShapeJson;
+use reachc_runtime::report::schema::ShapeJson;
 use serde::Serialize;
 use serde_json::{json, Value};
 

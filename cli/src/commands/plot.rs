@@ -136,11 +136,13 @@ fn write(files: Files) -> Result<(), u8> {
 fn quantile_of(sim: &SimFile, result: &ResultFile, source: String) -> Quantile {
     let n = result.states.len();
     let per_state = sim.states == result.states && sim.steps.iter().all(|s| s.states.len() == n);
+    // A statistic that was not finite is written as `null`, read as NaN.
+    let finite = |v: f64| Some(v).filter(|v| v.is_finite());
     Quantile {
-        values: sim.steps.iter().map(|s| s.quantile).collect(),
+        values: sim.steps.iter().map(|s| finite(s.quantile)).collect(),
         states: if per_state {
             StateWidths::per_state(&sim.steps, n, |s, i| {
-                (s.states[i].prs, s.states[i].quantile)
+                (finite(s.states[i].prs), finite(s.states[i].quantile))
             })
         } else {
             Vec::new()

@@ -5,11 +5,14 @@
 
 use super::figures::num;
 use super::geometry::{clip, half_planes, Plane, Point, Projected};
-use super::input::{Guarantee, Method, MovingSet, RateSource, ResultFile, Role, Shape, Step};
+use super::input::MovingSet;
 use super::regions::Region;
 use super::Quantile;
 use reachc_runtime::model::{Analysis, ModelInfo};
 use reachc_runtime::report::count;
+use reachc_runtime::report::schema::{
+    Guarantee, Method, RateSource, ResultJson, Role, Shape, StepJson,
+};
 
 /// The sets figure: a 2-D projection.
 #[derive(Clone, Debug)]
@@ -104,7 +107,7 @@ pub struct WidthCurves {
 /// The widths figure of the `plotted` states of a result, from a Monte Carlo report with
 /// per-state spreads (`None` without them).
 pub fn widths_scene(
-    result: &ResultFile,
+    result: &ResultJson,
     plotted: [usize; 2],
     quantile: &Quantile,
 ) -> Option<WidthsScene> {
@@ -178,16 +181,13 @@ pub struct RatesScene {
 }
 
 /// The rates figure of a result with time-varying rates, `None` for one global rate.
-pub fn rates_scene(result: &ResultFile) -> Option<RatesScene> {
+pub fn rates_scene(result: &ResultJson) -> Option<RatesScene> {
     let rate = result
         .rate
         .as_ref()
         .filter(|r| r.kind != RateSource::Global)?;
     let steps = result.steps.get(1..).unwrap_or_default();
-    let sigma = steps
-        .iter()
-        .filter_map(|s| s.sigma)
-        .filter(|v| v.is_finite());
+    let sigma = steps.iter().map(|s| s.sigma).filter(|v| v.is_finite());
     let (lo, hi) = sigma.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
     });
@@ -217,14 +217,14 @@ pub fn rates_scene(result: &ResultFile) -> Option<RatesScene> {
         times: steps.iter().map(|s| s.t).collect(),
         c: steps
             .iter()
-            .map(|s| s.c.filter(|v| v.is_finite()))
+            .map(|s| Some(s.c).filter(|v| v.is_finite()))
             .collect(),
         notes,
     })
 }
 
 /// The deterministic set of a step in the plane.
-fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
+fn det_set(result: &ResultJson, plane: &Plane, step: &StepJson) -> Projected {
     let d = &step.det_set;
     // ResultFile::read checked the shapes: lo and hi exist for boxes and parallelotopes, the
     // generators and the remainder for zonotopes.
@@ -254,14 +254,14 @@ fn det_set(result: &ResultFile, plane: &Plane, step: &Step) -> Projected {
 
 /// Whether a result's own sets are first-order zonotopes (a member of role
 /// [`Role::FirstOrder`] or [`Role::Linearised`]; its set at `t = 0` is the initial box).
-fn zonotopes(result: &ResultFile) -> bool {
+fn zonotopes(result: &ResultJson) -> bool {
     matches!(result.role, Role::FirstOrder | Role::Linearised)
 }
 
 /// The projected PRS `poly` of report step `k` clipped by the projected PRS of each further
 /// metric of the result (its polygon contains the set, so the clipped polygon contains the
 /// projection of the intersection).
-fn intersected(result: &ResultFile, plane: &Plane, k: usize, poly: Vec<Point>) -> Vec<Point> {
+fn intersected(result: &ResultJson, plane: &Plane, k: usize, poly: Vec<Point>) -> Vec<Point> {
     result.also.iter().fold(poly, |poly, m| {
         let (Some(mp), Some(step)) = (
             Plane::new(plane.states, &m.constants.metric),
@@ -295,7 +295,7 @@ fn samples_at(paths: &[Vec<Point>], k: usize) -> Vec<Point> {
 
 /// The PRS of every report step of a result, as polygons (their union is the set of states the
 /// PRS hold at some time of the horizon).
-pub fn envelope(result: &ResultFile, plane: &Plane) -> Vec<Vec<Point>> {
+pub fn envelope(result: &ResultJson, plane: &Plane) -> Vec<Vec<Point>> {
     result
         .steps
         .iter()
@@ -311,7 +311,7 @@ pub fn envelope(result: &ResultFile, plane: &Plane) -> Vec<Vec<Point>> {
 /// The sets figure of a result: the sets at report steps `picked`, the nominal, the sample
 /// paths (flat states at every report time of the result) and the unsafe regions.
 pub fn sets_scene(
-    result: &ResultFile,
+    result: &ResultJson,
     plane: &Plane,
     picked: &[usize],
     paths: &[Vec<f64>],
@@ -447,7 +447,7 @@ pub struct MovingRegions {
 /// ending there (its margins' set), a goal as its parts then. A set that does not constrain
 /// the plotted states is listed in `notes` instead, and a note says what is drawn.
 pub fn moving_regions(
-    result: &ResultFile,
+    result: &ResultJson,
     moving: &[MovingSet],
     plane: [usize; 2],
     at: &[usize],
@@ -545,7 +545,7 @@ pub fn paths_scene(
 /// The radius figure of a result, with the Monte Carlo quantile if given (`(values per report
 /// time, number of paths, where they come from)`).
 pub fn radius_scene(
-    result: &ResultFile,
+    result: &ResultJson,
     quantile: Option<(Vec<Option<f64>>, u64, &str)>,
 ) -> RadiusScene {
     let contraction = result.method == Method::Contraction;
@@ -602,9 +602,12 @@ pub fn radius_scene(
 
 #[cfg(test)]
 mod tests {
-    use super::super::input::{Constants, DetSet, PieceFile, PieceStep};
+    use super::super::input::tests::result as sample;
     use super::*;
     use reachc_runtime::model::{Bounds, UnsafeShape};
+    use reachc_runtime::report::schema::{
+        DetSetJson, MetricRef, PieceJson, PieceStepJson, VerdictJson,
+    };
 
     const P: [[f64; 2]; 2] = [[2.0, 0.5], [0.5, 1.0]];
     /// `P^-1`.
@@ -612,63 +615,51 @@ mod tests {
     const CENTER: [f64; 2] = [1.0, 0.0];
     const GENS: [[f64; 2]; 3] = [[0.3, 0.1], [-0.1, 0.4], [0.2, -0.2]];
 
-    /// The zonotope of [`GENS`] around [`CENTER`] plus `B_P(remainder)`.
-    fn zonotope(remainder: f64) -> DetSet {
-        DetSet {
-            shape: Shape::Zonotope,
+    /// A deterministic set of `shape` about [`CENTER`] of `radius`, without corners or
+    /// generators.
+    fn set_about(shape: Shape, radius: f64) -> DetSetJson {
+        DetSetJson {
+            shape,
             center: CENTER.to_vec(),
-            radius: 2.0,
+            radius,
+            metric: MetricRef::Constants,
             lo: None,
             hi: None,
+            hull_lo: None,
+            hull_hi: None,
+            generators: None,
+            remainder: None,
+        }
+    }
+
+    /// The zonotope of [`GENS`] around [`CENTER`] plus `B_P(remainder)`.
+    fn zonotope(remainder: f64) -> DetSetJson {
+        DetSetJson {
             generators: Some(GENS.iter().map(|g| g.to_vec()).collect()),
             remainder: Some(remainder),
+            ..set_about(Shape::Zonotope, 2.0)
         }
     }
 
     /// A result in two states with one report time holding `det` and `r_t`, and `also`.
-    fn result(method: Method, det: DetSet, r_t: f64, also: Vec<ResultFile>) -> ResultFile {
-        ResultFile {
-            model: "m".into(),
-            analysis: "a".into(),
-            method,
-            delta: 0.01,
-            guarantee: Guarantee::Uniform,
-            states: vec!["x".into(), "y".into()],
-            outputs: vec![0, 1],
-            constants: Constants {
-                metric: P.iter().map(|r| r.to_vec()).collect(),
-            },
-            transform: None,
-            initial_center: CENTER.to_vec(),
-            rate: None,
-            steps: vec![Step {
-                t: 1.0,
-                nominal: CENTER.to_vec(),
-                det_set: det,
-                r_t,
-                prs_radius: 2.0,
-                c: None,
-                sigma: None,
-            }],
-            also,
-            role: Role::Own,
-            pieces: Vec::new(),
-            unsafe_sets: Vec::new(),
-            goals: Vec::new(),
-        }
+    fn result(method: Method, det: DetSetJson, r_t: f64, also: Vec<ResultJson>) -> ResultJson {
+        let ball = serde_json::to_value(p_ball(1.0)).unwrap();
+        let mut r: ResultJson =
+            serde_json::from_value(sample(ball, serde_json::json!([]))).unwrap();
+        r.method = method;
+        r.guarantee = Guarantee::Uniform;
+        r.constants.metric = P.iter().map(|r| r.to_vec()).collect();
+        r.initial_center = CENTER.to_vec();
+        let step = &mut r.steps[0];
+        (step.t, step.nominal, step.det_set) = (1.0, CENTER.to_vec(), det);
+        (step.r_t, step.prs_radius) = (r_t, 2.0);
+        r.also = also;
+        r
     }
 
     /// The P-ball of `radius` about [`CENTER`].
-    fn p_ball(radius: f64) -> DetSet {
-        DetSet {
-            shape: Shape::PBall,
-            center: CENTER.to_vec(),
-            radius,
-            lo: None,
-            hi: None,
-            generators: None,
-            remainder: None,
-        }
+    fn p_ball(radius: f64) -> DetSetJson {
+        set_about(Shape::PBall, radius)
     }
 
     /// `sqrt(d' P^-1 d)`: the support of `B_P(1)`.
@@ -729,21 +720,20 @@ mod tests {
     /// outline), no dashed deterministic set, and the legend says so.
     #[test]
     fn the_pieces_of_a_split_are_drawn() {
-        let hull = DetSet {
-            shape: Shape::Box,
-            center: CENTER.to_vec(),
-            radius: 3.0,
+        let hull = DetSetJson {
             lo: Some(vec![-1.0, -1.0]),
             hi: Some(vec![2.0, 2.0]),
-            generators: None,
-            remainder: None,
+            ..set_about(Shape::Box, 3.0)
         };
         let mut union = result(Method::Contraction, hull, 0.0, vec![]);
-        let piece = |lo: [f64; 2], hi: [f64; 2]| PieceFile {
-            steps: vec![PieceStep {
+        let piece = |lo: [f64; 2], hi: [f64; 2]| PieceJson {
+            initial_box: vec![[0.0, 1.0]; 2],
+            verdict: VerdictJson::NoUnsafeSets,
+            steps: vec![PieceStepJson {
                 t: 1.0,
                 prs_hull_lo: lo.to_vec(),
                 prs_hull_hi: hi.to_vec(),
+                margins: Vec::new(),
             }],
         };
         union.pieces = vec![
@@ -807,7 +797,7 @@ mod tests {
     fn moving_sets_are_drawn_where_they_are_at_each_time() {
         let mut r = result(Method::Contraction, p_ball(1.0), 0.1, vec![]);
         r.steps = (0..3)
-            .map(|k| Step {
+            .map(|k| StepJson {
                 t: 0.5 * f64::from(k),
                 ..r.steps[0].clone()
             })

@@ -1,11 +1,12 @@
 //! Renderings of typed results, the one place where results become text: JSON (documented in
 //! docs/results.md), CSV and text summaries of a [`Prs`](reachc_core::Prs)
 //! ([`result`]) and of a Monte Carlo [`SimReport`](reachc_core::simulate::SimReport)
-//! ([`simulation`]), and the JSON form of set shapes ([`shape`]).
+//! ([`simulation`]), written through the types of their JSON documents ([`schema`], which the
+//! plots read back).
 
 pub mod probability;
 pub mod result;
-pub mod shape;
+pub mod schema;
 pub mod simulation;
 pub mod tightening;
 

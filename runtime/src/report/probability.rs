@@ -1,41 +1,17 @@
 //! The probability of safety in words and in the result's JSON (`reachc run --probability`,
 //! method.md 8.9).
 
-use super::result::GoalMissJson;
+use super::schema::{
+    GoalLimitJson, GoalMissJson, GoalProbabilityJson, LimitJson, ProbabilityJson, SearchLimitJson,
+};
 use super::{count, time};
 use reachc_core::model::{GoalSet, UnsafeSet};
 use reachc_core::probability::{GoalLimit, GoalProbability, SafetyLimit, SafetyProbability};
 use reachc_core::prs::{GoalMiss, Prs, Validation};
-use serde::Serialize;
 
-/// The `safety_probability` object of the JSON document.
-#[derive(Serialize)]
-pub(super) struct ProbabilityJson<'a> {
-    horizon: f64,
-    /// `1 - delta` rounded down; `null` without a bound.
-    lower_bound: Option<f64>,
-    delta: Option<f64>,
-    not_shown_at: Option<f64>,
-    limit: LimitJson<'a>,
-    runs: usize,
-    /// Every part of the run behind the bound is proved (no "not validated" entry).
-    proved: bool,
-    conditional_on_domain: bool,
-}
-
-#[derive(Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-enum LimitJson<'a> {
-    Resolution,
-    Floor,
-    Stochastic { t: f64, set: &'a str },
-    Deterministic { t: f64, set: &'a str },
-    Failed { delta: f64, why: String },
-}
-
-impl<'a> ProbabilityJson<'a> {
-    pub(super) fn of(prs: &'a Prs, p: &'a SafetyProbability) -> ProbabilityJson<'a> {
-        let name = |set: usize| prs.unsafe_sets()[set].name.as_str();
+impl ProbabilityJson {
+    pub(super) fn of(prs: &Prs, p: &SafetyProbability) -> ProbabilityJson {
+        let name = |set: usize| prs.unsafe_sets()[set].name.clone();
         ProbabilityJson {
             horizon: p.horizon,
             lower_bound: p.lower_bound(),
@@ -74,39 +50,8 @@ pub struct Probabilities<'a> {
     pub goals: &'a [GoalProbability],
 }
 
-/// The `probability` object of a goal in the JSON document.
-#[derive(Serialize)]
-pub(super) struct GoalProbabilityJson<'a> {
-    /// `1 - delta` rounded down; `null` without a bound.
-    lower_bound: Option<f64>,
-    delta: Option<f64>,
-    /// The first report time at which the goal is shown reached at `delta`.
-    t: Option<f64>,
-    not_shown_at: Option<f64>,
-    limit: GoalLimitJson<'a>,
-    runs: usize,
-    proved: bool,
-    conditional_on_domain: bool,
-}
-
-/// A goal probability's limit: the search's own, or the goal's miss at the largest delta tried.
-#[derive(Serialize)]
-#[serde(untagged)]
-enum GoalLimitJson<'a> {
-    Search(SearchLimitJson),
-    Miss(GoalMissJson<'a>),
-}
-
-#[derive(Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-enum SearchLimitJson {
-    Resolution,
-    Floor,
-    Failed { delta: f64, why: String },
-}
-
-impl<'a> GoalProbabilityJson<'a> {
-    pub(super) fn of(prs: &'a Prs, p: &'a GoalProbability) -> GoalProbabilityJson<'a> {
+impl GoalProbabilityJson {
+    pub(super) fn of(prs: &Prs, p: &GoalProbability) -> GoalProbabilityJson {
         GoalProbabilityJson {
             lower_bound: p.lower_bound(),
             delta: p.delta,

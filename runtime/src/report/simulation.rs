@@ -1,172 +1,23 @@
 //! Renderings of a Monte Carlo [`SimReport`]: JSON (documented in docs/results.md) and a text
 //! summary.
 
-use super::result::{inline_scalar_arrays, unsafe_kind};
+use super::result::unsafe_kind;
+use super::schema::{
+    CoverageJson, DtRuleJson, DtStatus, HorizonJson, InputsJson, SafetyJson, SimGoalJson, SimJson,
+    SimStateJson, SimStepJson, SimUnsafeJson, TubeJson,
+};
 use super::{count, summary_indices, time};
 use reachc_core::model::Guarantee;
 use reachc_core::simulate::{
     DtSource, DtUsed, InitialSampling, InputMode, NoiseKind, SimReport, DT_ACCURACY, DT_RULE,
     MAX_STEPS,
 };
-use serde::Serialize;
 use std::fmt::Write as _;
 
 /// Pretty-printed JSON of a report (arrays of scalars on one line, non-finite numbers as
 /// `null`).
 pub fn to_json(r: &SimReport) -> String {
-    // Plain data with string keys: serialising cannot fail.
-    let pretty =
-        serde_json::to_string_pretty(&Json::of(r)).expect("a Monte Carlo report serialises");
-    inline_scalar_arrays(&pretty)
-}
-
-/// The JSON document, field for field.
-#[derive(Serialize)]
-struct Json<'a> {
-    model: &'a str,
-    analysis: &'a str,
-    states: &'a [String],
-    method: &'static str,
-    delta: f64,
-    guarantee: &'static str,
-    paths: u64,
-    seed: u64,
-    dt: f64,
-    dt_min: f64,
-    dt_rule: DtRuleJson,
-    steps_per_path: u64,
-    initial_states: &'static str,
-    inputs: InputsJson,
-    noise: String,
-    compared: &'static str,
-    quantile_rank: u64,
-    confidence: f64,
-    steps: Vec<StepJson>,
-    horizon: HorizonJson,
-    outside_tube: Option<TubeJson>,
-    unsafe_sets: Vec<UnsafeJson<'a>>,
-    safety: Option<SafetyJson>,
-    /// Per goal set (absent without goals).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    goals: Vec<GoalJson<'a>>,
-    left_domain: Option<u64>,
-    diverged: u64,
-    verdict: CoverageJson,
-}
-
-/// How the Euler-Maruyama steps compare with the rules `h L_k <= 0.05` and
-/// `(h_k / 2) a_k tau_k <= 0.05 w_k`.
-#[derive(Serialize)]
-struct DtRuleJson {
-    /// `rule` (chosen by it) or `option` (`--dt`).
-    source: &'static str,
-    /// `met`, `capped` (the rule's cap of steps per report interval bound) or `coarser` (the
-    /// `--dt` is coarser than the rule asks).
-    status: &'static str,
-    bound: f64,
-    hl_max: f64,
-    accuracy: f64,
-    bias_max: f64,
-    rule_min: f64,
-    coarse_intervals: u64,
-    max_steps: u32,
-    warning: Option<String>,
-}
-
-#[derive(Serialize)]
-struct InputsJson {
-    mode: &'static str,
-    hold: Option<f64>,
-    description: String,
-}
-
-#[derive(Serialize)]
-struct StepJson {
-    t: f64,
-    r_t: f64,
-    prs_radius: f64,
-    quantile: f64,
-    max: f64,
-    outside: u64,
-    fraction: f64,
-    cp_upper: f64,
-    /// Uniform results only: the paths first leaving the tube in the interval ending here.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    left_tube: Option<u64>,
-    /// Per state, in the order of `states`.
-    states: Vec<StateJson>,
-}
-
-/// One state's spread against the PRS's bounding box at a report time.
-#[derive(Serialize)]
-struct StateJson {
-    quantile: f64,
-    max: f64,
-    prs: f64,
-    ratio: f64,
-}
-
-#[derive(Serialize)]
-struct TubeJson {
-    count: u64,
-    fraction: f64,
-    cp_upper: f64,
-    cp_lower: f64,
-    checks_per_path: u64,
-    checked: &'static str,
-}
-
-#[derive(Serialize)]
-struct HorizonJson {
-    outside_any: u64,
-    fraction: f64,
-    cp_upper: f64,
-}
-
-#[derive(Serialize)]
-struct UnsafeJson<'a> {
-    name: &'a str,
-    kind: &'static str,
-    hits: u64,
-    fraction: f64,
-    first_hit_t: Option<f64>,
-}
-
-/// The paths that entered no unsafe set, against the certified probability of safety.
-#[derive(Serialize)]
-struct SafetyJson {
-    safe: u64,
-    fraction: f64,
-    cp_upper: f64,
-    certified: Option<f64>,
-    /// `pass` or `fail`; `null` without a certified bound.
-    status: Option<&'static str>,
-}
-
-/// The paths whose goal event happened, against its certified probability.
-#[derive(Serialize)]
-struct GoalJson<'a> {
-    name: &'a str,
-    reached: u64,
-    fraction: f64,
-    cp_upper: f64,
-    certified: Option<f64>,
-    /// `pass` or `fail`; `null` without a certified bound.
-    status: Option<&'static str>,
-}
-
-#[derive(Serialize)]
-struct CoverageJson {
-    status: &'static str,
-    decided_by: &'static str,
-    pointwise_status: &'static str,
-    alpha: f64,
-    alpha_per_step: f64,
-    failing_steps: usize,
-    worst_step: usize,
-    worst_t: f64,
-    worst_outside: u64,
-    worst_cp_lower: f64,
+    SimJson::of(r).to_text()
 }
 
 /// What the distances and the outside counts measure.
@@ -183,30 +34,21 @@ const TUBE_CHECKED: &str = "all times at once: every path's state after every Eu
     initial state against the PRS at t = 0, and the state at each report time against that \
     time's PRS; outside_tube counts the paths that left at least once";
 
-/// `"pass"` or `"fail"`.
-fn status(passed: bool) -> &'static str {
-    if passed {
-        "pass"
-    } else {
-        "fail"
-    }
-}
-
-impl<'a> Json<'a> {
-    fn of(r: &'a SimReport) -> Json<'a> {
-        Json {
-            model: &r.model,
-            analysis: &r.analysis,
-            states: &r.states,
-            method: r.method.name(),
+impl SimJson {
+    fn of(r: &SimReport) -> SimJson {
+        SimJson {
+            model: r.model.clone(),
+            analysis: r.analysis.clone(),
+            states: r.states.clone(),
+            method: r.method.into(),
             delta: r.delta,
-            guarantee: r.guarantee.name(),
+            guarantee: r.guarantee.into(),
             paths: r.paths,
             seed: r.seed,
             dt: r.dt.max,
             dt_min: r.dt.min,
             dt_rule: DtRuleJson {
-                source: r.dt.source.name(),
+                source: r.dt.source.into(),
                 status: dt_status(&r.dt),
                 bound: DT_RULE,
                 hl_max: r.dt.hl_max,
@@ -218,20 +60,20 @@ impl<'a> Json<'a> {
                 warning: dt_warning(&r.dt),
             },
             steps_per_path: r.steps_per_path,
-            initial_states: initial_states(r.initial_states),
+            initial_states: initial_states(r.initial_states).to_string(),
             inputs: InputsJson {
-                mode: r.inputs.mode.name(),
+                mode: r.inputs.mode.into(),
                 hold: r.inputs.hold,
                 description: inputs(r),
             },
             noise: noise(r.noise),
-            compared: COMPARED,
+            compared: COMPARED.to_string(),
             quantile_rank: r.quantile_rank,
             confidence: r.confidence,
             steps: r
                 .steps
                 .iter()
-                .map(|s| StepJson {
+                .map(|s| SimStepJson {
                     t: s.t,
                     r_t: s.r_t,
                     prs_radius: s.prs_radius,
@@ -244,7 +86,7 @@ impl<'a> Json<'a> {
                     states: s
                         .states
                         .iter()
-                        .map(|v| StateJson {
+                        .map(|v| SimStateJson {
                             quantile: v.quantile,
                             max: v.max,
                             prs: v.prs,
@@ -264,14 +106,14 @@ impl<'a> Json<'a> {
                 cp_upper: t.cp_upper,
                 cp_lower: t.cp_lower,
                 checks_per_path: t.checks_per_path,
-                checked: TUBE_CHECKED,
+                checked: TUBE_CHECKED.to_string(),
             }),
             unsafe_sets: r
                 .unsafe_sets
                 .iter()
-                .map(|u| UnsafeJson {
-                    name: &u.name,
-                    kind: unsafe_kind(u.kind),
+                .map(|u| SimUnsafeJson {
+                    name: u.name.clone(),
+                    kind: u.kind.into(),
                     hits: u.hits,
                     fraction: u.fraction,
                     first_hit_t: u.first_hit_t,
@@ -282,26 +124,26 @@ impl<'a> Json<'a> {
                 fraction: c.fraction,
                 cp_upper: c.cp_upper,
                 certified: c.certified,
-                status: c.certified.map(|_| status(c.passed)),
+                status: c.certified.map(|_| c.passed.into()),
             }),
             goals: r
                 .goals
                 .iter()
-                .map(|g| GoalJson {
-                    name: &g.name,
+                .map(|g| SimGoalJson {
+                    name: g.name.clone(),
                     reached: g.reached,
                     fraction: g.fraction,
                     cp_upper: g.cp_upper,
                     certified: g.certified,
-                    status: g.certified.map(|_| status(g.passed)),
+                    status: g.certified.map(|_| g.passed.into()),
                 })
                 .collect(),
             left_domain: r.left_domain,
             diverged: r.diverged,
             verdict: CoverageJson {
-                status: status(r.verdict.passed),
-                decided_by: r.verdict.decided_by.name(),
-                pointwise_status: status(r.verdict.pointwise_passed),
+                status: r.verdict.passed.into(),
+                decided_by: r.verdict.decided_by.into(),
+                pointwise_status: r.verdict.pointwise_passed.into(),
                 alpha: r.verdict.alpha,
                 alpha_per_step: r.verdict.alpha_per_step,
                 failing_steps: r.verdict.failing_steps,
@@ -314,12 +156,12 @@ impl<'a> Json<'a> {
     }
 }
 
-/// `met`, `capped` or `coarser`.
-fn dt_status(dt: &DtUsed) -> &'static str {
+/// Met, capped or coarser.
+fn dt_status(dt: &DtUsed) -> DtStatus {
     match (dt.meets_rule(), dt.source) {
-        (true, _) => "met",
-        (false, DtSource::Rule) => "capped",
-        (false, DtSource::Option) => "coarser",
+        (true, _) => DtStatus::Met,
+        (false, DtSource::Rule) => DtStatus::Capped,
+        (false, DtSource::Option) => DtStatus::Coarser,
     }
 }
 

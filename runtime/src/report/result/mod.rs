@@ -1,5 +1,6 @@
-//! Renderings of a [`Prs`]: JSON (documented in docs/results.md; `json.rs`), CSV (`csv.rs`)
-//! and a text summary (`text.rs`), with the sentences the JSON and the text share (`words.rs`).
+//! Renderings of a [`Prs`]: JSON (documented in docs/results.md; `json.rs`, through the result
+//! file's types in [`schema`](super::schema)), CSV (`csv.rs`) and a text summary (`text.rs`),
+//! with the sentences the JSON and the text share (`words.rs`).
 
 mod csv;
 mod json;
@@ -7,7 +8,6 @@ mod text;
 mod words;
 
 pub use csv::write_csv;
-pub(crate) use json::{inline_scalar_arrays, GoalMissJson};
 pub use json::{to_json, to_json_with, to_json_within, MEMBERS_BUDGET};
 pub use text::summary;
 pub(crate) use words::unsafe_kind;
