@@ -27,4 +27,4 @@ pub use lanes::X8;
 pub use model::{Bounds, ModelInfo};
 pub use prs::Prs;
 pub use reach::{InputPlan, Reach};
-pub use system::System;
+pub use system::{Model, System};

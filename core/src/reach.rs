@@ -11,7 +11,7 @@ use crate::model::{
     Rate, Split,
 };
 use crate::prs::{Prs, Role, Verdict};
-use crate::system::System;
+use crate::system::{Model, System};
 use crate::workers::Workers;
 use std::time::{Duration, Instant};
 
@@ -25,7 +25,7 @@ use std::time::{Duration, Instant};
 /// outside the input box, is an error.
 ///
 /// ```ignore
-/// let reach = Reach::new(&sys, &info, "contraction")?;
+/// let reach = Reach::new(&Pendulum, pendulum::analysis::CONTRACTION)?;
 /// let prs = reach.from_box(&[Bounds::new(-0.1, 0.1), Bounds::new(-0.2, 0.2)])?;
 /// let radius_at_1 = prs.at(1.0).unwrap().prs_radius;
 /// ```
@@ -44,23 +44,48 @@ pub struct Reach<'a> {
 }
 
 impl<'a> Reach<'a> {
-    /// The analysis `name` of the model (`info` as generated with `sys`).
-    pub fn new(
+    /// The analysis `name` of `model`.
+    pub fn new(model: &'a dyn Model, name: &str) -> Result<Reach<'a>, RunError> {
+        Reach::named(model, model.info(), name)
+    }
+
+    /// The analysis `name` of the system `sys` with the model data `info`: test support
+    /// (feature `test-util`), for tests of hand-written systems and data.
+    #[cfg(feature = "test-util")]
+    #[doc(hidden)]
+    pub fn paired(
         sys: &'a dyn System,
         info: &'a ModelInfo,
         name: &str,
     ) -> Result<Reach<'a>, RunError> {
+        Reach::named(sys, info, name)
+    }
+
+    /// `analysis` (built by hand) of the system `sys` with the model data `info`: test support
+    /// (feature `test-util`).
+    #[cfg(feature = "test-util")]
+    #[doc(hidden)]
+    pub fn for_analysis(
+        sys: &'a dyn System,
+        info: &'a ModelInfo,
+        analysis: &'a Analysis,
+    ) -> Result<Reach<'a>, RunError> {
+        Reach::of(sys, info, analysis)
+    }
+
+    /// The analysis `name` of `info`, run with `sys`.
+    fn named(sys: &'a dyn System, info: &'a ModelInfo, name: &str) -> Result<Reach<'a>, RunError> {
         let analysis = info
             .analysis(name)
             .ok_or_else(|| RunError::UnknownAnalysis {
                 name: name.to_string(),
                 available: info.analyses.iter().map(|a| a.spec.name.clone()).collect(),
             })?;
-        Reach::for_analysis(sys, info, analysis)
+        Reach::of(sys, info, analysis)
     }
 
-    /// `analysis` (one of `info.analyses`, or one built like it) of the model.
-    pub fn for_analysis(
+    /// `analysis` of `info`, run with `sys`.
+    fn of(
         sys: &'a dyn System,
         info: &'a ModelInfo,
         analysis: &'a Analysis,

@@ -58,12 +58,12 @@ pub use tighten::{tighten, Constraint, TightStep, TightenError, Tightening};
 
 use crate::interval::Interval;
 use crate::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, NoConstants,
-    RadiusRule, Split, MAX_PIECES,
+    AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, NoConstants, RadiusRule, Split,
+    MAX_PIECES,
 };
 use crate::prs::Prs;
 use crate::reach::InputPlan;
-use crate::system::System;
+use crate::system::{Model, System};
 use std::fmt;
 
 /// Why an analysis could not run.
@@ -312,10 +312,22 @@ impl Run<'_> {
     }
 }
 
-/// Runs one analysis of the model as the spec wrote it (its initial set, inputs anywhere in
-/// the input box). The same as [`Reach::for_analysis`](crate::Reach::for_analysis) then
+/// Runs the analysis `name` of the model as the spec wrote it (its initial set, inputs
+/// anywhere in the input box). The same as [`Reach::new`](crate::Reach::new) then
 /// [`Reach::run`](crate::Reach::run).
-pub fn run(sys: &dyn System, info: &ModelInfo, analysis: &Analysis) -> Result<Prs, RunError> {
+pub fn run(model: &dyn Model, name: &str) -> Result<Prs, RunError> {
+    crate::Reach::new(model, name)?.run()
+}
+
+/// Runs `analysis` (one built by hand) of the system `sys` with the model data `info`: test
+/// support (feature `test-util`), for tests of what the engines do with unusual data.
+#[cfg(feature = "test-util")]
+#[doc(hidden)]
+pub fn run_paired(
+    sys: &dyn System,
+    info: &ModelInfo,
+    analysis: &crate::model::Analysis,
+) -> Result<Prs, RunError> {
     crate::Reach::for_analysis(sys, info, analysis)?.run()
 }
 

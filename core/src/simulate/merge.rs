@@ -379,7 +379,7 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut To
 mod tests {
     use super::super::part_file::FORMAT_VERSION;
     use super::super::tests::{info, narrow, sys};
-    use super::super::{run_part, simulate, Options};
+    use super::super::{run_part_paired, simulate_paired, Options};
     use super::*;
     use crate::engine;
     use crate::prs::Prs;
@@ -391,7 +391,7 @@ mod tests {
         (0..shards)
             .map(|i| {
                 let shard = Shard::new(i, shards).unwrap();
-                let part = run_part(sys, &info, r, opts, shard, &mut |_, _| {}).unwrap();
+                let part = run_part_paired(sys, &info, r, opts, shard, &mut |_, _| {}).unwrap();
                 let bytes = part.to_bytes();
                 let read = Part::from_bytes(&bytes).unwrap();
                 assert_eq!(read, part);
@@ -409,7 +409,7 @@ mod tests {
     fn sharded_runs_merge_into_the_unsharded_report() {
         for b in [0.0, 1.0] {
             let (sys, info) = (sys(b), info(b));
-            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             let mut pointwise = narrow(&r, 0.5);
             pointwise.guarantee = Guarantee::Pointwise;
             for r in [narrow(&r, 0.5), pointwise] {
@@ -419,7 +419,7 @@ mod tests {
                     dt: Some(0.005),
                     ..Options::default()
                 };
-                let whole = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+                let whole = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
                 assert_eq!(whole.quantile_rank, 51);
                 if r.guarantee == Guarantee::Uniform {
                     assert!(whole.tube.as_ref().unwrap().outside > 30);
@@ -443,7 +443,7 @@ mod tests {
     #[test]
     fn merge_refuses_parts_that_do_not_belong_together() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 200,
             ..Options::default()
@@ -507,7 +507,7 @@ mod tests {
     #[test]
     fn malformed_parts_are_refused() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 100,
             ..Options::default()
@@ -542,7 +542,7 @@ mod tests {
     #[test]
     fn bad_part_files_are_refused() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 50,
             ..Options::default()

@@ -65,7 +65,7 @@ pub use shard::Shard;
 use crate::interval::Interval;
 use crate::model::{Guarantee, ModelInfo};
 use crate::prs::{Prs, UnsafeKind};
-use crate::system::System;
+use crate::system::{Model, System};
 use crate::workers::Workers;
 use paths::{ChunkStats, Plan, Span, Thresholds};
 use std::fmt;
@@ -147,28 +147,78 @@ impl fmt::Display for SimError {
 
 impl std::error::Error for SimError {}
 
-/// Simulates `opts.paths` sample paths of `sys` and checks them against `result` (an analysis
-/// of `info` computed by [`engine::run`](crate::engine::run)). `progress(done, total)` is called
-/// after each batch of paths, on the calling thread. The paths run on a pool of
+/// Simulates `opts.paths` sample paths of `model` and checks them against `result` (one of its
+/// analyses, computed by [`engine::run`](crate::engine::run)). `progress(done, total)` is
+/// called after each batch of paths, on the calling thread. The paths run on a pool of
 /// `opts.threads` threads, or on the current rayon pool.
 ///
 /// This is [`run_part`] of all the paths ([`Shard::WHOLE`]) merged alone ([`merge`]): the
 /// parts of a sharded run merge into this very report.
-pub fn simulate<S: System + Sync + ?Sized>(
+pub fn simulate<M: Model + ?Sized>(
+    model: &M,
+    result: &Prs,
+    opts: &Options,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<SimReport, SimError> {
+    whole(model, model.info(), result, opts, progress)
+}
+
+/// Simulates the paths of `shard` (of `opts.paths`) of `model` and returns their exact
+/// statistics, with what the report needs besides them ([`Part`]; its `run.spec_hash` is
+/// empty: the caller knows the spec). `progress(done, total)` counts the shard's paths.
+pub fn run_part<M: Model + ?Sized>(
+    model: &M,
+    result: &Prs,
+    opts: &Options,
+    shard: Shard,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Part, SimError> {
+    part(model, model.info(), result, opts, shard, progress)
+}
+
+/// [`simulate`] of the system `sys` with the model data `info`: test support (feature
+/// `test-util`), for tests of hand-written systems and data.
+#[cfg(feature = "test-util")]
+#[doc(hidden)]
+pub fn simulate_paired<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
     result: &Prs,
     opts: &Options,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<SimReport, SimError> {
-    let part = run_part(sys, info, result, opts, Shard::WHOLE, progress)?;
+    whole(sys, info, result, opts, progress)
+}
+
+/// [`run_part`] of the system `sys` with the model data `info`: test support (feature
+/// `test-util`).
+#[cfg(feature = "test-util")]
+#[doc(hidden)]
+pub fn run_part_paired<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+    shard: Shard,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Part, SimError> {
+    part(sys, info, result, opts, shard, progress)
+}
+
+/// [`simulate`] of `sys` with its model data `info`.
+fn whole<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<SimReport, SimError> {
+    let part = part(sys, info, result, opts, Shard::WHOLE, progress)?;
     merge([(String::new(), part)]).map_err(|e| SimError::Invalid(e.0))
 }
 
-/// Simulates the paths of `shard` (of `opts.paths`) and returns their exact statistics, with
-/// what the report needs besides them ([`Part`]; its `run.spec_hash` is empty: the caller
-/// knows the spec). `progress(done, total)` counts the shard's paths.
-pub fn run_part<S: System + Sync + ?Sized>(
+/// [`run_part`] of `sys` with its model data `info`.
+fn part<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
     result: &Prs,
@@ -562,7 +612,7 @@ mod tests {
             (0.0, &skewed, 0.05, 0.6),
         ] {
             let (sys, info) = (sys(b), info_in(b, metric.clone()));
-            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             let mut pointwise = r.clone();
             pointwise.guarantee = Guarantee::Pointwise;
             for (tube, r) in [
@@ -661,7 +711,7 @@ mod tests {
     #[test]
     fn a_path_leaving_the_tube_between_report_times_is_counted() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 1,
             seed: 3,
@@ -687,7 +737,7 @@ mod tests {
         assert!(hand_made.span_contains(k, end));
         assert!((0..9).any(|j| !hand_made.span_contains(k, state(j))));
 
-        let simulate = |r: &Prs| simulate(&sys, &info, r, &opts, &mut |_, _| {}).unwrap();
+        let simulate = |r: &Prs| simulate_paired(&sys, &info, r, &opts, &mut |_, _| {}).unwrap();
         let computed = simulate(&r);
         assert_eq!(computed.tube.as_ref().unwrap().outside, 0);
         let rep = simulate(&hand_made);
@@ -721,7 +771,7 @@ mod tests {
             (1.0, &identity, 0.4),
         ] {
             let (sys, info) = (sys(b), info_in(b, metric.clone()));
-            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             for (factor, r) in [(1.0, r.clone()), (factor, narrow(&r, factor))] {
                 let opts = Options {
                     paths: 300,
@@ -730,7 +780,7 @@ mod tests {
                     hold: Some(0.05),
                     ..Options::default()
                 };
-                let rep = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+                let rep = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
                 let (left, between) = recount(&sys, &info, &r, &opts);
                 let case = format!("b = {b}, metric {metric:?}, spans x {factor}");
                 let counted: Vec<u64> = rep.steps.iter().map(|s| s.left_tube.unwrap()).collect();
@@ -759,7 +809,7 @@ mod tests {
     #[test]
     fn the_uniform_verdict_is_decided_by_the_tube() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let run = |r: &Prs, threads: usize| {
             let opts = Options {
                 paths: 3_000,
@@ -768,7 +818,7 @@ mod tests {
                 threads: Some(threads),
                 ..Options::default()
             };
-            simulate(&sys, &info, r, &opts, &mut |_, _| {}).unwrap()
+            simulate_paired(&sys, &info, r, &opts, &mut |_, _| {}).unwrap()
         };
         let computed = run(&r, 2);
         assert_eq!(computed, run(&r, 1));
@@ -814,11 +864,11 @@ mod tests {
         let sorted = ChunkStats::sorted;
         for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
             let (sys, info) = (sys(0.0), info_in(0.0, metric.clone()));
-            let mut r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let mut r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             r.guarantee = Guarantee::Pointwise;
             let mut boxes = info.clone();
             boxes.analyses[0].spec.method = Method::Interval;
-            let b = engine::run(&sys, &boxes, &boxes.analyses[0]).unwrap();
+            let b = engine::run_paired(&sys, &boxes, &boxes.analyses[0]).unwrap();
             r.also = vec![prs::tests::boxes_to_zonotopes(b, prs::tests::SQUARE, 0.2)];
             let opts = Options {
                 paths: 300,
@@ -837,7 +887,7 @@ mod tests {
                 assert_eq!(detected, baseline, "{metric:?}, {threshold}");
                 assert_eq!(avx2, baseline, "{metric:?}, {threshold}");
             }
-            let rep = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+            let rep = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
             let paths = result_paths(&sys, &info, &r, &opts).unwrap();
             let outside: Vec<u64> = (0..r.steps.len())
                 .map(|k| {
@@ -861,7 +911,7 @@ mod tests {
     #[test]
     fn malformed_spans_are_refused() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 10,
             ..Options::default()
@@ -877,7 +927,7 @@ mod tests {
         ] {
             let mut bad = r.clone();
             change(&mut bad.steps[3].span);
-            match simulate(&sys, &info, &bad, &opts, &mut |_, _| {}) {
+            match simulate_paired(&sys, &info, &bad, &opts, &mut |_, _| {}) {
                 Err(SimError::Invalid(m)) => {
                     assert!(m.contains("report step 3") && m.contains(what), "{m}")
                 }
@@ -971,8 +1021,8 @@ mod tests {
 
     /// The report of `opts.paths` paths of `sys` checked against `info`'s sets.
     fn simulate_sets(sys: &Brownian, info: &ModelInfo, opts: &Options) -> SimReport {
-        let r = engine::run(sys, info, &info.analyses[0]).unwrap();
-        simulate(sys, info, &r, opts, &mut |_, _| {}).unwrap()
+        let r = engine::run_paired(sys, info, &info.analyses[0]).unwrap();
+        simulate_paired(sys, info, &r, opts, &mut |_, _| {}).unwrap()
     }
 
     /// The unsafe half-space `x >= offset` (at `t = 0`), its offset moving number `number`.
@@ -1101,10 +1151,10 @@ mod tests {
         };
         let moving = sys(0.0, lines);
         let rep = simulate_sets(&moving, &info, &opts);
-        let r = engine::run(&moving, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&moving, &info, &info.analyses[0]).unwrap();
         let parts = (0..3).map(|i| {
             let shard = Shard::new(i, 3).unwrap();
-            let part = run_part(&moving, &info, &r, &opts, shard, &mut |_, _| {}).unwrap();
+            let part = run_part_paired(&moving, &info, &r, &opts, shard, &mut |_, _| {}).unwrap();
             (i.to_string(), Part::from_bytes(&part.to_bytes()).unwrap())
         });
         assert_eq!(merge(parts).unwrap(), rep);

@@ -1270,7 +1270,7 @@ pub(super) mod tests {
             // Valid for P = I and for the skewed P below (generous c, sigma).
             constants: Ok(Constants::given(&info, metric, -0.2, 0.5, 0.0)),
         };
-        let mut r = engine::run(&Sys, &info, &analysis).unwrap();
+        let mut r = engine::run_paired(&Sys, &info, &analysis).unwrap();
         if members {
             assert!(!r.also.is_empty(), "{method:?}: an intersection");
         } else {
