@@ -3,7 +3,7 @@
 //! cover is refused.
 
 use reach_api::{forced, forcing, info, start, sweep, Duffing};
-use reachc_runtime::engine::RunError;
+use reachc_runtime::engine::{Coverage, Problem, RunError};
 use reachc_runtime::model::Rate;
 use reachc_runtime::{Bounds, InputPlan, Reach, System};
 
@@ -80,7 +80,8 @@ fn what_the_constants_do_not_cover_is_refused() {
     // outgrows its regions and the run says when (the global rate refuses the box outright).
     assert!(matches!(
         reach.from_box(&start(1.95)),
-        Err(RunError::NonFinite(m)) if m.message.contains("local rates cannot be certified at t = 4.5")
+        Err(RunError::NonFinite(m))
+            if matches!(m.problem, Problem::LocalRates { t, .. } if (t - 4.5).abs() < 1e-9)
     ));
     let mut global = info.clone();
     for a in &mut global.analyses {
@@ -89,7 +90,7 @@ fn what_the_constants_do_not_cover_is_refused() {
     let reach_global = Reach::new(&sys, &global, "contraction").unwrap();
     assert!(matches!(
         reach_global.from_box(&start(1.95)),
-        Err(RunError::Invalid(m)) if m.message.contains("leaves the domain")
+        Err(RunError::Invalid(m)) if matches!(m.problem, Problem::InitialOutsideDomain { .. })
     ));
     // The input box is [-0.05, 0.05].
     let strong = InputPlan::constant(&[0.1]);
@@ -99,6 +100,7 @@ fn what_the_constants_do_not_cover_is_refused() {
     edited.domain[0] = Bounds::new(-3.0, 3.0);
     assert!(matches!(
         Reach::new(&sys, &edited, "contraction").map(|_| ()),
-        Err(RunError::Invalid(m)) if m.message.contains("domain")
+        Err(RunError::Invalid(m))
+            if matches!(m.problem, Problem::NotCovered { what: Coverage::Domain, .. })
     ));
 }
