@@ -115,7 +115,8 @@ impl Culprit {
 }
 
 /// Why an analysis could not run: the problem, what in the spec it points at, and the
-/// circumstances (the piece of a split box, ...). Its words are in [`crate::words`].
+/// circumstances (the piece of a split box, ...). Its `Display` (the words) is in
+/// `core/src/words.rs`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Detail {
     /// What went wrong, with what it is about.

@@ -1,6 +1,6 @@
 //! What went wrong in a run, as data: the [`Problem`] inside each [`RunError`](super::RunError)
 //! variant's [`Detail`](super::Detail), with the numbers, times, states and names it is about.
-//! The words live in one place, [`crate::words`].
+//! The words live in one place, `core/src/words.rs`.
 
 use crate::interval::Interval;
 use crate::model::{Bounds, Inclusion, Integrator, NoConstants, Rate};
