@@ -297,7 +297,7 @@ fn an_initial_ball_cannot_be_split() {
         panic!("a ball cannot be split");
     };
     assert_eq!(detail.culprit, Some(Culprit::Setting(Setting::Split)));
-    assert_eq!(detail.problem, Problem::SplitNotABox, "{detail}");
+    assert_eq!(*detail.problem, Problem::SplitNotABox, "{detail}");
 }
 
 /// `split = auto` cuts a piece that cannot run like one whose sets are infinite: `x' = x^2`

@@ -119,8 +119,8 @@ impl Culprit {
 /// `core/src/words.rs`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Detail {
-    /// What went wrong, with what it is about.
-    pub problem: Problem,
+    /// What went wrong, with what it is about (boxed: results stay small).
+    pub problem: Box<Problem>,
     /// The state or setting to look at, when the engine knows it.
     pub culprit: Option<Culprit>,
     /// Circumstances, in the order they were added.
@@ -145,7 +145,7 @@ impl Detail {
 impl From<Problem> for Detail {
     fn from(problem: Problem) -> Detail {
         Detail {
-            problem,
+            problem: Box::new(problem),
             culprit: None,
             notes: Vec::new(),
         }

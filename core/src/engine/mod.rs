@@ -135,7 +135,7 @@ impl RunError {
             RunError::Unsupported(d)
             | RunError::NoConstants(d)
             | RunError::Invalid(d)
-            | RunError::NonFinite(d) => Some(&d.problem),
+            | RunError::NonFinite(d) => Some(d.problem.as_ref()),
         }
     }
 }

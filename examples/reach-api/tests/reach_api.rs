@@ -81,7 +81,7 @@ fn what_the_constants_do_not_cover_is_refused() {
     assert!(matches!(
         reach.from_box(&start(1.95)),
         Err(RunError::NonFinite(m))
-            if matches!(m.problem, Problem::LocalRates { t, .. } if (t - 4.5).abs() < 1e-9)
+            if matches!(*m.problem, Problem::LocalRates { t, .. } if (t - 4.5).abs() < 1e-9)
     ));
     let mut global = info.clone();
     for a in &mut global.analyses {
@@ -90,7 +90,7 @@ fn what_the_constants_do_not_cover_is_refused() {
     let reach_global = Reach::new(&sys, &global, "contraction").unwrap();
     assert!(matches!(
         reach_global.from_box(&start(1.95)),
-        Err(RunError::Invalid(m)) if matches!(m.problem, Problem::InitialOutsideDomain { .. })
+        Err(RunError::Invalid(m)) if matches!(*m.problem, Problem::InitialOutsideDomain { .. })
     ));
     // The input box is [-0.05, 0.05].
     let strong = InputPlan::constant(&[0.1]);
@@ -101,6 +101,6 @@ fn what_the_constants_do_not_cover_is_refused() {
     assert!(matches!(
         Reach::new(&sys, &edited, "contraction").map(|_| ()),
         Err(RunError::Invalid(m))
-            if matches!(m.problem, Problem::NotCovered { what: Coverage::Domain, .. })
+            if matches!(*m.problem, Problem::NotCovered { what: Coverage::Domain, .. })
     ));
 }
