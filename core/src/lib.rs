@@ -20,6 +20,7 @@ pub mod system;
 pub mod table;
 #[cfg(test)]
 mod test_support;
+mod words;
 mod workers;
 
 pub use interval::Interval;

@@ -6,7 +6,6 @@
 //! Matrices are flat row-major vectors: entry `(i, j)` of an `r x c` matrix is `[i * c + j]`.
 
 use crate::interval::Interval;
-use std::fmt;
 
 mod sealed;
 
@@ -127,7 +126,7 @@ impl InitialSet {
 
     /// A box holding the set (balls by their bounding boxes, rounded outward), or why not
     /// (inconsistent data).
-    pub fn bounding_box(&self) -> Result<Vec<Bounds>, String> {
+    pub fn bounding_box(&self) -> Result<Vec<Bounds>, crate::engine::InitialSetError> {
         let (center, half) =
             crate::engine::radius::initial_center_and_halfwidths(self, self.boxes.len())?;
         Ok(self
@@ -580,20 +579,6 @@ pub enum NoConstants {
     },
 }
 
-impl fmt::Display for NoConstants {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            NoConstants::Unbounded { entry, expression } => {
-                write!(f, "{entry} = {expression} is unbounded over the domain")
-            }
-            NoConstants::BadMetric { reason } => write!(f, "invalid metric: {reason}"),
-            NoConstants::NotCertified { constant } => {
-                write!(f, "could not certify a bound for {constant}")
-            }
-        }
-    }
-}
-
 impl std::error::Error for NoConstants {}
 
 /// Constants of Assumption 1 for one metric, certified by the compiler over a [`Region`].
@@ -682,22 +667,6 @@ pub enum MetricRegion {
     IdentityAtRun,
 }
 
-impl fmt::Display for MetricRegion {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            MetricRegion::Given => "given in the spec",
-            MetricRegion::Domain => "synthesised for the Jacobian over the domain",
-            MetricRegion::InitialSet => {
-                "synthesised for the Jacobian over the initial set during the first report step"
-            }
-            MetricRegion::IdentityAtRun => {
-                "the identity: a smaller PRS at the horizon than the metric synthesised over the \
-                 initial set (both were run)"
-            }
-        })
-    }
-}
-
 /// The states, inputs and times over which [`Constants`] were certified. A run whose model
 /// data differs (another domain or input box, a longer horizon) is not covered by them.
 #[derive(Clone, Debug, PartialEq)]
@@ -766,67 +735,4 @@ pub enum InputGain {
     Corners(MatrixBound),
     /// Column by column (many inputs), for the matrices of `D_u f`.
     Columns(MatrixBound),
-}
-
-impl fmt::Display for MatrixBound {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let fixed_note = |fixed: usize| {
-            if fixed == 0 {
-                String::new()
-            } else {
-                format!(", {fixed} fixed at one end by semidefiniteness")
-            }
-        };
-        match *self {
-            MatrixBound::Vertices {
-                count,
-                atoms,
-                fixed,
-            } => write!(
-                f,
-                "max over {count} vertex matri{} ({atoms} atom{}{})",
-                if count == 1 { "x" } else { "ces" },
-                if atoms == 1 { "" } else { "s" },
-                fixed_note(fixed)
-            ),
-            MatrixBound::Hull {
-                atoms,
-                fixed,
-                vertex_limit,
-            } => write!(
-                f,
-                "interval-matrix bound ({atoms} atoms{}, {} free > {vertex_limit}, too many \
-                 vertices)",
-                fixed_note(fixed),
-                atoms - fixed
-            ),
-        }
-    }
-}
-
-impl fmt::Display for InputGain {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            InputGain::NoInputs => f.write_str("no inputs"),
-            InputGain::Corners(m) => write!(f, "{m}, max over the input box's corners"),
-            InputGain::Columns(m) => write!(f, "{m}, column bound (many inputs)"),
-        }
-    }
-}
-
-impl fmt::Display for Provenance {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (c, sigma, rho) = match self {
-            Provenance::Certified { c, sigma, rho } => (c, sigma, rho),
-            Provenance::Given => return f.write_str("given by hand, not certified by reachc"),
-            Provenance::Unbounded { why } => {
-                return write!(f, "not bounded over the domain ({why})");
-            }
-        };
-        match c {
-            Some(c) => write!(f, "c: {c}; ")?,
-            None => f.write_str("c: not bounded by the compiler; ")?,
-        }
-        write!(f, "sigma: {sigma}; rho: {rho}; certified by interval LDL'")
-    }
 }

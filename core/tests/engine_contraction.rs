@@ -543,7 +543,7 @@ fn errors() {
         }),
     );
     match engine::run_paired(&sys, &inf, &an) {
-        Err(RunError::NoConstants(m)) => assert!(m.message.contains("unbounded"), "{m}"),
+        Err(RunError::NoConstants(m)) => assert!(m.to_string().contains("unbounded"), "{m}"),
         other => panic!("expected NoConstants, got {other:?}"),
     }
     an.constants = constants;
@@ -559,7 +559,7 @@ fn errors() {
     (tiny.spec.horizon, tiny.spec.step) = (1e-320, 1e-322);
     match engine::run_paired(&sys, &inf, &tiny) {
         Err(RunError::Invalid(m)) => {
-            assert!(m.message.contains("at least 1e-100"), "{m}");
+            assert!(m.to_string().contains("at least 1e-100"), "{m}");
             assert_eq!(m.culprit, Some(Culprit::Setting(Setting::Step)));
         }
         other => panic!("expected Invalid, got {other:?}"),
@@ -738,7 +738,7 @@ fn reach_refuses_what_the_constants_do_not_cover() {
     let mut wider = inf.clone();
     *wider.input_box_mut() = vec![Bounds::new(-2.0, 2.0)];
     match Reach::paired(&sys, &wider, "main").map(|_| ()) {
-        Err(RunError::Invalid(m)) => assert!(m.message.contains("input box"), "{m}"),
+        Err(RunError::Invalid(m)) => assert!(m.to_string().contains("input box"), "{m}"),
         other => panic!("expected Invalid, got {other:?}"),
     }
     let mut bounded = inf.clone();
@@ -746,7 +746,7 @@ fn reach_refuses_what_the_constants_do_not_cover() {
     *bounded.has_domain_mut() = true;
     assert!(matches!(
         engine::run_paired(&sys, &bounded, &bounded.analyses()[0]),
-        Err(RunError::Invalid(m)) if m.message.contains("domain")
+        Err(RunError::Invalid(m)) if m.to_string().contains("domain")
     ));
     // With constants certified over that domain: initial sets inside it run, others do not.
     let constants = Constants::given(&bounded, vec![1.0], -1.0, 0.1, 1.0);
@@ -755,7 +755,7 @@ fn reach_refuses_what_the_constants_do_not_cover() {
     assert!(reach.from_box(&[Bounds::new(4.0, 5.0)]).is_ok());
     match reach.from_box(&[Bounds::new(4.0, 5.5)]).map(|_| ()) {
         Err(RunError::Invalid(m)) => {
-            assert!(m.message.contains("leaves the domain"), "{m}");
+            assert!(m.to_string().contains("leaves the domain"), "{m}");
             assert_eq!(m.culprit, Some(Culprit::State(0)));
         }
         other => panic!("expected Invalid, got {other:?}"),
@@ -801,7 +801,7 @@ fn reach_under_an_input_plan() {
     let outside = InputPlan::constant(&[1.5]);
     assert!(matches!(
         reach.from_box_with(&x0, &outside),
-        Err(RunError::Invalid(m)) if m.message.contains("input box")
+        Err(RunError::Invalid(m)) if m.to_string().contains("input box")
     ));
     assert!(InputPlan::steps(vec![0.5], vec![vec![0.0]]).is_err());
     // A plan is not simulated with random inputs: the simulator refuses it.
@@ -863,7 +863,7 @@ fn a_radius_that_overflows_is_an_error_not_an_infinite_set() {
     assert!(0.8 < t_over && t_over < 0.9, "{t_over}");
     match Reach::paired(&sys, &inf, "main").unwrap().run() {
         Err(RunError::NonFinite(d)) => {
-            let m = &d.message;
+            let m = &d.to_string();
             assert!(
                 m.contains("the PRS is not finite from t = 0.9 on")
                     && m.contains("r_t = inf")
@@ -894,7 +894,7 @@ fn a_radius_that_overflows_is_an_error_not_an_infinite_set() {
 fn a_nominal_that_blows_up_is_an_error() {
     let (sys, inf) = growing(400.0, 1.0, 3.0, Guarantee::Uniform);
     match Reach::paired(&sys, &inf, "main").unwrap().run() {
-        Err(RunError::NonFinite(d)) => assert!(d.message.contains("t = "), "{d}"),
+        Err(RunError::NonFinite(d)) => assert!(d.to_string().contains("t = "), "{d}"),
         other => panic!("expected NonFinite, got {other:?}"),
     }
 }

@@ -456,7 +456,7 @@ impl Spec {
             },
         };
         let report = sim.map_err(|e| match e {
-            SimError::Usage(m) => PyValueError::new_err(m),
+            SimError::Usage(m) => PyValueError::new_err(m.to_string()),
             SimError::Invalid(m) => {
                 AnalysisError::new_err(format!("analysis `{name}` cannot be simulated: {m}"))
             }

@@ -3,7 +3,7 @@
 //! from the whole initial box and a Monte Carlo check of the union.
 
 use reachc_e2e::inline;
-use reachc_runtime::engine::{Culprit, RunError, Setting};
+use reachc_runtime::engine::{Culprit, Problem, RunError, Setting};
 use reachc_runtime::model::Split;
 use reachc_runtime::probability::SafetyLimit;
 use reachc_runtime::prs::{DetSet, Prs, Verdict};
@@ -297,7 +297,7 @@ fn an_initial_ball_cannot_be_split() {
         panic!("a ball cannot be split");
     };
     assert_eq!(detail.culprit, Some(Culprit::Setting(Setting::Split)));
-    assert!(detail.message.contains("not a box"), "{}", detail.message);
+    assert_eq!(*detail.problem, Problem::SplitNotABox, "{detail}");
 }
 
 /// `split = auto` cuts a piece that cannot run like one whose sets are infinite: `x' = x^2`

@@ -32,6 +32,7 @@
 mod avx512;
 mod binomial;
 mod dt;
+mod error;
 mod initial;
 mod inputs;
 mod merge;
@@ -51,8 +52,12 @@ mod topk;
 pub use crate::workers::thread_count;
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
 pub use dt::{DtSource, DtUsed, ACCURACY as DT_ACCURACY, MAX_STEPS, RULE as DT_RULE};
+pub use error::{
+    Coded, InitialFault, MergeError, PartFault, PartFileError, RegionFault, RunDifference,
+    RunOption, SimError, SimInvalid, SimUsage, SpanFault,
+};
 pub use inputs::InputMode;
-pub use merge::{merge, MergeError, Merger};
+pub use merge::{merge, Merger};
 pub use part::{Part, PartStats, RunInfo, StepInfo};
 pub use part_file::{FORMAT_VERSION, MAGIC};
 pub use report::{
@@ -60,7 +65,7 @@ pub use report::{
     SimReport, SimStep, StateSpread, TubeReport, UnsafeHits,
 };
 pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
-pub use shard::Shard;
+pub use shard::{Shard, ShardError};
 
 use crate::interval::Interval;
 use crate::model::{Guarantee, ModelInfo};
@@ -68,7 +73,6 @@ use crate::prs::{Prs, UnsafeKind};
 use crate::system::{Model, System};
 use crate::workers::Workers;
 use paths::{ChunkStats, Plan, Span, Thresholds};
-use std::fmt;
 
 /// The version of reachc that simulates (recorded in parts: only parts of one version merge).
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -127,25 +131,6 @@ impl Default for Options {
         }
     }
 }
-
-/// Why a simulation could not run.
-#[derive(Clone, Debug, PartialEq)]
-pub enum SimError {
-    /// Bad options (a usage error).
-    Usage(String),
-    /// The model or result cannot be simulated (inconsistent data, unbounded initial set...).
-    Invalid(String),
-}
-
-impl fmt::Display for SimError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            SimError::Usage(m) | SimError::Invalid(m) => f.write_str(m),
-        }
-    }
-}
-
-impl std::error::Error for SimError {}
 
 /// Simulates `opts.paths` sample paths of `model` and checks them against `result` (one of its
 /// analyses, computed by [`engine::run`](crate::engine::run)). `progress(done, total)` is
@@ -214,7 +199,7 @@ fn whole<S: System + ?Sized>(
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<SimReport, SimError> {
     let part = part(sys, info, result, opts, Shard::WHOLE, progress)?;
-    merge([(String::new(), part)]).map_err(|e| SimError::Invalid(e.0))
+    merge([(String::new(), part)]).map_err(|e| SimError::Invalid(SimInvalid::Merge(e)))
 }
 
 /// [`run_part`] of `sys` with its model data `info`.
@@ -231,10 +216,10 @@ fn part<S: System + ?Sized>(
     let n_paths = opts.paths;
     // (`index < count` holds by construction.)
     if shard.count > n_paths {
-        return Err(SimError::Usage(format!(
-            "shard {shard} of {n_paths} paths: the number of shards must be at most the number \
-             of paths"
-        )));
+        return Err(SimError::Usage(SimUsage::Shards {
+            shard,
+            paths: n_paths,
+        }));
     }
     // j-th largest = ceil((1 - delta) N)-th smallest; the slack keeps delta * N = 1000 (say)
     // from rounding down to 999. N is the whole run's: every part keeps the same j.
@@ -244,13 +229,14 @@ fn part<S: System + ?Sized>(
     let buffers = steps as u64 * (1 + n as u64);
     let quantile_bytes = 16u64.saturating_mul(j).saturating_mul(buffers);
     if quantile_bytes > QUANTILE_BYTES {
-        return Err(SimError::Usage(format!(
-            "exact quantiles of {n_paths} paths at delta = {} over {steps} report times and \
-             {n} states need {:.1} GiB (more than {} GiB): use fewer paths",
-            result.delta,
-            quantile_bytes as f64 / f64::from(1u32 << 30),
-            QUANTILE_BYTES >> 30
-        )));
+        return Err(SimError::Usage(SimUsage::QuantileMemory {
+            paths: n_paths,
+            delta: result.delta,
+            steps,
+            n,
+            bytes: quantile_bytes,
+            max_gib: QUANTILE_BYTES >> 30,
+        }));
     }
     // Batches: many chunks per batch for the threads, few enough candidates in memory. Until a
     // buffer has `j` values every path's distances are candidates (one per state and report
@@ -264,7 +250,8 @@ fn part<S: System + ?Sized>(
         .clamp(chunk, MAX_BATCH)
         .div_ceil(chunk)
         * chunk;
-    let workers = Workers::new(opts.threads).map_err(SimError::Invalid)?;
+    let workers =
+        Workers::new(opts.threads).map_err(|e| SimError::Invalid(SimInvalid::Threads(e)))?;
     let j = usize::try_from(j).unwrap_or(usize::MAX);
     let (mut topk, mut state_topk) = (topk::TopK::new(steps, j), topk::TopK::new(steps * n, j));
     let sets = &plan.sets;
@@ -402,71 +389,67 @@ fn make_plan<'a, S: System + ?Sized>(
     result: &'a Prs,
     opts: &Options,
 ) -> Result<Plan<'a, S>, SimError> {
-    let usage = |m: String| Err(SimError::Usage(m));
+    let usage = |m: SimUsage| Err(SimError::Usage(m));
     if opts.paths == 0 || opts.paths > rng::MAX_PATHS {
-        return usage(format!(
-            "the number of paths must be between 1 and {}, not {}",
-            rng::MAX_PATHS,
-            opts.paths
-        ));
+        return usage(SimUsage::Paths {
+            paths: opts.paths,
+            max: rng::MAX_PATHS,
+        });
     }
     if let Some(dt) = opts.dt.filter(|dt| !(*dt > 0.0 && dt.is_finite())) {
-        return usage(format!("dt = {dt} must be positive and finite"));
+        return usage(SimUsage::Dt(dt));
     }
     let hold = opts.hold.unwrap_or(result.step);
     if !(hold > 0.0 && hold.is_finite()) {
-        return usage(format!("the hold time {hold} must be positive and finite"));
+        return usage(SimUsage::Hold(hold));
     }
     let bounds = opts
         .safety_bound
         .iter()
         .chain(opts.goal_bounds.iter().flatten());
     if let Some(b) = bounds.copied().find(|b| !(0.0..=1.0).contains(b)) {
-        return usage(format!("the probability bound {b} must lie in [0, 1]"));
+        return usage(SimUsage::ProbabilityBound(b));
     }
     if !opts.goal_bounds.is_empty() && opts.goal_bounds.len() != info.goals.len() {
-        return usage(format!(
-            "{} goal probability bounds for {} goal sets",
-            opts.goal_bounds.len(),
-            info.goals.len()
-        ));
+        return usage(SimUsage::GoalBounds {
+            bounds: opts.goal_bounds.len(),
+            goals: info.goals.len(),
+        });
     }
     if !(opts.confidence > 0.0 && opts.confidence < 1.0) {
-        return usage(format!(
-            "the confidence {} must lie in (0, 1)",
-            opts.confidence
-        ));
+        return usage(SimUsage::Confidence(opts.confidence));
     }
-    let invalid = |m: String| Err(SimError::Invalid(m));
+    let invalid = |m: SimInvalid| Err(SimError::Invalid(m));
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
     if result.states.len() != n || result.steps.is_empty() {
-        return invalid(format!(
-            "the result has {} states and {} steps; the system has {n} states",
-            result.states.len(),
-            result.steps.len()
-        ));
+        return invalid(SimInvalid::ResultSize {
+            states: result.states.len(),
+            steps: result.steps.len(),
+            n,
+        });
     }
     if result.constants.metric.len() != n * n {
-        return invalid("the result's metric is not n x n".into());
+        return invalid(SimInvalid::MetricSize);
     }
     if result.input_plan.is_some() {
-        return invalid("sets under an input plan cannot be simulated (the paths draw inputs from the input box)".into());
+        return invalid(SimInvalid::InputPlan);
     }
     if info.input_box.len() != p {
-        return invalid(format!(
-            "the input box has {} ranges, the system has {p} inputs",
-            info.input_box.len()
-        ));
+        return invalid(SimInvalid::InputRanges {
+            ranges: info.input_box.len(),
+            p,
+        });
     }
     if let Some(b) = info
         .input_box
         .iter()
         .find(|r| !(r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi))
     {
-        return invalid(format!("the input box [{}, {}] is not bounded", b.lo, b.hi));
+        return invalid(SimInvalid::UnboundedInput(*b));
     }
     let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
-    let (steps, dt) = dt::choose(sys, info, result, &times, opts.dt).map_err(SimError::Usage)?;
+    let (steps, dt) = dt::choose(sys, info, result, &times, opts.dt)
+        .map_err(|dt| SimError::Usage(SimUsage::DtSteps(dt)))?;
     let spans: Vec<Span> = times
         .windows(2)
         .zip(steps)
@@ -475,9 +458,10 @@ fn make_plan<'a, S: System + ?Sized>(
     let per_path: u64 = spans.iter().map(|s| u64::from(s.steps)).sum();
     // Draws per Euler step: m normals (about 1% need a second draw), p inputs at most.
     if per_path.saturating_mul(2 * (m + p + 1) as u64) >= rng::DRAWS_PER_PATH {
-        return usage(format!(
-            "{per_path} Euler steps of {m} noise channels are too many random numbers per path"
-        ));
+        return usage(SimUsage::TooManyDraws {
+            steps: per_path,
+            channels: m,
+        });
     }
     let nominal: Vec<f64> = result
         .steps
@@ -485,10 +469,11 @@ fn make_plan<'a, S: System + ?Sized>(
         .flat_map(|s| s.nominal().iter().copied())
         .collect();
     if nominal.len() != n * times.len() {
-        return invalid("a nominal state has the wrong dimension".into());
+        return invalid(SimInvalid::NominalSize);
     }
     let metric = prs::Metric::new(&result.constants.metric, n);
-    let sets = regions::SetRegions::new(info, n, result.horizon).map_err(SimError::Invalid)?;
+    let sets = regions::SetRegions::new(info, n, result.horizon)
+        .map_err(|e| SimError::Invalid(SimInvalid::UnsafeSet(e)))?;
     let tube = match result.guarantee {
         Guarantee::Uniform => Some(prs::Tube::new(result, &metric).map_err(SimError::Invalid)?),
         Guarantee::Pointwise => None,
@@ -503,7 +488,8 @@ fn make_plan<'a, S: System + ?Sized>(
         tube,
         metric,
         // The paths start where the sets start.
-        initial: initial::InitialSampler::new(&result.initial, n).map_err(SimError::Invalid)?,
+        initial: initial::InitialSampler::new(&result.initial, n)
+            .map_err(|e| SimError::Invalid(SimInvalid::Initial(e)))?,
         inputs: inputs::InputSchedule::new(&info.input_box, opts.inputs, hold),
         noise: noise::Noise::new(sys, *times.last().unwrap_or(&0.0), &result.initial_center),
         sets,
@@ -928,8 +914,8 @@ mod tests {
             let mut bad = r.clone();
             change(&mut bad.steps[3].span);
             match simulate_paired(&sys, &info, &bad, &opts, &mut |_, _| {}) {
-                Err(SimError::Invalid(m)) => {
-                    assert!(m.contains("report step 3") && m.contains(what), "{m}")
+                Err(SimError::Invalid(m @ SimInvalid::Span { step: 3, .. })) => {
+                    assert!(m.to_string().contains(what), "{m}")
                 }
                 other => panic!("{other:?}"),
             }
