@@ -238,7 +238,7 @@ impl Group8 {
 
     /// The mask of the lanes where `q < bound` is false (NaN included), `q = sum_i w_i (x_i -
     /// y_i)^2` with `y_i` the state clamped into `[lo_i, hi_i]`: per lane, what
-    /// [`diag_quad_to_box`](super::prs::diag_quad_to_box) computes, to the bit.
+    /// [`diag_quad_to_box`](super::check::diag_quad_to_box) computes, to the bit.
     #[inline]
     #[target_feature(enable = "avx512f")]
     pub(crate) fn outside_box(
@@ -334,7 +334,7 @@ mod tests {
     )]
     #[test]
     fn lanes_measure_the_distance_to_a_box_as_the_scalar_loop() {
-        use super::super::prs::diag_quad_to_box;
+        use super::super::check::diag_quad_to_box;
         require();
         let mut rng = PathRng::new(4, 0);
         let (w, lo, hi) = ([2.0, 0.5, 1.0], [-1.0, 0.0, 0.25], [1.0, 0.0, 0.75]);

@@ -31,6 +31,7 @@
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 mod binomial;
+mod check;
 mod dt;
 mod error;
 mod initial;
@@ -41,7 +42,6 @@ mod normal;
 mod part;
 mod part_file;
 mod paths;
-mod prs;
 mod regions;
 mod report;
 mod rng;
@@ -471,11 +471,11 @@ fn make_plan<'a, S: System + ?Sized>(
     if nominal.len() != n * times.len() {
         return invalid(SimInvalid::NominalSize);
     }
-    let metric = prs::Metric::new(&result.constants.metric, n);
+    let metric = check::Metric::new(&result.constants.metric, n);
     let sets = regions::SetRegions::new(info, n, result.horizon)
         .map_err(|e| SimError::Invalid(SimInvalid::UnsafeSet(e)))?;
     let tube = match result.guarantee {
-        Guarantee::Uniform => Some(prs::Tube::new(result, &metric).map_err(SimError::Invalid)?),
+        Guarantee::Uniform => Some(check::Tube::new(result, &metric).map_err(SimError::Invalid)?),
         Guarantee::Pointwise => None,
     };
     Ok(Plan {
@@ -484,7 +484,7 @@ fn make_plan<'a, S: System + ?Sized>(
         spans,
         dt,
         nominal,
-        membership: prs::Membership::new(result, &metric),
+        membership: check::Membership::new(result, &metric),
         tube,
         metric,
         // The paths start where the sets start.
@@ -855,7 +855,11 @@ mod tests {
             let mut boxes = info.clone();
             boxes.analyses[0].spec.method = Method::Interval;
             let b = engine::run_paired(&sys, &boxes, &boxes.analyses[0]).unwrap();
-            r.also = vec![prs::tests::boxes_to_zonotopes(b, prs::tests::SQUARE, 0.2)];
+            r.also = vec![check::fixtures::boxes_to_zonotopes(
+                b,
+                check::fixtures::SQUARE,
+                0.2,
+            )];
             let opts = Options {
                 paths: 300,
                 seed: 5,

@@ -28,12 +28,12 @@
 //! the loops agree on every decision. A state at a report time outside that time's PRS has
 //! left the tube too (the tube there is that PRS).
 
+use super::check::{diag_quad, diag_quad_to_box, lanes, quad_small, Membership, Metric, Tube};
 use super::dt::DtUsed;
 use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
 use super::noise::Noise;
 use super::normal::Ziggurat;
-use super::prs::{diag_quad, diag_quad_to_box, lanes, quad_small, Membership, Metric, Tube};
 use super::regions::{GoalEvent, SetRegions};
 use super::rng::PathRng;
 use crate::interval::Interval;

@@ -2,8 +2,8 @@
 //! enter an unsafe set, reach a goal or leave the domain. Sets are closed (a point on the
 //! boundary is in the set).
 
+use super::check::lanes;
 use super::error::RegionFault;
-use super::prs::lanes;
 use crate::interval::Interval;
 use crate::lanes::X8;
 use crate::model::{Bounds, ModelInfo, Sweep, UnsafeShape};
