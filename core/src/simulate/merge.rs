@@ -11,9 +11,10 @@ use super::report::{
     Coverage, GoalCheck, HorizonReport, InputsReport, SafetyCheck, SimReport, SimStep, StateSpread,
     TubeReport, UnsafeHits,
 };
+use super::run::QUANTILE_BYTES;
 use super::shard::Shard;
 use super::topk::TopK;
-use super::{InputMode, QUANTILE_BYTES};
+use super::InputMode;
 use crate::model::Guarantee;
 use std::collections::BTreeMap;
 

@@ -1,4 +1,5 @@
-use super::super::{make_plan, InputMode, Options};
+use super::super::plan::make_plan;
+use super::super::{InputMode, Options};
 use super::*;
 use crate::engine;
 use crate::interval::Interval;
