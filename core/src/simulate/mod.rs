@@ -69,6 +69,8 @@ pub use report::{
 pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
 pub use shard::{Shard, ShardError};
 
+#[cfg(doc)]
+use crate::model::Guarantee;
 use crate::model::ModelInfo;
 use crate::prs::Prs;
 use crate::system::{Model, System};

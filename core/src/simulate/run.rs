@@ -7,6 +7,8 @@ use super::{
     merge, part_file, topk, Options, Part, PartStats, RunInfo, Shard, SimError, SimInvalid,
     SimReport, SimUsage, StepInfo, VERSION,
 };
+#[cfg(doc)]
+use super::{run_part, simulate};
 use crate::interval::Interval;
 use crate::model::ModelInfo;
 use crate::prs::{Prs, UnsafeKind};
@@ -24,7 +26,7 @@ const BATCH_BYTES: u64 = 32 << 20;
 /// Memory limit of the quantile buffers, in bytes.
 pub(super) const QUANTILE_BYTES: u64 = 8 << 30;
 
-/// [`simulate`](super::simulate) of `sys` with its model data `info`.
+/// [`simulate`] of `sys` with its model data `info`.
 pub(super) fn whole<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
@@ -36,7 +38,7 @@ pub(super) fn whole<S: System + ?Sized>(
     merge([(String::new(), part)]).map_err(|e| SimError::Invalid(SimInvalid::Merge(e)))
 }
 
-/// [`run_part`](super::run_part) of `sys` with its model data `info`.
+/// [`run_part`] of `sys` with its model data `info`.
 pub(super) fn part<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,

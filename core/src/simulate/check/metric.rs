@@ -1,6 +1,8 @@
 //! The metric's quadratic form `d' P d`, and the sums of squares the hot loops compute
 //! with it.
 
+#[cfg(doc)]
+use super::Tube;
 use crate::lanes::Real;
 use crate::simulate::paths::SMALL;
 
@@ -129,7 +131,7 @@ pub(crate) fn clamp(x: f64, lo: f64, hi: f64) -> f64 {
 
 /// `sum_i w_i (x_i - y_i)^2` with `y = clamp(x, lo, hi)`, in [`diag_quad`]'s order: the squared
 /// P-distance of `x` to the box `[lo, hi]` for a non-negative diagonal metric `w` (the clamp is
-/// the nearest point), as [`Tube`](super::Tube) and the eight-lane loop compute it.
+/// the nearest point), as [`Tube`] and the eight-lane loop compute it.
 #[inline(always)]
 pub(crate) fn diag_quad_to_box(w: &[f64], x: &[f64], lo: &[f64], hi: &[f64]) -> f64 {
     let n = x.len();

@@ -1,6 +1,8 @@
 //! Membership in the time-uniform tube: every Euler-Maruyama state against the span of its
 //! report interval, the shortcuts, then `Prs::span_contains`.
 
+#[cfg(doc)]
+use super::diag_quad_to_box;
 use super::metric::clamp;
 use super::{members, Hulls, Metric};
 use crate::interval::Interval;
@@ -48,10 +50,9 @@ impl<'a> Tube<'a> {
     }
 
     /// The box and the "clearly inside" bound of step `k` for the caller's own
-    /// [`diag_quad_to_box`](super::diag_quad_to_box) (non-negative diagonal metrics):
-    /// `(lo, hi, q_in)`. With the members of an intersection the own span's distance proves
-    /// nothing alone: `q_in` is `-inf`, and every state goes to
-    /// [`inside_slow`](Self::inside_slow).
+    /// [`diag_quad_to_box`] (non-negative diagonal metrics): `(lo, hi, q_in)`. With the members
+    /// of an intersection the own span's distance proves nothing alone: `q_in` is `-inf`, and
+    /// every state goes to [`inside_slow`](Self::inside_slow).
     #[inline(always)]
     pub(crate) fn diag_bounds(&self, k: usize) -> (&[f64], &[f64], f64) {
         let (lo, hi, q_in) = self.own.diag_bounds(k);

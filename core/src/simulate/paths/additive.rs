@@ -1,6 +1,8 @@
 //! The loops for additive diagonal noise: one block's step with every constant in a register,
 //! and eight paths through every span in AVX-512 lanes.
 
+#[cfg(doc)]
+use super::Lanes;
 #[cfg(target_arch = "x86_64")]
 use super::Thresholds;
 use super::{ChunkStats, Dim, Path, Plan, Step, SMALL};

@@ -1,5 +1,7 @@
 //! Eight paths of a small model through every span in AVX-512 lanes.
 
+#[cfg(doc)]
+use super::Lanes;
 use super::{ChunkStats, Dim, Group, Plan, Report, Thresholds, SMALL};
 use crate::lanes::X8;
 use crate::simulate::check::quad_small;

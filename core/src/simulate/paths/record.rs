@@ -5,6 +5,8 @@ use super::{ChunkStats, Path, Plan, Report};
 use crate::lanes::X8;
 #[cfg(target_arch = "x86_64")]
 use crate::simulate::check::lanes;
+#[cfg(doc)]
+use crate::simulate::check::Membership;
 use crate::system::System;
 
 impl<S: System + ?Sized> Plan<'_, S> {
