@@ -8,11 +8,11 @@
 //! (the report marks how it was computed).
 
 use super::linalg;
-use super::transform::Frame;
-use super::zonotope;
 use crate::interval::Interval;
 use crate::model::{UnsafeSet, UnsafeShape};
 use crate::prs::{DetSet, Span, UnsafeKind};
+use crate::sets::parallelotope::Frame;
+use crate::sets::zonotope;
 
 /// What the margins of box-shaped sets need besides the set.
 pub(crate) struct Context<'a> {

@@ -48,12 +48,12 @@
 //! inside the tube when it is not.
 
 use super::paths::SMALL;
-use crate::engine::interval::ParallelotopeTest;
-use crate::engine::zonotope::ZonotopeTest;
 use crate::interval::Interval;
 use crate::lanes::{Real, X8};
 use crate::model::Bounds;
 use crate::prs::{DetSet, Prepared, Prs};
+use crate::sets::parallelotope::ParallelotopeTest;
+use crate::sets::zonotope::ZonotopeTest;
 
 /// The quadratic form `d' P d` as a list of terms.
 #[derive(Clone, Debug)]
@@ -1181,10 +1181,10 @@ impl<'a> OneSpan<'a> {
 pub(super) mod tests {
     use super::*;
     use crate::engine;
-    use crate::engine::zonotope;
     use crate::interval::Interval;
     use crate::model::*;
     use crate::prs::TransformUsed;
+    use crate::sets::zonotope;
     use crate::simulate::rng::PathRng;
     use crate::system::System;
     use crate::test_support::models::model;

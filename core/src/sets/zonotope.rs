@@ -3,7 +3,7 @@
 //! in the direction it is used (hulls and supports rounded outward, membership `true` only
 //! when certain). Generators are stored generator-major: `g_j = gens[j n..(j + 1) n]`.
 
-use super::transform::Frame;
+use super::parallelotope::Frame;
 use crate::interval::Interval;
 use crate::lanes::Real;
 use crate::model::{Transform, TransformSource};
@@ -770,8 +770,8 @@ mod tests {
     /// rounded down by no more than rounding.
     #[test]
     fn margins_use_the_support_and_the_hull_with_both_balls() {
-        use super::super::linalg;
-        use super::super::safety::{Check, Context};
+        use crate::engine::linalg;
+        use crate::engine::safety::{Check, Context};
         use crate::model::{Bounds, UnsafeSet, UnsafeShape};
         use crate::prs::DetSet;
         let (c, g) = set();
