@@ -74,7 +74,7 @@ pub(crate) fn contains(p: &[f64], x: &[f64], center: &[f64], gens: &[f64], r: f6
 ///   `|x - z|_P <= sum_s max(|xi_s| - 1, 0) |g_s|_P`: 0 inside `c + G_S [-1, 1]^n`, exact for
 ///   a point beyond one face. `xi` is computed in floating point with an approximate inverse
 ///   `M` of `G_S`, whose error `|G_S^-1 - M| <= e` entry-wise is enclosed as for a coordinate
-///   transform (interval residual `I - M G_S`, see `transform.rs`), every rounding bounded.
+///   transform (interval residual `I - M G_S`, see `parallelotope.rs`), every rounding bounded.
 /// - a point `z = c + G xi` of `Z` near `x` in the metric, the minimiser of the convex
 ///   quadratic `|x - c - G xi|_P^2` over the cube (primal active-set steps from the clamped
 ///   `M (x - c)` or 0, [`nearest_in_cube`]; projected coordinate descent where they stop short),
@@ -360,7 +360,7 @@ impl ZonotopeTest {
     /// `q + sum |P_ij| (|e_i| w_j + w_i |e_j| + w_i w_j)` plus the roundings of both sums,
     /// within `c2 sum |P_ij| (|e_i| + w_i)(|e_j| + w_j)`, `c2 = 16 (n^2 + 4) eps`; and
     /// `r^2 (1 - 4 eps)` lies below the exact `r^2` (the bound of `Frame::clearly_within` in
-    /// `transform.rs`, for a point of the zonotope instead of the parallelotope).
+    /// `parallelotope.rs`, for a point of the zonotope instead of the parallelotope).
     fn clearly_within(&self, x: &[f64], xi: &[f64], r: f64) -> (bool, f64) {
         let n = x.len();
         let (center, gens, p) = (&self.center, &self.gens, &self.p);
