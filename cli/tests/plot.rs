@@ -416,13 +416,13 @@ fn sample_paths_are_the_monte_carlo_paths() {
     let info = prepared.info.clone();
     let interp = Interpreter::new(loaded.model, &prepared);
     let analysis = info.analysis("contraction").unwrap();
-    let result = engine::run(&interp, &info, analysis).unwrap();
+    let result = engine::run_paired(&interp, &info, analysis).unwrap();
     let opts = Options {
         paths: 64,
         seed: 5,
         ..Options::default()
     };
-    let report = simulate::simulate(&interp, &info, &result, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&interp, &info, &result, &opts, &mut |_, _| {}).unwrap();
     let paths = simulate::result_paths(&interp, &info, &result, &opts).unwrap();
     assert_eq!(paths.len(), 64);
     let p = &result.constants().metric;
@@ -601,7 +601,8 @@ fn moving_sets_are_read_and_drawn_where_they_are() {
     let prepared = prepare(&mut loaded.model);
     let info = prepared.info.clone();
     let interp = Interpreter::new(loaded.model, &prepared);
-    let mut prs = engine::run(&interp, &info, info.analysis("contraction").unwrap()).unwrap();
+    let mut prs =
+        engine::run_paired(&interp, &info, info.analysis("contraction").unwrap()).unwrap();
     let steps = prs.steps().len();
     assert_eq!(steps, 17);
     // (Multiples of 1/8: the decimals in the file are exact.)

@@ -32,7 +32,7 @@ fn contraction_prs_interpreted(bencher: divan::Bencher) {
     let (interp, info) = pendulum();
     let analysis = info.analysis("contraction").unwrap();
     bencher.bench(|| {
-        reachc_runtime::engine::run(&interp, &info, analysis)
+        reachc_runtime::engine::run_paired(&interp, &info, analysis)
             .unwrap()
             .steps()
             .len()
@@ -57,7 +57,7 @@ fn interval_prs(bencher: divan::Bencher, name: &str, inclusion: &str) {
     let (interp, info) = pendulum();
     let analysis = with_inclusion(&info, name, inclusion);
     bencher.bench(|| {
-        reachc_runtime::engine::run(&interp, &info, &analysis)
+        reachc_runtime::engine::run_paired(&interp, &info, &analysis)
             .unwrap()
             .steps()
             .len()

@@ -21,6 +21,7 @@ pub mod system;
 pub mod table;
 #[cfg(test)]
 mod test_support;
+mod words;
 mod workers;
 
 pub use interval::Interval;
@@ -28,4 +29,4 @@ pub use lanes::X8;
 pub use model::{Bounds, ModelInfo};
 pub use prs::Prs;
 pub use reach::{InputPlan, Reach};
-pub use system::System;
+pub use system::{Model, System};

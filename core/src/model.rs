@@ -1,11 +1,15 @@
 //! The data model of a spec: its sets, inputs and analyses, and the constants the compiler
 //! certified for each analysis. The compiler lowers a spec straight into these types; generated
-//! code writes them as the literal returned by `info()`; the engines read them.
+//! code builds them through the hidden constructors of the sealed ones (`sealed.rs`); the
+//! engines read them.
 //!
 //! Matrices are flat row-major vectors: entry `(i, j)` of an `r x c` matrix is `[i * c + j]`.
 
 use crate::interval::Interval;
-use std::fmt;
+
+mod sealed;
+
+pub use sealed::{ConstantsParts, ModelParts};
 
 /// A closed interval `[lo, hi]` of reals given by its ends (`-inf` and `inf` allowed), as plain
 /// data (no rounding: see [`Interval`] for arithmetic).
@@ -30,39 +34,58 @@ impl Bounds {
     }
 }
 
-/// Everything about a model that is not code: names, sets and analyses.
+/// Everything about a model that is not code: names, sets and analyses, with the constants the
+/// compiler certified for each analysis.
+///
+/// Sealed: read through accessors of the fields' names, made only by the compiler and the code
+/// it generates ([`ModelInfo::from_parts`], hidden), and reached by callers through
+/// [`Model::info`](crate::system::Model::info) of the system it was generated with. A caller
+/// cannot build one, or edit one to claim another domain or other analyses:
+///
+/// ```compile_fail,E0451
+/// # use reachc_core::model::{InitialSet, ModelInfo};
+/// let info = ModelInfo { name: "forged".into(), states: vec![], inputs: vec![], noises: vec![],
+///     input_box: vec![], initial: InitialSet::default(), domain: vec![], has_domain: false,
+///     affine: true, constant_diffusion: true, unsafe_sets: vec![], goals: vec![], analyses: vec![] };
+/// ```
+///
+/// ```compile_fail,E0616
+/// # fn edit(mut info: reachc_core::ModelInfo) {
+/// info.affine = true;
+/// # }
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelInfo {
     /// `model NAME`.
-    pub name: String,
+    pub(crate) name: String,
     /// State names (family elements as `x[3]`).
-    pub states: Vec<String>,
+    pub(crate) states: Vec<String>,
     /// Input names.
-    pub inputs: Vec<String>,
+    pub(crate) inputs: Vec<String>,
     /// Noise channel names.
-    pub noises: Vec<String>,
+    pub(crate) noises: Vec<String>,
     /// The input box, one range per input.
-    pub input_box: Vec<Bounds>,
+    pub(crate) input_box: Vec<Bounds>,
     /// The initial set.
-    pub initial: InitialSet,
+    pub(crate) initial: InitialSet,
     /// Per state, the box where the constants were derived ([`Bounds::ENTIRE`] when unbounded).
-    pub domain: Vec<Bounds>,
+    pub(crate) domain: Vec<Bounds>,
     /// Whether the spec gave a domain (results then hold while the state stays in it).
-    pub has_domain: bool,
+    pub(crate) has_domain: bool,
     /// Whether `D_x f` and `G` are constant (no state, input or time in them): then
     /// `X_t - x_t` is exactly Gaussian (method.md section 8.1) and engines size the stochastic
     /// part from its covariance.
-    pub affine: bool,
+    pub(crate) affine: bool,
     /// Whether `G` is constant (no state, input, time or table in it: additive noise). Then
     /// the noise of the linearisation along the nominal cancels the model's exactly and the
     /// first-order sets get a Gaussian part (method.md 8.10).
-    pub constant_diffusion: bool,
+    pub(crate) constant_diffusion: bool,
     /// Unsafe sets.
-    pub unsafe_sets: Vec<UnsafeSet>,
+    pub(crate) unsafe_sets: Vec<UnsafeSet>,
     /// Goal sets (reach-avoid and reach-and-stay questions, method.md 8.13).
-    pub goals: Vec<GoalSet>,
+    pub(crate) goals: Vec<GoalSet>,
     /// The analyses, with their certified constants.
-    pub analyses: Vec<Analysis>,
+    pub(crate) analyses: Vec<Analysis>,
 }
 
 impl ModelInfo {
@@ -103,7 +126,7 @@ impl InitialSet {
 
     /// A box holding the set (balls by their bounding boxes, rounded outward), or why not
     /// (inconsistent data).
-    pub fn bounding_box(&self) -> Result<Vec<Bounds>, String> {
+    pub fn bounding_box(&self) -> Result<Vec<Bounds>, crate::engine::InitialSetError> {
         let (center, half) =
             crate::engine::radius::initial_center_and_halfwidths(self, self.boxes.len())?;
         Ok(self
@@ -556,50 +579,56 @@ pub enum NoConstants {
     },
 }
 
-impl fmt::Display for NoConstants {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            NoConstants::Unbounded { entry, expression } => {
-                write!(f, "{entry} = {expression} is unbounded over the domain")
-            }
-            NoConstants::BadMetric { reason } => write!(f, "invalid metric: {reason}"),
-            NoConstants::NotCertified { constant } => {
-                write!(f, "could not certify a bound for {constant}")
-            }
-        }
-    }
-}
-
 impl std::error::Error for NoConstants {}
 
 /// Constants of Assumption 1 for one metric, certified by the compiler over a [`Region`].
+///
+/// Sealed: read through accessors of the fields' names; made by the compiler and the code it
+/// generates ([`Constants::from_parts`], hidden), or given by hand and labelled so
+/// ([`Constants::given`], [`Provenance::Given`]). A caller cannot label numbers of its own as
+/// certified, nor change a certified rate:
+///
+/// ```compile_fail,E0451
+/// # use reachc_core::model::*;
+/// let forged = Constants {
+///     metric: vec![1.0], metric_region: MetricRegion::Given, c: -10.0, sigma: 0.0, rho: 0.0,
+///     provenance: Provenance::Given, region: Region { domain: vec![], input_box: vec![],
+///     time: Bounds::new(0.0, 1.0) }, also: vec![], alternatives: vec![],
+/// };
+/// ```
+///
+/// ```compile_fail,E0616
+/// # fn edit(mut constants: reachc_core::model::Constants) {
+/// constants.c = -10.0;
+/// # }
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Constants {
     /// The metric `P`, `n x n` row-major, symmetric positive definite.
-    pub metric: Vec<f64>,
+    pub(crate) metric: Vec<f64>,
     /// Where `P` comes from (given, or synthesised for which region).
-    pub metric_region: MetricRegion,
+    pub(crate) metric_region: MetricRegion,
     /// Contraction rate: `mu_P(D_x f) <= c` over the region, for all inputs and times (`inf`
     /// for a [`Rate::Empirical`] analysis: the compiler does not bound it then).
-    pub c: f64,
+    pub(crate) c: f64,
     /// Noise level: `P^(1/2) G G' P^(1/2) <= sigma^2 I`.
-    pub sigma: f64,
+    pub(crate) sigma: f64,
     /// Input gain: `|D_u f v|_P <= rho |v|_U`, where `|v|_U = max_j |v_j| / h_j` for the input
     /// box half-widths `h_j` (so the input box is the U-ball of radius 1 around its centre).
-    pub rho: f64,
+    pub(crate) rho: f64,
     /// How each constant was bounded.
-    pub provenance: Provenance,
+    pub(crate) provenance: Provenance,
     /// What the constants hold for.
-    pub region: Region,
+    pub(crate) region: Region,
     /// The analysis' further metrics (`metric = auto(states = [..])`), each with its own
     /// certified constants: the PRS is the intersection of the sets of this metric and of every
     /// one here, each computed at `delta / K` (`K = 1 + also.len()`).
-    pub also: Vec<Constants>,
+    pub(crate) also: Vec<Constants>,
     /// Other metrics the engine runs the analysis with as well, keeping the result whose PRS
     /// has the smallest bounding box at the horizon (a choice from deterministic quantities:
     /// every candidate's result is valid). Used where the compiler cannot predict the PRS
     /// (`metric = auto` without bounded constants over the domain).
-    pub alternatives: Vec<Constants>,
+    pub(crate) alternatives: Vec<Constants>,
 }
 
 impl Constants {
@@ -636,22 +665,6 @@ pub enum MetricRegion {
     /// smaller PRS at the horizon than the metric synthesised over the initial set (the engine
     /// ran both, see [`Constants::alternatives`]).
     IdentityAtRun,
-}
-
-impl fmt::Display for MetricRegion {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            MetricRegion::Given => "given in the spec",
-            MetricRegion::Domain => "synthesised for the Jacobian over the domain",
-            MetricRegion::InitialSet => {
-                "synthesised for the Jacobian over the initial set during the first report step"
-            }
-            MetricRegion::IdentityAtRun => {
-                "the identity: a smaller PRS at the horizon than the metric synthesised over the \
-                 initial set (both were run)"
-            }
-        })
-    }
 }
 
 /// The states, inputs and times over which [`Constants`] were certified. A run whose model
@@ -722,67 +735,4 @@ pub enum InputGain {
     Corners(MatrixBound),
     /// Column by column (many inputs), for the matrices of `D_u f`.
     Columns(MatrixBound),
-}
-
-impl fmt::Display for MatrixBound {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let fixed_note = |fixed: usize| {
-            if fixed == 0 {
-                String::new()
-            } else {
-                format!(", {fixed} fixed at one end by semidefiniteness")
-            }
-        };
-        match *self {
-            MatrixBound::Vertices {
-                count,
-                atoms,
-                fixed,
-            } => write!(
-                f,
-                "max over {count} vertex matri{} ({atoms} atom{}{})",
-                if count == 1 { "x" } else { "ces" },
-                if atoms == 1 { "" } else { "s" },
-                fixed_note(fixed)
-            ),
-            MatrixBound::Hull {
-                atoms,
-                fixed,
-                vertex_limit,
-            } => write!(
-                f,
-                "interval-matrix bound ({atoms} atoms{}, {} free > {vertex_limit}, too many \
-                 vertices)",
-                fixed_note(fixed),
-                atoms - fixed
-            ),
-        }
-    }
-}
-
-impl fmt::Display for InputGain {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            InputGain::NoInputs => f.write_str("no inputs"),
-            InputGain::Corners(m) => write!(f, "{m}, max over the input box's corners"),
-            InputGain::Columns(m) => write!(f, "{m}, column bound (many inputs)"),
-        }
-    }
-}
-
-impl fmt::Display for Provenance {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (c, sigma, rho) = match self {
-            Provenance::Certified { c, sigma, rho } => (c, sigma, rho),
-            Provenance::Given => return f.write_str("given by hand, not certified by reachc"),
-            Provenance::Unbounded { why } => {
-                return write!(f, "not bounded over the domain ({why})");
-            }
-        };
-        match c {
-            Some(c) => write!(f, "c: {c}; ")?,
-            None => f.write_str("c: not bounded by the compiler; ")?,
-        }
-        write!(f, "sigma: {sigma}; rho: {rho}; certified by interval LDL'")
-    }
 }

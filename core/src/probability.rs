@@ -9,7 +9,7 @@
 //! random outcome, so the bound of every run shown safe holds, and the smallest such `delta`
 //! is reported.
 
-use crate::engine::{self, Detail, RunError, Setting};
+use crate::engine::{self, Detail, Problem, RunError, Setting};
 use crate::model::Guarantee;
 use crate::prs::{GoalMiss, GoalOutcome, GoalVerdict, Prs, Validation, Verdict};
 use crate::reach::Reach;
@@ -164,18 +164,12 @@ impl Reach<'_> {
         let spec = self.analysis();
         if spec.guarantee != Guarantee::Uniform {
             return Err(RunError::Unsupported(
-                Detail::from(
-                    "a probability of safety over the horizon needs `guarantee = uniform` (a \
-                     pointwise PRS bounds each time separately, not the path)",
-                )
-                .at_setting(Setting::Guarantee),
+                Detail::from(Problem::SafetyNeedsUniform).at_setting(Setting::Guarantee),
             ));
         }
         let sets = &self.model().unsafe_sets;
         if sets.is_empty() {
-            return Err(RunError::Unsupported(Detail::from(
-                "a probability of safety needs unsafe sets (the model has none)",
-            )));
+            return Err(RunError::Unsupported(Problem::SafetyNeedsUnsafeSets.into()));
         }
         let search = self.bisect(
             |p| p.verdict == Verdict::Safe,
@@ -290,19 +284,15 @@ impl Reach<'_> {
             .is_some_and(|g| !g.stay && self.model().unsafe_sets.is_empty());
         if self.analysis().guarantee != Guarantee::Uniform && !one_time {
             return Err(RunError::Unsupported(
-                Detail::from(
-                    "a probability of reaching a goal needs `guarantee = uniform` (a pointwise \
-                     PRS bounds each time separately, not the path)",
-                )
-                .at_setting(Setting::Guarantee),
+                Detail::from(Problem::GoalNeedsUniform).at_setting(Setting::Guarantee),
             ));
         }
         if goal >= self.model().goals.len() {
             return Err(RunError::Invalid(
-                format!(
-                    "no goal {goal}: the model has {} goal sets",
-                    self.model().goals.len()
-                )
+                Problem::NoGoal {
+                    goal,
+                    goals: self.model().goals.len(),
+                }
                 .into(),
             ));
         }

@@ -2,8 +2,8 @@
 //! constants were certified for.
 
 use crate::engine::{
-    self, check_initial, union, BoxMemo, Constraint, Detail, Inputs, Needs, Run, RunError, Setting,
-    Setup, TightenError, Tightening,
+    self, check_initial, union, BoxMemo, Constraint, Detail, Inputs, Needs, Note, Problem, Run,
+    RunError, Setting, Setup, TightenError, Tightening,
 };
 use crate::interval::Interval;
 use crate::model::{
@@ -11,7 +11,7 @@ use crate::model::{
     Rate, Split,
 };
 use crate::prs::{Prs, Role, Verdict};
-use crate::system::System;
+use crate::system::{Model, System};
 use crate::workers::Workers;
 use std::time::{Duration, Instant};
 
@@ -25,7 +25,7 @@ use std::time::{Duration, Instant};
 /// outside the input box, is an error.
 ///
 /// ```ignore
-/// let reach = Reach::new(&sys, &info, "contraction")?;
+/// let reach = Reach::new(&Pendulum, pendulum::analysis::CONTRACTION)?;
 /// let prs = reach.from_box(&[Bounds::new(-0.1, 0.1), Bounds::new(-0.2, 0.2)])?;
 /// let radius_at_1 = prs.at(1.0).unwrap().prs_radius;
 /// ```
@@ -44,23 +44,48 @@ pub struct Reach<'a> {
 }
 
 impl<'a> Reach<'a> {
-    /// The analysis `name` of the model (`info` as generated with `sys`).
-    pub fn new(
+    /// The analysis `name` of `model`.
+    pub fn new(model: &'a dyn Model, name: &str) -> Result<Reach<'a>, RunError> {
+        Reach::named(model, model.info(), name)
+    }
+
+    /// The analysis `name` of the system `sys` with the model data `info`: test support
+    /// (feature `test-util`), for tests of hand-written systems and data.
+    #[cfg(feature = "test-util")]
+    #[doc(hidden)]
+    pub fn paired(
         sys: &'a dyn System,
         info: &'a ModelInfo,
         name: &str,
     ) -> Result<Reach<'a>, RunError> {
+        Reach::named(sys, info, name)
+    }
+
+    /// `analysis` (built by hand) of the system `sys` with the model data `info`: test support
+    /// (feature `test-util`).
+    #[cfg(feature = "test-util")]
+    #[doc(hidden)]
+    pub fn for_analysis(
+        sys: &'a dyn System,
+        info: &'a ModelInfo,
+        analysis: &'a Analysis,
+    ) -> Result<Reach<'a>, RunError> {
+        Reach::of(sys, info, analysis)
+    }
+
+    /// The analysis `name` of `info`, run with `sys`.
+    fn named(sys: &'a dyn System, info: &'a ModelInfo, name: &str) -> Result<Reach<'a>, RunError> {
         let analysis = info
             .analysis(name)
             .ok_or_else(|| RunError::UnknownAnalysis {
                 name: name.to_string(),
                 available: info.analyses.iter().map(|a| a.spec.name.clone()).collect(),
             })?;
-        Reach::for_analysis(sys, info, analysis)
+        Reach::of(sys, info, analysis)
     }
 
-    /// `analysis` (one of `info.analyses`, or one built like it) of the model.
-    pub fn for_analysis(
+    /// `analysis` of `info`, run with `sys`.
+    fn of(
         sys: &'a dyn System,
         info: &'a ModelInfo,
         analysis: &'a Analysis,
@@ -69,12 +94,7 @@ impl<'a> Reach<'a> {
         let needs = match (spec.method, spec.rate) {
             (_, Rate::Local) if spec.guarantee != Guarantee::Uniform => {
                 return Err(RunError::Unsupported(
-                    Detail::from(
-                        "local rates with a pointwise guarantee (the proof that the process \
-                         never leaves the regions needs the time-uniform tube): use \
-                         `rate = global`",
-                    )
-                    .at_setting(Setting::Rate),
+                    Detail::from(Problem::LocalPointwise).at_setting(Setting::Rate),
                 ))
             }
             (_, Rate::Local) => Needs {
@@ -89,11 +109,7 @@ impl<'a> Reach<'a> {
             },
             (Method::Interval, rate) => {
                 return Err(RunError::Unsupported(
-                    Detail::from(format!(
-                        "a {} rate with the interval method (it uses a certified rate)",
-                        rate.name()
-                    ))
-                    .at_setting(Setting::Rate),
+                    Detail::from(Problem::IntervalRate(rate)).at_setting(Setting::Rate),
                 ))
             }
             (Method::Contraction, Rate::Global) => Needs {
@@ -188,10 +204,7 @@ impl<'a> Reach<'a> {
         plan.check(&self.info.input_box)?;
         if let Rate::Empirical { .. } = self.spec.rate {
             return Err(RunError::Unsupported(
-                Detail::from(
-                    "an input plan with an empirical rate (its sample paths draw random inputs)",
-                )
-                .at_setting(Setting::Rate),
+                Detail::from(Problem::PlanWithEmpiricalRate).at_setting(Setting::Rate),
             ));
         }
         self.run_from(x0, Inputs::Plan(plan))
@@ -200,11 +213,10 @@ impl<'a> Reach<'a> {
     fn initial_box(&self, x0: &[Bounds]) -> Result<InitialSet, RunError> {
         if x0.len() != self.setup.n {
             return Err(RunError::Invalid(
-                format!(
-                    "the initial box has {} ranges, the model {} states",
-                    x0.len(),
-                    self.setup.n
-                )
+                Problem::InitialBoxSize {
+                    ranges: x0.len(),
+                    n: self.setup.n,
+                }
                 .into(),
             ));
         }
@@ -255,27 +267,18 @@ impl<'a> Reach<'a> {
             Ok(b) if initial.balls.is_empty() => b,
             _ => {
                 return Err(RunError::Unsupported(
-                    Detail::from(
-                        "splitting an initial set that is not a box (an initial ball): give \
-                         the states ranges, or remove `split`",
-                    )
-                    .at_setting(Setting::Split),
+                    Detail::from(Problem::SplitNotABox).at_setting(Setting::Split),
                 ))
             }
         };
-        let workers = Workers::new(None).map_err(|m| RunError::Invalid(m.into()))?;
+        let workers =
+            Workers::new(None).map_err(|e| RunError::Invalid(Problem::Threads(e).into()))?;
         // A piece's failure says which piece.
         let run = |b: &[Bounds]| {
             self.run_piece(own, &InitialSet::from_box(b), inputs)
                 .map_err(|e| {
-                    let ranges: Vec<String> = self
-                        .info
-                        .states
-                        .iter()
-                        .zip(b)
-                        .map(|(x, r)| format!("{x} in [{}, {}]", r.lo, r.hi))
-                        .collect();
-                    e.in_piece(&ranges.join(", "))
+                    let ranges = self.info.states.iter().cloned().zip(b.iter().copied());
+                    e.in_piece(ranges.collect())
                 })
         };
         let (split, pieces) = match &own.split {
@@ -476,10 +479,7 @@ impl<'a> Reach<'a> {
             );
             match alone {
                 Ok(Some(prs)) => Ok(prs),
-                Ok(None) => Err(failed.noted(
-                    "the linearised Gaussian set alone (method.md 8.12) could not be bounded \
-                     over the horizon either",
-                )),
+                Ok(None) => Err(failed.noted(Note::AloneFailed)),
                 Err(_) => Err(failed),
             }
         };
@@ -571,9 +571,7 @@ impl InputPlan {
     pub fn steps(times: Vec<f64>, values: Vec<Vec<f64>>) -> Result<InputPlan, RunError> {
         let increasing = times.windows(2).all(|w| w[0] < w[1]);
         if times.first() != Some(&0.0) || !increasing || times.len() != values.len() {
-            return Err(RunError::Invalid(
-                "an input plan needs increasing times starting at 0, one value per time".into(),
-            ));
+            return Err(RunError::Invalid(Problem::PlanTimes.into()));
         }
         Ok(InputPlan { times, values })
     }
@@ -589,11 +587,10 @@ impl InputPlan {
         for u in &self.values {
             if u.len() != input_box.len() {
                 return Err(RunError::Invalid(
-                    format!(
-                        "an input plan value has {} entries, the model {} inputs",
-                        u.len(),
-                        input_box.len()
-                    )
+                    Problem::PlanValueSize {
+                        entries: u.len(),
+                        p: input_box.len(),
+                    }
                     .into(),
                 ));
             }
@@ -603,10 +600,7 @@ impl InputPlan {
                 .all(|(&v, b)| Interval::try_new(b.lo, b.hi).is_some_and(|iv| iv.contains(v)));
             if !inside {
                 return Err(RunError::Invalid(
-                    format!(
-                        "the input plan value {u:?} leaves the input box, where the constants hold"
-                    )
-                    .into(),
+                    Problem::PlanValueOutside(u.clone()).into(),
                 ));
             }
         }

@@ -6,6 +6,13 @@
 
 use crate::interval::Interval;
 use crate::lanes::X8;
+use crate::model::ModelInfo;
+
+#[cfg(feature = "test-util")]
+mod paired;
+#[cfg(feature = "test-util")]
+#[doc(hidden)]
+pub use paired::Paired;
 
 /// `f(x, u, out)` lane by lane, for lane `l` of every entry of `x`, `u` and `out` (the
 /// trait's default lanes forms).
@@ -110,4 +117,22 @@ pub trait System: Sync {
     fn set_numbers(&self, t: Interval, out: &mut [Interval]) {
         let _ = (t, out);
     }
+}
+
+/// A [`System`] together with the model data generated with it from one spec: its sets, its
+/// analyses and the constants the compiler certified for them. Generated model types implement
+/// it (as does the compiler's interpreter), and the engines take a `Model`
+/// ([`Reach::new`](crate::Reach::new), [`engine::run`](crate::engine::run),
+/// [`simulate`](crate::simulate::simulate)), so one model's constants cannot be used with
+/// another model's system:
+///
+/// ```compile_fail,E0061
+/// # use reachc_core::{ModelInfo, Reach, System};
+/// fn mixed(sys: &dyn System, other: &ModelInfo) {
+///     let _ = Reach::new(sys, other, "contraction");
+/// }
+/// ```
+pub trait Model: System {
+    /// The model's data, generated with this system.
+    fn info(&self) -> &ModelInfo;
 }

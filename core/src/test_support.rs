@@ -6,7 +6,7 @@
 #![allow(dead_code)] // each unit test uses some of the fixtures
 
 use crate::interval::Interval;
-use crate::model::{Bounds, Constants, InitialSet, ModelInfo};
+use crate::model::{Bounds, Constants, InitialSet, ModelInfo, ModelParts};
 use crate::system::System;
 
 #[path = "../../test-support/src/models.rs"]

@@ -2,6 +2,8 @@
 //! rayon pool with the `parallel` feature, otherwise in order on the calling thread. Items are
 //! independent and their results come back in order, so the results are the same either way.
 
+use crate::engine::ThreadsError;
+
 /// The workers of one simulation or one split run.
 pub(crate) struct Workers {
     /// A pool of the requested size (`None`: the current rayon pool).
@@ -12,7 +14,7 @@ pub(crate) struct Workers {
 impl Workers {
     /// `threads` workers, or the current rayon pool when `None` (one thread without the
     /// `parallel` feature, whatever is asked).
-    pub(crate) fn new(threads: Option<usize>) -> Result<Workers, String> {
+    pub(crate) fn new(threads: Option<usize>) -> Result<Workers, ThreadsError> {
         #[cfg(feature = "parallel")]
         {
             let pool = match threads {
@@ -20,7 +22,10 @@ impl Workers {
                     rayon::ThreadPoolBuilder::new()
                         .num_threads(t)
                         .build()
-                        .map_err(|e| format!("cannot start {t} threads: {e}"))?,
+                        .map_err(|e| ThreadsError {
+                            threads: t,
+                            cause: e.to_string(),
+                        })?,
                 ),
                 None => None,
             };

@@ -5,7 +5,7 @@ use reachc_core::engine::{self, Culprit, RunError, Setting};
 use reachc_core::kappa::kappa;
 use reachc_core::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, InitialSet, Integrator, Method,
-    ModelInfo, RadiusRule, Rate, Transform, TransformSource, UnsafeSet, UnsafeShape,
+    ModelInfo, ModelParts, RadiusRule, Rate, Transform, TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_core::prs::{BallBound, DetSet, Prs, Span, Unproved, UnsafeKind, Verdict};
 use reachc_core::{InputPlan, Reach, System};
@@ -51,14 +51,14 @@ fn info(
     boxes: Vec<(f64, f64)>,
     input_box: Vec<(f64, f64)>,
 ) -> ModelInfo {
-    ModelInfo {
+    ModelInfo::from_parts(ModelParts {
         inputs: (0..input_box.len()).map(|j| format!("u{j}")).collect(),
         input_box: input_box
             .into_iter()
             .map(|(a, b)| Bounds::new(a, b))
             .collect(),
-        ..model(name, states, &["w"], &boxes)
-    }
+        ..model(name, states, &["w"], &boxes).into_parts()
+    })
 }
 
 /// System (a): `dX = -0.4 X dt + sqrt(2) dW`, n = 2, X0 = 0.
@@ -108,7 +108,7 @@ fn step_at(res: &Prs, t: f64) -> usize {
 fn linear_psi_matches_closed_form_and_r_uses_kappa() {
     let delta = 1e-3;
     let (sys, inf, an) = linear_setup(delta, 4.0, 0.01);
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     assert_eq!(res.steps().len(), 401);
     assert_eq!(res.steps().last().unwrap().t, 4.0);
     let k = kappa(2, delta, RadiusRule::Amgf);
@@ -153,12 +153,12 @@ fn linear_psi_matches_closed_form_and_r_uses_kappa() {
 fn paper_rules_report_eps() {
     let (sys, inf, mut an) = linear_setup(1e-3, 1.0, 0.1);
     an.spec.radius = RadiusRule::Paper(1.0 / 16.0);
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     assert_eq!(res.radius_rule().rule, RadiusRule::Paper(1.0 / 16.0));
     assert_eq!(res.radius_rule().eps, Some(1.0 / 16.0));
     assert_eq!(res.kappa(), kappa(2, 1e-3, RadiusRule::Paper(1.0 / 16.0)));
     an.spec.radius = RadiusRule::PaperOptimal;
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     assert_eq!(res.radius_rule().rule, RadiusRule::PaperOptimal);
     let eps = res.radius_rule().eps.unwrap();
     assert!(eps > 0.0 && eps < 1.0);
@@ -171,7 +171,7 @@ fn paper_rules_report_eps() {
 #[test]
 fn input_deterministic_radius() {
     let (sys, inf, an) = input_setup();
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     assert_eq!(res.r1(), 0.5);
     assert_eq!(res.r2(), 1.0);
     assert_eq!(res.constants().rho, 1.0);
@@ -197,7 +197,7 @@ fn input_deterministic_radius() {
 #[test]
 fn membership() {
     let (sys, inf, an) = input_setup();
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     let k = step_at(&res, 1.0);
     let st = &res.steps()[k];
     let (c, r) = (st.nominal()[0], st.prs_radius);
@@ -209,7 +209,7 @@ fn membership() {
 
     // Pendulum: the P-ball boundary along an eigen-direction of P.
     let (sys, inf, an) = pendulum_setup();
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     let k = step_at(&res, 2.0);
     let st = &res.steps()[k];
     let d = [1.0, -0.5];
@@ -234,7 +234,7 @@ fn monte_carlo_probability_level() {
     let delta = 0.05;
     let t_end = 1.5;
     let (sys, inf, an) = linear_setup(delta, t_end, 0.01);
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     let k = step_at(&res, t_end);
     let r_t = res.steps()[k].r_t;
 
@@ -276,7 +276,7 @@ fn monte_carlo_probability_level() {
 #[test]
 fn half_space_safety() {
     let (sys, mut inf, an) = linear_setup(1e-3, 2.0, 0.05);
-    inf.unsafe_sets = vec![
+    *inf.unsafe_sets_mut() = vec![
         UnsafeSet {
             name: "far".into(),
             shape: UnsafeShape::HalfSpace {
@@ -294,7 +294,7 @@ fn half_space_safety() {
             moving: Vec::new(),
         },
     ];
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     // P = I: max of a.x over the ball is |a| R, margin = (100 - 5 R) / 5 = 20 - R.
     let far = &res.unsafe_sets()[0];
     assert!(far.safe);
@@ -324,7 +324,7 @@ fn half_space_safety() {
 fn safety_against_boxes_and_balls() {
     // Input system: x* = e^-t, PRS radius R_t + r_t, P = 1.
     let (sys, mut inf, an) = input_setup();
-    inf.unsafe_sets = vec![
+    *inf.unsafe_sets_mut() = vec![
         UnsafeSet {
             name: "box_far".into(),
             shape: UnsafeShape::Box(vec![(0, Bounds::new(5.0, f64::INFINITY))]),
@@ -345,7 +345,7 @@ fn safety_against_boxes_and_balls() {
             moving: Vec::new(),
         },
     ];
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     for (k, st) in res.steps().iter().enumerate() {
         // The margins are over the report interval ending at t: its span holds the PRS at
         // both ends, [x - r, x + r] now and at the previous report time.
@@ -377,7 +377,7 @@ fn safety_against_boxes_and_balls() {
 #[test]
 fn pendulum_half_space_uses_inverse_metric() {
     let (sys, mut inf, an) = pendulum_setup();
-    inf.unsafe_sets = vec![
+    *inf.unsafe_sets_mut() = vec![
         UnsafeSet {
             name: "theta_high".into(),
             shape: UnsafeShape::HalfSpace {
@@ -401,7 +401,7 @@ fn pendulum_half_space_uses_inverse_metric() {
             moving: Vec::new(),
         },
     ];
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     let det = PENDULUM_METRIC[0] * PENDULUM_METRIC[3] - PENDULUM_METRIC[1] * PENDULUM_METRIC[2];
     let pinv = [
         PENDULUM_METRIC[3] / det,
@@ -479,7 +479,7 @@ fn pendulum_half_space_uses_inverse_metric() {
 #[test]
 fn pendulum_radii_finite_and_decreasing() {
     let (sys, inf, an) = pendulum_setup();
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     assert_eq!(res.steps().len(), 401);
     // r1 = |(pi/10, 0.2)|_P (the vertex maximising d'Pd, both signs agree with P_12 > 0).
     let d = [std::f64::consts::PI / 10.0, 0.2];
@@ -530,7 +530,7 @@ fn errors() {
         source: TransformSource::Given,
     });
     assert!(matches!(
-        engine::run(&sys, &inf, &an),
+        engine::run_paired(&sys, &inf, &an),
         Err(RunError::Unsupported(_))
     ));
     an.spec.transform = None;
@@ -542,14 +542,14 @@ fn errors() {
             expression: "x1^2".into(),
         }),
     );
-    match engine::run(&sys, &inf, &an) {
-        Err(RunError::NoConstants(m)) => assert!(m.message.contains("unbounded"), "{m}"),
+    match engine::run_paired(&sys, &inf, &an) {
+        Err(RunError::NoConstants(m)) => assert!(m.to_string().contains("unbounded"), "{m}"),
         other => panic!("expected NoConstants, got {other:?}"),
     }
     an.constants = constants;
     an.spec.delta = 1.5;
     assert!(matches!(
-        engine::run(&sys, &inf, &an),
+        engine::run_paired(&sys, &inf, &an),
         Err(RunError::Invalid(_))
     ));
     an.spec.delta = 1e-3;
@@ -557,17 +557,17 @@ fn errors() {
     // validated integrator's steps used to shrink to zero and never end.
     let mut tiny = an.clone();
     (tiny.spec.horizon, tiny.spec.step) = (1e-320, 1e-322);
-    match engine::run(&sys, &inf, &tiny) {
+    match engine::run_paired(&sys, &inf, &tiny) {
         Err(RunError::Invalid(m)) => {
-            assert!(m.message.contains("at least 1e-100"), "{m}");
+            assert!(m.to_string().contains("at least 1e-100"), "{m}");
             assert_eq!(m.culprit, Some(Culprit::Setting(Setting::Step)));
         }
         other => panic!("expected Invalid, got {other:?}"),
     }
     let mut bad = an.clone();
-    bad.constants.as_mut().unwrap().metric = vec![1.0, 2.0, 2.0, 1.0];
+    *bad.constants.as_mut().unwrap().metric_mut() = vec![1.0, 2.0, 2.0, 1.0];
     assert!(matches!(
-        engine::run(&sys, &inf, &bad),
+        engine::run_paired(&sys, &inf, &bad),
         Err(RunError::Invalid(_))
     ));
 }
@@ -576,9 +576,9 @@ fn errors() {
 fn euler_uneven_horizon_domain_and_ball() {
     let (sys, mut inf, mut an) = linear_setup(1e-2, 1.05, 0.1);
     an.spec.integrator = Integrator::Euler;
-    inf.has_domain = true;
+    *inf.has_domain_mut() = true;
     // Ball of radius 0.5 over both states with metric diag(4, 1): bounding box (0.25, 0.5).
-    inf.initial = InitialSet {
+    *inf.initial_mut() = InitialSet {
         boxes: vec![None, None],
         balls: vec![reachc_core::model::Ball {
             states: vec![0, 1],
@@ -587,7 +587,7 @@ fn euler_uneven_horizon_domain_and_ball() {
             metric: Some(vec![4.0, 0.0, 0.0, 1.0]),
         }],
     };
-    let res = engine::run(&sys, &inf, &an).unwrap();
+    let res = engine::run_paired(&sys, &inf, &an).unwrap();
     assert_eq!(res.steps().len(), 12);
     assert_eq!(res.steps().last().unwrap().t, 1.05);
     assert_eq!(res.initial_center(), vec![1.0, -1.0]);
@@ -624,13 +624,13 @@ fn empirical_rate_of_a_linear_drift_is_its_rate() {
             (Box::new(s) as Box<dyn System>, i, a)
         },
     ] {
-        let exact = certified.constants.as_ref().unwrap().c;
+        let exact = certified.constants.as_ref().unwrap().c();
         let mut empirical = certified.clone();
         empirical.spec.rate = Rate::Empirical { paths: 50 };
         // The compiler leaves c unbounded for an empirical analysis.
-        empirical.constants.as_mut().unwrap().c = f64::INFINITY;
-        let want = engine::run(sys.as_ref(), &inf, &certified).unwrap();
-        let got = engine::run(sys.as_ref(), &inf, &empirical).unwrap();
+        *empirical.constants.as_mut().unwrap().c_mut() = f64::INFINITY;
+        let want = engine::run_paired(sys.as_ref(), &inf, &certified).unwrap();
+        let got = engine::run_paired(sys.as_ref(), &inf, &empirical).unwrap();
         assert_eq!(got.rate().rate, Rate::Empirical { paths: 50 });
         assert_eq!(
             got.validation().not_validated[0],
@@ -654,16 +654,16 @@ fn empirical_rate_of_a_linear_drift_is_its_rate() {
 #[test]
 fn empirical_rate_needs_no_certified_c_and_not_the_interval_method() {
     let (sys, inf, mut an) = linear_setup(1e-3, 1.0, 0.1);
-    an.constants.as_mut().unwrap().c = f64::NAN;
+    *an.constants.as_mut().unwrap().c_mut() = f64::NAN;
     assert!(matches!(
-        engine::run(&sys, &inf, &an),
+        engine::run_paired(&sys, &inf, &an),
         Err(RunError::NoConstants(_))
     ));
     an.spec.rate = Rate::Empirical { paths: 20 };
-    assert!(engine::run(&sys, &inf, &an).is_ok());
+    assert!(engine::run_paired(&sys, &inf, &an).is_ok());
     an.spec.method = Method::Interval;
     assert!(matches!(
-        engine::run(&sys, &inf, &an),
+        engine::run_paired(&sys, &inf, &an),
         Err(RunError::Unsupported(_))
     ));
 }
@@ -676,16 +676,16 @@ fn empirical_rate_needs_no_certified_c_and_not_the_interval_method() {
 #[test]
 fn reach_from_a_box_is_the_run_from_that_box() {
     let (sys, mut inf, an) = pendulum_setup();
-    inf.analyses = vec![an];
-    let reach = Reach::new(&sys, &inf, "main").unwrap();
+    *inf.analyses_mut() = vec![an];
+    let reach = Reach::paired(&sys, &inf, "main").unwrap();
     let x0 = [Bounds::new(0.1, 0.2), Bounds::new(-0.05, 0.0)];
     let prs = reach.from_box(&x0).unwrap();
     // The ball's own questions (the interval box it is intersected with is checked in
     // tests/tests/tighter_sets.rs).
     let prs = prs.without_members();
     let mut moved = inf.clone();
-    moved.initial = InitialSet::from_box(&x0);
-    let direct = engine::run(&sys, &moved, &moved.analyses[0]).unwrap();
+    *moved.initial_mut() = InitialSet::from_box(&x0);
+    let direct = engine::run_paired(&sys, &moved, &moved.analyses()[0]).unwrap();
     assert_eq!(prs.steps(), direct.steps());
     assert_eq!(prs.r1(), direct.r1());
     // The spec's own initial set gives another (larger) PRS.
@@ -729,41 +729,46 @@ fn reach_from_a_box_is_the_run_from_that_box() {
 #[test]
 fn reach_refuses_what_the_constants_do_not_cover() {
     let (sys, mut inf, an) = input_setup();
-    inf.analyses = vec![an];
-    assert!(Reach::new(&sys, &inf, "main").is_ok());
+    *inf.analyses_mut() = vec![an];
+    assert!(Reach::paired(&sys, &inf, "main").is_ok());
     assert!(matches!(
-        Reach::new(&sys, &inf, "other"),
+        Reach::paired(&sys, &inf, "other"),
         Err(RunError::UnknownAnalysis { .. })
     ));
     let mut wider = inf.clone();
-    wider.input_box = vec![Bounds::new(-2.0, 2.0)];
-    match Reach::new(&sys, &wider, "main").map(|_| ()) {
-        Err(RunError::Invalid(m)) => assert!(m.message.contains("input box"), "{m}"),
+    *wider.input_box_mut() = vec![Bounds::new(-2.0, 2.0)];
+    match Reach::paired(&sys, &wider, "main").map(|_| ()) {
+        Err(RunError::Invalid(m)) => assert!(m.to_string().contains("input box"), "{m}"),
         other => panic!("expected Invalid, got {other:?}"),
     }
     let mut bounded = inf.clone();
-    bounded.domain = vec![Bounds::new(-5.0, 5.0)];
-    bounded.has_domain = true;
+    *bounded.domain_mut() = vec![Bounds::new(-5.0, 5.0)];
+    *bounded.has_domain_mut() = true;
     assert!(matches!(
-        engine::run(&sys, &bounded, &bounded.analyses[0]),
-        Err(RunError::Invalid(m)) if m.message.contains("domain")
+        engine::run_paired(&sys, &bounded, &bounded.analyses()[0]),
+        Err(RunError::Invalid(m)) if m.to_string().contains("domain")
     ));
     // With constants certified over that domain: initial sets inside it run, others do not.
     let constants = Constants::given(&bounded, vec![1.0], -1.0, 0.1, 1.0);
-    bounded.analyses[0].constants = Ok(constants);
-    let reach = Reach::new(&sys, &bounded, "main").unwrap();
+    bounded.analyses_mut()[0].constants = Ok(constants);
+    let reach = Reach::paired(&sys, &bounded, "main").unwrap();
     assert!(reach.from_box(&[Bounds::new(4.0, 5.0)]).is_ok());
     match reach.from_box(&[Bounds::new(4.0, 5.5)]).map(|_| ()) {
         Err(RunError::Invalid(m)) => {
-            assert!(m.message.contains("leaves the domain"), "{m}");
+            assert!(m.to_string().contains("leaves the domain"), "{m}");
             assert_eq!(m.culprit, Some(Culprit::State(0)));
         }
         other => panic!("expected Invalid, got {other:?}"),
     }
     // A longer horizon than certified.
     let mut longer = inf.clone();
-    longer.analyses[0].constants.as_mut().unwrap().region.time = Bounds::new(0.0, 1.0);
-    assert!(Reach::new(&sys, &longer, "main").is_err());
+    longer.analyses_mut()[0]
+        .constants
+        .as_mut()
+        .unwrap()
+        .region_mut()
+        .time = Bounds::new(0.0, 1.0);
+    assert!(Reach::paired(&sys, &longer, "main").is_err());
 }
 
 /// A known input: no input uncertainty (`R_t = e^(ct) r1`), the nominal follows the plan, and
@@ -771,8 +776,8 @@ fn reach_refuses_what_the_constants_do_not_cover() {
 #[test]
 fn reach_under_an_input_plan() {
     let (sys, mut inf, an) = input_setup();
-    inf.analyses = vec![an];
-    let reach = Reach::new(&sys, &inf, "main").unwrap();
+    *inf.analyses_mut() = vec![an];
+    let reach = Reach::paired(&sys, &inf, "main").unwrap();
     let x0 = [Bounds::new(0.9, 1.1)];
     let plan = InputPlan::steps(vec![0.0, 1.0], vec![vec![0.5], vec![-0.5]]).unwrap();
     let prs = reach.from_box_with(&x0, &plan).unwrap();
@@ -796,21 +801,23 @@ fn reach_under_an_input_plan() {
     let outside = InputPlan::constant(&[1.5]);
     assert!(matches!(
         reach.from_box_with(&x0, &outside),
-        Err(RunError::Invalid(m)) if m.message.contains("input box")
+        Err(RunError::Invalid(m)) if m.to_string().contains("input box")
     ));
     assert!(InputPlan::steps(vec![0.5], vec![vec![0.0]]).is_err());
     // A plan is not simulated with random inputs: the simulator refuses it.
     let opts = reachc_core::simulate::Options::default();
-    assert!(reachc_core::simulate::simulate(&sys, &inf, &prs, &opts, &mut |_, _| {}).is_err());
+    assert!(
+        reachc_core::simulate::simulate_paired(&sys, &inf, &prs, &opts, &mut |_, _| {}).is_err()
+    );
 }
 
 /// Another delta changes the stochastic radius only, by the ratio of the kappas.
 #[test]
 fn reach_at_another_delta() {
     let (sys, mut inf, an) = linear_setup(1e-3, 1.0, 0.1);
-    inf.analyses = vec![an];
-    let base = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
-    let wide = Reach::new(&sys, &inf, "main")
+    *inf.analyses_mut() = vec![an];
+    let base = Reach::paired(&sys, &inf, "main").unwrap().run().unwrap();
+    let wide = Reach::paired(&sys, &inf, "main")
         .unwrap()
         .with_delta(0.1)
         .unwrap()
@@ -820,7 +827,7 @@ fn reach_at_another_delta() {
     let (a, b) = (&base.steps()[10], &wide.steps()[10]);
     assert!((b.r_t / a.r_t - ratio).abs() < 1e-12);
     assert_eq!(wide.delta(), 0.1);
-    assert!(Reach::new(&sys, &inf, "main")
+    assert!(Reach::paired(&sys, &inf, "main")
         .unwrap()
         .with_delta(1.0)
         .is_err());
@@ -842,7 +849,7 @@ fn growing(a: f64, x0: f64, horizon: f64, guarantee: Guarantee) -> (Linear, Mode
     let constants = Constants::given(&inf, vec![1.0], a, 1.0, 0.0);
     let mut an = analysis(1e-2, horizon, 0.1, constants);
     an.spec.guarantee = guarantee;
-    inf.analyses = vec![an];
+    *inf.analyses_mut() = vec![an];
     (sys, inf)
 }
 
@@ -854,9 +861,9 @@ fn a_radius_that_overflows_is_an_error_not_an_infinite_set() {
     let (sys, inf) = growing(400.0, 0.0, 2.0, Guarantee::Pointwise);
     let t_over = (800.0f64.ln() + f64::MAX.ln()) / 800.0;
     assert!(0.8 < t_over && t_over < 0.9, "{t_over}");
-    match Reach::new(&sys, &inf, "main").unwrap().run() {
+    match Reach::paired(&sys, &inf, "main").unwrap().run() {
         Err(RunError::NonFinite(d)) => {
-            let m = &d.message;
+            let m = &d.to_string();
             assert!(
                 m.contains("the PRS is not finite from t = 0.9 on")
                     && m.contains("r_t = inf")
@@ -874,7 +881,7 @@ fn a_radius_that_overflows_is_an_error_not_an_infinite_set() {
     }
     // A horizon before the overflow: a finite result, r_t = sqrt(Psi kappa) at 0.8.
     let (sys, inf) = growing(400.0, 0.0, 0.8, Guarantee::Pointwise);
-    let res = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
+    let res = Reach::paired(&sys, &inf, "main").unwrap().run().unwrap();
     let last = res.steps().last().unwrap();
     let psi = (800.0f64 * 0.8).exp_m1() / 800.0;
     assert!((last.psi / psi - 1.0).abs() < 1e-9, "{} vs {psi}", last.psi);
@@ -886,8 +893,8 @@ fn a_radius_that_overflows_is_an_error_not_an_infinite_set() {
 #[test]
 fn a_nominal_that_blows_up_is_an_error() {
     let (sys, inf) = growing(400.0, 1.0, 3.0, Guarantee::Uniform);
-    match Reach::new(&sys, &inf, "main").unwrap().run() {
-        Err(RunError::NonFinite(d)) => assert!(d.message.contains("t = "), "{d}"),
+    match Reach::paired(&sys, &inf, "main").unwrap().run() {
+        Err(RunError::NonFinite(d)) => assert!(d.to_string().contains("t = "), "{d}"),
         other => panic!("expected NonFinite, got {other:?}"),
     }
 }
@@ -899,7 +906,7 @@ fn a_nominal_that_blows_up_is_an_error() {
 #[test]
 fn r_pointwise_is_at_most_the_uniform_radius() {
     let (sys, inf) = growing(40.0, 0.0, 10.0, Guarantee::Uniform);
-    let res = Reach::new(&sys, &inf, "main").unwrap().run().unwrap();
+    let res = Reach::paired(&sys, &inf, "main").unwrap().run().unwrap();
     let last = res.steps().last().unwrap();
     assert_eq!(last.t, 10.0);
     assert!(last.psi.is_infinite(), "Psi_10 = e^800 / 80 overflows");

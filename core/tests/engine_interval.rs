@@ -4,8 +4,8 @@
 
 use reachc_core::engine::{self, RunError};
 use reachc_core::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, Inclusion, Integrator, Method, ModelInfo, Transform,
-    TransformSource, UnsafeSet, UnsafeShape,
+    Analysis, AnalysisSpec, Bounds, Constants, Inclusion, Integrator, Method, ModelInfo,
+    ModelParts, Transform, TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_core::prs::{DetSet, Prs, Unproved, Verdict};
 use reachc_core::{Reach, System};
@@ -54,12 +54,12 @@ fn run_with(
 }
 
 fn lin_info(unsafe_sets: Vec<UnsafeSet>) -> ModelInfo {
-    ModelInfo {
+    ModelInfo::from_parts(ModelParts {
         inputs: vec!["u".into()],
         input_box: vec![Bounds::new(-1.0, 1.0)],
         unsafe_sets,
-        ..model("lin", &["x"], &["w"], &[(0.5, 1.5)])
-    }
+        ..model("lin", &["x"], &["w"], &[(0.5, 1.5)]).into_parts()
+    })
 }
 
 fn lin_constants() -> Constants {
@@ -123,7 +123,7 @@ fn linear_box_matches_exact_reachable_set() {
 fn linear_runs_through_dispatch() {
     let a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
     let info = lin_info(vec![]);
-    let res = engine::run(&LIN, &info, &a).unwrap();
+    let res = engine::run_paired(&LIN, &info, &a).unwrap();
     assert_eq!(res.method(), Method::Interval);
     assert_eq!(res.inclusion(), Some(Inclusion::Jacobian));
     assert_eq!(res.steps().len(), 11);
@@ -137,7 +137,7 @@ fn linear_runs_through_dispatch() {
     // r_t agrees with the contraction engine's (same Psi_t, kappa).
     let mut c = a.clone();
     c.spec.method = Method::Contraction;
-    let rc = engine::run(&LIN, &info, &c).unwrap();
+    let rc = engine::run_paired(&LIN, &info, &c).unwrap();
     for (s, t) in res.steps().iter().zip(rc.steps()) {
         assert_eq!(s.r_t, t.r_t);
         assert_eq!(s.psi, t.psi);
@@ -158,7 +158,7 @@ fn refuses_transform_and_missing_constants() {
         source: TransformSource::Given,
     });
     assert!(matches!(
-        engine::run(&LIN, &lin_info(vec![]), &a),
+        engine::run_paired(&LIN, &lin_info(vec![]), &a),
         Err(RunError::Unsupported(_))
     ));
     let mut a = analysis(1.0, 0.1, Integrator::Rk4, lin_constants());
@@ -166,7 +166,7 @@ fn refuses_transform_and_missing_constants() {
         constant: "c".into(),
     });
     assert!(matches!(
-        engine::run(&LIN, &lin_info(vec![]), &a),
+        engine::run_paired(&LIN, &lin_info(vec![]), &a),
         Err(RunError::NoConstants(_))
     ));
 }
@@ -207,7 +207,7 @@ fn linear_safety_and_membership() {
         },
     ];
     let a = analysis(2.0, 0.01, Integrator::Rk4, lin_constants());
-    let res = engine::run(&LIN, &lin_info(sets), &a).unwrap();
+    let res = engine::run_paired(&LIN, &lin_info(sets), &a).unwrap();
     assert!(res.unsafe_sets()[0].safe && res.unsafe_sets()[1].safe && res.unsafe_sets()[2].safe);
     assert!(!res.unsafe_sets()[3].safe);
     assert_eq!(

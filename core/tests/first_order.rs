@@ -4,7 +4,7 @@
 //! closed-form `exp(A t)` image of the initial box with a remainder at rounding level.
 
 use reachc_core::engine;
-use reachc_core::model::{Analysis, AnalysisSpec, Method, ModelInfo};
+use reachc_core::model::{Analysis, AnalysisSpec, Method, ModelInfo, ModelParts};
 use reachc_core::prs::{DetSet, Prs};
 
 use reachc_test_support::flow::rk4_step;
@@ -17,10 +17,10 @@ const HALF: [f64; 2] = [std::f64::consts::PI / 10.0, 0.2];
 /// The model with the initial box `[-HALF, HALF]` and the paper's constants, and one analysis
 /// of `method` with the defaults (validated steps, time-uniform tube, local rates).
 fn setup(method: Method) -> (ModelInfo, Analysis) {
-    let info = ModelInfo {
+    let info = ModelInfo::from_parts(ModelParts {
         name: "pend".into(),
-        ..pendulum_model()
-    };
+        ..pendulum_model().into_parts()
+    });
     let constants = pendulum_constants(&info);
     let analysis = Analysis {
         spec: AnalysisSpec {
@@ -121,7 +121,7 @@ fn pendulum_first_order_sets_hold_the_sampled_flows_both_methods() {
     let sys = Pendulum::PAPER;
     for method in [Method::Contraction, Method::Interval] {
         let (info, analysis) = setup(method);
-        let prs = engine::run(&sys, &info, &analysis).expect("runs");
+        let prs = engine::run_paired(&sys, &info, &analysis).expect("runs");
         for (t, (worst, rem, hull, sampled)) in
             [1.0, 2.0, 4.0]
                 .into_iter()
@@ -152,7 +152,7 @@ fn linear_first_order_set_is_the_closed_form_image() {
     // A = [[0, 1], [-20, -20]]: eigenvalues l = -10 +- sqrt(80), exp(A t) in closed form.
     let sys = Pendulum { k: 0.0 };
     let (info, analysis) = setup(Method::Contraction);
-    let prs = engine::run(&sys, &info, &analysis).expect("runs");
+    let prs = engine::run_paired(&sys, &info, &analysis).expect("runs");
     let member = zonotope_member(&prs);
     let (l1, l2) = (-10.0 + 80f64.sqrt(), -10.0 - 80f64.sqrt());
     for st in member.steps().iter().skip(1) {

@@ -6,7 +6,7 @@
 
 use reachc_core::interval::Interval;
 use reachc_core::model::{
-    Analysis, AnalysisSpec, Constants, Guarantee, Integrator, Method, ModelInfo, Rate,
+    Analysis, AnalysisSpec, Constants, Guarantee, Integrator, Method, ModelInfo, ModelParts, Rate,
 };
 use reachc_core::prs::Prs;
 use reachc_core::{Reach, System};
@@ -107,10 +107,10 @@ fn forced_exact(x0: f64, t: f64) -> f64 {
 /// A model of `n` states from the box `x0`, with constants `c` (sigma = 0, P = I) by hand.
 fn model(name: &str, x0: &[(f64, f64)], c: f64) -> ModelInfo {
     let n = x0.len();
-    let mut info = ModelInfo {
+    let mut info = ModelInfo::from_parts(ModelParts {
         states: (0..n).map(|i| format!("x{i}")).collect(),
-        ..models::model(name, &[], &["w"], x0)
-    };
+        ..models::model(name, &[], &["w"], x0).into_parts()
+    });
     let identity = (0..n * n)
         .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
         .collect();
@@ -120,7 +120,7 @@ fn model(name: &str, x0: &[(f64, f64)], c: f64) -> ModelInfo {
         (Method::Interval, Integrator::Validated),
         (Method::Contraction, Integrator::Rk4),
     ] {
-        info.analyses.push(Analysis {
+        info.analyses_mut().push(Analysis {
             spec: AnalysisSpec {
                 name: format!("{}_{}", method.name(), integrator.name()),
                 method,
@@ -167,7 +167,7 @@ fn the_stiff_system_is_enclosed_inside_every_step() {
     let info = model("stiff", &[(0.9, 1.1), (0.9, 1.1)], c);
     let corners = [(0.9, 0.9), (0.9, 1.1), (1.1, 0.9), (1.1, 1.1), (1.0, 1.0)];
     for name in ["contraction_validated", "interval_validated"] {
-        let prs = Reach::new(&Stiff, &info, name).unwrap().run().unwrap();
+        let prs = Reach::paired(&Stiff, &info, name).unwrap().run().unwrap();
         assert!(prs.internal_steps() >= prs.steps().len() - 1);
         for &(x0, y0) in &corners {
             let exact = |t: f64| stiff_exact(x0, y0, t).to_vec();
@@ -177,7 +177,7 @@ fn the_stiff_system_is_enclosed_inside_every_step() {
     }
     // One unvalidated RK4 step per report step of 0.1 (h * 20 = 2): its nominal is far off,
     // and the exact solution leaves the "set" (what reachc printed before validated steps).
-    let rk4 = Reach::new(&Stiff, &info, "contraction_rk4")
+    let rk4 = Reach::paired(&Stiff, &info, "contraction_rk4")
         .unwrap()
         .run()
         .unwrap();
@@ -191,7 +191,7 @@ fn the_stiff_system_is_enclosed_inside_every_step() {
 fn a_time_varying_drift_is_enclosed_inside_every_step() {
     let info = model("forced", &[(-0.5, 0.5)], -2.0);
     for name in ["contraction_validated", "interval_validated"] {
-        let prs = Reach::new(&Forced, &info, name).unwrap().run().unwrap();
+        let prs = Reach::paired(&Forced, &info, name).unwrap().run().unwrap();
         for x0 in [-0.5, -0.2, 0.0, 0.3, 0.5] {
             let exact = |t: f64| vec![forced_exact(x0, t)];
             assert_eq!(first_miss(&prs, &exact), None, "{name} from {x0}");

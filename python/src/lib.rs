@@ -27,11 +27,11 @@ use reachc_compiler::driver::{self, LoadError, Loaded};
 use reachc_compiler::ir::{ExprId, Names};
 use reachc_compiler::model::Model;
 use reachc_runtime::engine::RunError;
-use reachc_runtime::model::{InitialSet, ModelInfo};
+use reachc_runtime::model::InitialSet;
 use reachc_runtime::probability::{GoalLimit, SafetyLimit};
 use reachc_runtime::prs::{DetSet, GoalMiss, GoalOutcome, Verdict};
 use reachc_runtime::simulate::{self, InputMode, SimError, SimReport};
-use reachc_runtime::{report, Bounds, InputPlan, Prs, Reach};
+use reachc_runtime::{report, Bounds, InputPlan, Model as _, Prs, Reach};
 
 create_exception!(
     _native,
@@ -136,11 +136,10 @@ fn run_error(e: RunError) -> PyErr {
     }
 }
 
-/// What a spec holds once loaded: the interpreter, its model info, the checked model (for
-/// printing), the source and the warnings.
+/// What a spec holds once loaded: the interpreter (with its model info), the checked model
+/// (for printing), the source and the warnings.
 struct Inner {
     interp: Interpreter,
-    info: ModelInfo,
     model: Model,
     path: PathBuf,
     source: String,
@@ -164,7 +163,6 @@ fn make_spec(py: Python<'_>, loaded: Result<Loaded, LoadError>) -> PyResult<Spec
     Ok(Spec {
         inner: Arc::new(Inner {
             interp,
-            info: prepared.info,
             model,
             path: loaded.path,
             source: loaded.source,
@@ -215,7 +213,7 @@ impl Spec {
     /// `model NAME`.
     #[getter]
     fn name(&self) -> &str {
-        &self.inner.info.name
+        self.inner.interp.info().name()
     }
 
     /// The path given to `load`, or the name given to `loads`.
@@ -231,25 +229,26 @@ impl Spec {
 
     #[getter]
     fn states(&self) -> Vec<String> {
-        self.inner.info.states.clone()
+        self.inner.interp.info().states().to_vec()
     }
 
     #[getter]
     fn inputs(&self) -> Vec<String> {
-        self.inner.info.inputs.clone()
+        self.inner.interp.info().inputs().to_vec()
     }
 
     #[getter]
     fn noises(&self) -> Vec<String> {
-        self.inner.info.noises.clone()
+        self.inner.interp.info().noises().to_vec()
     }
 
     /// The analyses' names, in spec order.
     #[getter]
     fn analyses(&self) -> Vec<String> {
         self.inner
-            .info
-            .analyses
+            .interp
+            .info()
+            .analyses()
             .iter()
             .map(|a| a.spec.name.clone())
             .collect()
@@ -328,7 +327,7 @@ impl Spec {
     /// The analysis `name` as the compiler prepared it: its parameters and certified constants
     /// (or why they could not be derived).
     fn analysis<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
-        let a = self.inner.info.analysis(name).ok_or_else(|| {
+        let a = self.inner.interp.info().analysis(name).ok_or_else(|| {
             run_error(RunError::UnknownAnalysis {
                 name: name.to_string(),
                 available: self.analyses(),
@@ -347,18 +346,18 @@ impl Spec {
         match &a.constants {
             Ok(c) => {
                 let k = PyDict::new(py);
-                k.set_item("c", c.c)?;
-                k.set_item("sigma", c.sigma)?;
-                k.set_item("rho", c.rho)?;
-                let n = self.inner.info.states.len();
-                let metric = Array2::from_shape_vec((n, n), c.metric.clone())
+                k.set_item("c", c.c())?;
+                k.set_item("sigma", c.sigma())?;
+                k.set_item("rho", c.rho())?;
+                let n = self.inner.interp.info().states().len();
+                let metric = Array2::from_shape_vec((n, n), c.metric().to_vec())
                     .map_err(|e| PyValueError::new_err(e.to_string()))?;
                 k.set_item("metric", metric.into_pyarray(py))?;
                 k.set_item(
                     "certified",
-                    !matches!(c.provenance, reachc_runtime::model::Provenance::Given),
+                    !matches!(c.provenance(), reachc_runtime::model::Provenance::Given),
                 )?;
-                k.set_item("metrics", 1 + c.also.len())?;
+                k.set_item("metrics", 1 + c.also().len())?;
                 d.set_item("constants", k)?;
                 d.set_item("constants_error", py.None())?;
             }
@@ -373,11 +372,10 @@ impl Spec {
     /// A handle on the analysis `name`: checked once, run many times.
     fn reach(slf: &Bound<'_, Self>, name: &str) -> PyResult<ReachHandle> {
         let inner = slf.get().inner.clone();
-        // SAFETY: the references point into `inner`, an `Arc` kept alive by the handle next to
+        // SAFETY: the reference points into `inner`, an `Arc` kept alive by the handle next to
         // the `Reach` (and dropped after it: fields drop in declaration order), never moved.
-        let (sys, info): (&'static Interpreter, &'static ModelInfo) =
-            unsafe { (&*(&inner.interp as *const _), &*(&inner.info as *const _)) };
-        let reach = Reach::new(sys, info, name).map_err(run_error)?;
+        let sys: &'static Interpreter = unsafe { &*(&inner.interp as *const _) };
+        let reach = Reach::new(sys, name).map_err(run_error)?;
         Ok(ReachHandle {
             reach: SyncReach(reach),
             inner,
@@ -426,12 +424,12 @@ impl Spec {
         };
         let inner = &*self.inner;
         let result = py.detach(|| {
-            let reach = Reach::new(&inner.interp, &inner.info, name).and_then(|r| match delta {
+            let reach = Reach::new(&inner.interp, name).and_then(|r| match delta {
                 Some(d) => r.with_delta(d),
                 None => Ok(r),
             })?;
             // As `reachc simulate --probability`: the bound where it is defined.
-            if probability && !inner.info.unsafe_sets.is_empty() {
+            if probability && !inner.interp.info().unsafe_sets().is_empty() {
                 opts.safety_bound = reach
                     .safety_probability()
                     .ok()
@@ -443,7 +441,7 @@ impl Spec {
         let result = result.map_err(run_error)?;
         let sim = py.detach(|| {
             std::panic::catch_unwind(AssertUnwindSafe(|| {
-                simulate::simulate(&inner.interp, &inner.info, &result, &opts, &mut |_, _| {
+                simulate::simulate(&inner.interp, &result, &opts, &mut |_, _| {
                     if let Some(e) = pending_signal() {
                         std::panic::resume_unwind(Box::new(Interrupted(e)));
                     }
@@ -458,7 +456,7 @@ impl Spec {
             },
         };
         let report = sim.map_err(|e| match e {
-            SimError::Usage(m) => PyValueError::new_err(m),
+            SimError::Usage(m) => PyValueError::new_err(m.to_string()),
             SimError::Invalid(m) => {
                 AnalysisError::new_err(format!("analysis `{name}` cannot be simulated: {m}"))
             }
@@ -495,10 +493,10 @@ impl Spec {
         };
         let inner = &*self.inner;
         let got = py.detach(|| {
-            simulate::sample_paths(&inner.interp, &inner.info, &times, center.as_deref(), &opts)
+            simulate::sample_paths(&inner.interp, inner.interp.info(), &times, center.as_deref(), &opts)
         });
         let got = got.map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let n = inner.info.states.len();
+        let n = inner.interp.info().states().len();
         let flat: Vec<f64> = got.into_iter().flatten().collect();
         let arr = Array3::from_shape_vec((paths as usize, times.len(), n), flat)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
@@ -508,8 +506,8 @@ impl Spec {
     fn __repr__(&self) -> String {
         format!(
             "Spec({:?}: {} states, analyses {:?})",
-            self.inner.info.name,
-            self.inner.info.states.len(),
+            self.inner.interp.info().name(),
+            self.inner.interp.info().states().len(),
             self.analyses()
         )
     }
@@ -574,7 +572,7 @@ impl ReachHandle {
             (None, None) => r.run(),
             (Some(b), None) => r.from_box(b),
             (Some(b), Some(p)) => r.from_box_with(b, p),
-            (None, Some(p)) => r.from_set_with(&self.inner.info.initial, p),
+            (None, Some(p)) => r.from_set_with(self.inner.interp.info().initial(), p),
         }
         .map_err(run_error)
     }
@@ -632,7 +630,7 @@ impl ReachHandle {
         let p = py
             .detach(|| self.reach.0.safety_probability())
             .map_err(run_error)?;
-        let sets = &self.inner.info.unsafe_sets;
+        let sets = self.inner.interp.info().unsafe_sets();
         let name = |set: usize| Some(sets[set].name.clone());
         let (limit, t, set, why) = match &p.limit {
             SafetyLimit::Resolution => ("resolution", None, None, None),
@@ -664,9 +662,9 @@ impl ReachHandle {
     /// for every start and input (`reachc run --probability`; about a dozen runs, the GIL
     /// released).
     fn goal_probability(&self, py: Python<'_>, goal: &str) -> PyResult<GoalProbabilityPy> {
-        let info = &self.inner.info;
-        let Some(g) = info.goals.iter().position(|x| x.name == goal) else {
-            let names: Vec<&str> = info.goals.iter().map(|x| x.name.as_str()).collect();
+        let info = &self.inner.interp.info();
+        let Some(g) = info.goals().iter().position(|x| x.name == goal) else {
+            let names: Vec<&str> = info.goals().iter().map(|x| x.name.as_str()).collect();
             return Err(PyValueError::new_err(format!(
                 "no goal `{goal}` (the goals: {})",
                 names.join(", ")
@@ -675,7 +673,7 @@ impl ReachHandle {
         let p = py
             .detach(|| self.reach.0.goal_probability(g))
             .map_err(run_error)?;
-        let sets = &info.unsafe_sets;
+        let sets = info.unsafe_sets();
         let (limit, t, set, why) = match &p.limit {
             GoalLimit::Resolution => ("resolution", None, None, None),
             GoalLimit::Floor => ("floor", None, None, None),
@@ -701,7 +699,7 @@ impl ReachHandle {
             runs: p.runs,
             proved: p.validation.not_validated.is_empty(),
             conditional_on_domain: p.validation.conditional_on_domain,
-            text: report::probability::goal_line(&info.goals, sets, horizon, &p),
+            text: report::probability::goal_line(info.goals(), sets, horizon, &p),
         })
     }
 
@@ -709,7 +707,7 @@ impl ReachHandle {
         format!(
             "Reach({:?} of model {:?})",
             self.reach.0.analysis().name,
-            self.inner.info.name
+            self.inner.interp.info().name()
         )
     }
 }
@@ -1251,8 +1249,8 @@ impl Simulation {
 /// The initial set of a spec as boxes, shape `(n, 2)` (NaN without a box part).
 #[pyfunction]
 fn initial_box<'py>(py: Python<'py>, spec: &Spec) -> Bound<'py, PyArray2<f64>> {
-    let init: &InitialSet = &spec.inner.info.initial;
-    let n = spec.inner.info.states.len();
+    let init: &InitialSet = spec.inner.interp.info().initial();
+    let n = spec.inner.interp.info().states().len();
     let v = init
         .boxes
         .iter()

@@ -85,7 +85,7 @@ fn info() -> ModelInfo {
         1.4142135623730954,
         0.0,
     );
-    info.analyses.push(Analysis {
+    info.analyses_mut().push(Analysis {
         spec: AnalysisSpec {
             name: "amgf_rule".into(),
             horizon: 1.5,
@@ -102,14 +102,14 @@ fn info() -> ModelInfo {
 #[divan::bench(args = [1, 2], sample_count = 5, sample_size = 1)]
 fn linear_100k_paths(bencher: divan::Bencher, threads: usize) {
     let info = info();
-    let result = engine::run(&Linear, &info, &info.analyses[0]).unwrap();
+    let result = engine::run_paired(&Linear, &info, &info.analyses()[0]).unwrap();
     let opts = Options {
         paths: PATHS,
         threads: Some(threads),
         ..Options::default()
     };
     bencher.bench(|| {
-        simulate::simulate(&Linear, &info, &result, &opts, &mut |_, _| {})
+        simulate::simulate_paired(&Linear, &info, &result, &opts, &mut |_, _| {})
             .unwrap()
             .horizon
             .outside_any

@@ -23,7 +23,7 @@ use crate::report;
 use reachc_core::engine::RunError;
 use reachc_core::model::ModelInfo;
 use reachc_core::simulate::{self, InputMode, Shard, SimError, SimReport};
-use reachc_core::{Reach, System};
+use reachc_core::{Model, Reach};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -375,11 +375,10 @@ impl SimulateOptions {
 
 /// The `main` of a generated binary: parses `std::env::args`, see [`run_cli`]. Generic so that
 /// the simulation's hot loop calls the generated model directly (no virtual calls).
-pub fn main_with<S: System + Sync>(sys: &S, info: &ModelInfo) -> ExitCode {
+pub fn main_with<M: Model>(model: &M) -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let code = run_cli(
-        sys,
-        info,
+        model,
         &args,
         &mut std::io::stdout().lock(),
         &mut std::io::stderr().lock(),
@@ -390,16 +389,15 @@ pub fn main_with<S: System + Sync>(sys: &S, info: &ModelInfo) -> ExitCode {
 /// Runs the command line `args` (without the program name), writing to `out` / `err`: parses
 /// it ([`Command::parse`]) and calls [`run`] or [`simulate()`]. A usage error exits with
 /// [`EXIT_USAGE`] after the help text.
-pub fn run_cli<S: System + Sync>(
-    sys: &S,
-    info: &ModelInfo,
+pub fn run_cli<M: Model>(
+    model: &M,
     args: &[String],
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> u8 {
     match Command::parse(args) {
-        Ok(Command::Run(opts)) => run(sys, info, &opts, out, err),
-        Ok(Command::Simulate(opts)) => simulate(sys, info, &opts, out, err, None),
+        Ok(Command::Run(opts)) => run(model, &opts, out, err),
+        Ok(Command::Simulate(opts)) => simulate(model, &opts, out, err, None),
         Ok(Command::Help(usage)) => {
             let _ = writeln!(out, "{usage}");
             EXIT_OK
@@ -458,44 +456,37 @@ impl<'a> Failures<'a> {
 /// files that cannot be written, [`EXIT_UNSAFE`] with `deny_unsafe` when a verdict is "not
 /// shown safe" (and nothing failed). Analyses with an unsupported method are reported as
 /// skipped, not as failures.
-pub fn run<S: System + Sync>(
-    sys: &S,
-    info: &ModelInfo,
-    opts: &RunOptions,
-    out: &mut dyn Write,
-    err: &mut dyn Write,
-) -> u8 {
-    run_analyses(sys, info, opts, out, err, None)
+pub fn run<M: Model>(model: &M, opts: &RunOptions, out: &mut dyn Write, err: &mut dyn Write) -> u8 {
+    run_analyses(model, opts, out, err, None)
 }
 
 /// [`run`], with the failed analyses added to `failures` instead of printed (the CLI's
 /// interpreter backend locates them in the spec), [`Failure::summary`] included.
-pub fn run_collecting<S: System + Sync>(
-    sys: &S,
-    info: &ModelInfo,
+pub fn run_collecting<M: Model>(
+    model: &M,
     opts: &RunOptions,
     out: &mut dyn Write,
     err: &mut dyn Write,
     failures: &mut Vec<Failure>,
 ) -> u8 {
-    run_analyses(sys, info, opts, out, err, Some(failures))
+    run_analyses(model, opts, out, err, Some(failures))
 }
 
-fn run_analyses<S: System + Sync>(
-    sys: &S,
-    info: &ModelInfo,
+fn run_analyses<M: Model>(
+    model: &M,
     opts: &RunOptions,
     out: &mut dyn Write,
     err: &mut dyn Write,
     collect: Option<&mut Vec<Failure>>,
 ) -> u8 {
+    let info = model.info();
     let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
     let mut failures = Failures::new(collect, opts.error_lines);
     let (mut files, mut not_safe) = (Files::new(), false);
     for &name in &selected {
-        let ran = Reach::new(sys, info, name).and_then(|r| r.run().map(|res| (r, res)));
+        let ran = Reach::new(model, name).and_then(|r| r.run().map(|res| (r, res)));
         let (reach, res) = match ran {
             Ok(ran) => ran,
             Err(RunError::Unsupported(why)) => {
@@ -508,20 +499,24 @@ fn run_analyses<S: System + Sync>(
             }
         };
         // The probability of safety and of reaching each goal, where asked for and defined.
-        let probability =
-            (opts.probability && !info.unsafe_sets.is_empty()).then(|| reach.safety_probability());
-        let goal_probabilities: Vec<_> = (0..info.goals.len())
+        let probability = (opts.probability && !info.unsafe_sets().is_empty())
+            .then(|| reach.safety_probability());
+        let goal_probabilities: Vec<_> = (0..info.goals().len())
             .filter(|_| opts.probability)
             .map(|g| reach.goal_probability(g))
             .collect();
         // The unsafe sets inflated for a nominal plan, where asked for.
         let tightening =
-            (opts.tighten && !info.unsafe_sets.is_empty()).then(|| reach.tighten(&res, &[]));
+            (opts.tighten && !info.unsafe_sets().is_empty()).then(|| reach.tighten(&res, &[]));
         if !opts.quiet {
             let _ = write!(out, "{}", report::summary(&res));
             match &probability {
                 Some(Ok(p)) => {
-                    let _ = writeln!(out, "  {}", report::probability::line(&info.unsafe_sets, p));
+                    let _ = writeln!(
+                        out,
+                        "  {}",
+                        report::probability::line(info.unsafe_sets(), p)
+                    );
                 }
                 Some(Err(why)) => {
                     let _ = writeln!(out, "  {}", report::probability::not_computed(why));
@@ -534,8 +529,8 @@ fn run_analyses<S: System + Sync>(
                         out,
                         "  {}",
                         report::probability::goal_line(
-                            &info.goals,
-                            &info.unsafe_sets,
+                            info.goals(),
+                            info.unsafe_sets(),
                             res.horizon(),
                             p
                         )
@@ -543,13 +538,13 @@ fn run_analyses<S: System + Sync>(
                     Err(why) => writeln!(
                         out,
                         "  {}",
-                        report::probability::goal_not_computed(&info.goals[g], why)
+                        report::probability::goal_not_computed(&info.goals()[g], why)
                     ),
                 };
             }
             match &tightening {
                 Some(Ok(t)) => {
-                    let _ = writeln!(out, "  {}", report::tightening::line(&info.unsafe_sets, t));
+                    let _ = writeln!(out, "  {}", report::tightening::line(info.unsafe_sets(), t));
                 }
                 Some(Err(why)) => {
                     let _ = writeln!(out, "  {}", report::tightening::not_computed(why));
@@ -582,7 +577,7 @@ fn run_analyses<S: System + Sync>(
         files.add(dir.join(format!("{name}.csv")), csv);
         if let Some(Ok(t)) = &tightening {
             let mut csv = Vec::new();
-            let _ = report::tightening::write_csv(t, &info.states, &mut csv);
+            let _ = report::tightening::write_csv(t, info.states(), &mut csv);
             files.add(dir.join(format!("{name}.tightening.csv")), csv);
         }
     }
@@ -629,7 +624,7 @@ fn select<'a>(
     name: Option<&str>,
     err: &mut dyn Write,
 ) -> Option<Vec<&'a str>> {
-    let names = info.analyses.iter().map(|a| a.spec.name.as_str());
+    let names = info.analyses().iter().map(|a| a.spec.name.as_str());
     let Some(name) = name else {
         return Some(names.collect());
     };
@@ -639,7 +634,7 @@ fn select<'a>(
         let _ = writeln!(
             err,
             "error: model `{}` has no analysis `{name}` (available: {})",
-            info.name,
+            info.name(),
             all.join(", ")
         );
         return None;
@@ -694,51 +689,49 @@ pub type Progress<'a> = dyn FnMut(&str, u64, u64) + 'a;
 /// With `opts.shard`, only that shard's paths run and `DIR/<analysis>.shard-I-of-K.part` is
 /// written instead of each report ([`part_file_name`]; no verdict: [`EXIT_OK`] when written),
 /// for [`crate::merge::merge_files`].
-pub fn simulate<S: System + Sync>(
-    sys: &S,
-    info: &ModelInfo,
+pub fn simulate<M: Model>(
+    model: &M,
     opts: &SimulateOptions,
     out: &mut dyn Write,
     err: &mut dyn Write,
     progress: Option<&mut Progress<'_>>,
 ) -> u8 {
-    simulate_analyses(sys, info, opts, (out, err), progress, None)
+    simulate_analyses(model, opts, (out, err), progress, None)
 }
 
 /// [`simulate()`], with the failed analyses added to `failures` instead of printed (the CLI's
 /// interpreter backend locates them in the spec), [`Failure::summary`] included.
-pub fn simulate_collecting<S: System + Sync>(
-    sys: &S,
-    info: &ModelInfo,
+pub fn simulate_collecting<M: Model>(
+    model: &M,
     opts: &SimulateOptions,
     (out, err): (&mut dyn Write, &mut dyn Write),
     progress: Option<&mut Progress<'_>>,
     failures: &mut Vec<Failure>,
 ) -> u8 {
-    simulate_analyses(sys, info, opts, (out, err), progress, Some(failures))
+    simulate_analyses(model, opts, (out, err), progress, Some(failures))
 }
 
-fn simulate_analyses<S: System + Sync>(
-    sys: &S,
-    info: &ModelInfo,
+fn simulate_analyses<M: Model>(
+    model: &M,
     opts: &SimulateOptions,
     (out, err): (&mut dyn Write, &mut dyn Write),
     mut progress: Option<&mut Progress<'_>>,
     collect: Option<&mut Vec<Failure>>,
 ) -> u8 {
+    let info = model.info();
     let Some(selected) = select(info, opts.analysis.as_deref(), err) else {
         return EXIT_USAGE;
     };
     let mut failures = Failures::new(collect, opts.error_lines);
     let (mut files, mut coverage_failed) = (Files::new(), false);
     for &name in &selected {
-        let reach = Reach::new(sys, info, name).and_then(|r| match opts.delta {
+        let reach = Reach::new(model, name).and_then(|r| match opts.delta {
             Some(d) => r.with_delta(d),
             None => Ok(r),
         });
         // The certified probability of safety to test, where asked for and defined.
         let mut sim_opts = opts.sim.clone();
-        let wanted = opts.probability && !info.unsafe_sets.is_empty();
+        let wanted = opts.probability && !info.unsafe_sets().is_empty();
         if let Some(reach) = reach.as_ref().ok().filter(|_| wanted) {
             match reach.safety_probability() {
                 Ok(p) => sim_opts.safety_bound = p.lower_bound(),
@@ -752,14 +745,14 @@ fn simulate_analyses<S: System + Sync>(
         }
         // And of reaching each goal.
         if let Some(reach) = reach.as_ref().ok().filter(|_| opts.probability) {
-            sim_opts.goal_bounds = (0..info.goals.len())
+            sim_opts.goal_bounds = (0..info.goals().len())
                 .map(|g| match reach.goal_probability(g) {
                     Ok(p) => p.lower_bound(),
                     Err(e) => {
                         let _ = writeln!(
                             err,
                             "note: analysis `{name}`: no probability of reaching `{}`: {e}",
-                            info.goals[g].name
+                            info.goals()[g].name
                         );
                         None
                     }
@@ -788,10 +781,10 @@ fn simulate_analyses<S: System + Sync>(
             };
             match opts.shard {
                 Some(shard) => {
-                    simulate::run_part(sys, info, &result, &sim_opts, shard, &mut report_progress)
+                    simulate::run_part(model, &result, &sim_opts, shard, &mut report_progress)
                         .map(Simulated::Part)
                 }
-                None => simulate::simulate(sys, info, &result, &sim_opts, &mut report_progress)
+                None => simulate::simulate(model, &result, &sim_opts, &mut report_progress)
                     .map(Simulated::Report),
             }
         };

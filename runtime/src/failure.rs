@@ -13,6 +13,7 @@
 //! renders each as a diagnostic located in the spec; this is the only text parsed between them.
 
 use reachc_core::engine::{Culprit, RunError};
+use reachc_core::simulate::SimInvalid;
 use std::fmt;
 
 /// The prefix of a failure line.
@@ -41,7 +42,7 @@ impl Failure {
     }
 
     /// An analysis whose result cannot be simulated.
-    pub fn simulation(analysis: &str, why: &str) -> Failure {
+    pub fn simulation(analysis: &str, why: &SimInvalid) -> Failure {
         Failure {
             analysis: analysis.to_string(),
             message: format!("cannot be simulated: {why}"),
@@ -99,22 +100,29 @@ impl fmt::Display for Failure {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use reachc_core::engine::{Detail, Setting};
+    use reachc_core::engine::{Detail, Problem, Setting};
 
     #[test]
     fn failures_round_trip_through_their_lines() {
         let e = RunError::NonFinite(
-            Detail::from("the nominal trajectory cannot be validated at t = 0")
-                .at_setting(Setting::Step),
+            Detail::from(Problem::EmpiricalPathNotFinite(0.0)).at_setting(Setting::Step),
         );
         let f = Failure::run("fast", &e);
         assert_eq!(
             f.to_line(),
-            "reachc-failure fast setting:step could not run: numerical failure: the nominal \
-             trajectory cannot be validated at t = 0"
+            "reachc-failure fast setting:step could not run: numerical failure: a sample path of \
+             the empirical rate estimate is not finite at t = 0"
         );
         assert_eq!(Failure::parse_line(&f.to_line()), Some(f));
-        let plain = Failure::simulation("a", "two\nlines");
+        let simulation = Failure::simulation("a", &SimInvalid::NominalSize);
+        assert_eq!(
+            simulation.message,
+            "cannot be simulated: a nominal state has the wrong dimension"
+        );
+        let plain = Failure {
+            message: "cannot be simulated: two\nlines".into(),
+            ..simulation
+        };
         let back = Failure::parse_line(&plain.to_line()).unwrap();
         assert_eq!(back.culprit, None);
         assert_eq!(back.message, "cannot be simulated: two lines");

@@ -3,15 +3,15 @@
 //! the renderings of results (feature `report`: JSON, CSV, text), parallel Monte Carlo (feature
 //! `simulate`) and the `main` of generated binaries (feature `app`).
 //!
-//! A generated model is a type implementing [`System`] and a function `info()` returning its
-//! [`ModelInfo`] (sets, analyses and the constants the compiler certified). [`Reach`] runs one
-//! of its analyses from any initial set inside what the constants were certified for, and
-//! returns a typed [`Prs`]:
+//! A generated model is a type implementing [`System`] and [`Model`], whose
+//! [`Model::info`] is its [`ModelInfo`] (sets, analyses and the constants the compiler
+//! certified). [`Reach`] runs one of its analyses from any initial set inside what the
+//! constants were certified for, and returns a typed [`Prs`]:
 //!
 //! ```
 //! use reachc_runtime::{Bounds, Reach};
 //! # use reachc_runtime::model::*;
-//! # use reachc_runtime::{Interval, ModelInfo, System};
+//! # use reachc_runtime::{Interval, Model, ModelInfo, System};
 //! # // What `reachc build` generates for `dx = -x dt + 0.5 dW` (by hand here, with constants
 //! # // given by hand instead of certified by the compiler).
 //! # struct Decay;
@@ -29,20 +29,24 @@
 //! #     fn diffusion_interval(&self, _: &[Interval], _: Interval, out: &mut [Interval]) { out[0] = Interval::point(0.5) }
 //! # }
 //! # fn info() -> ModelInfo {
-//! #     let mut info = ModelInfo {
+//! #     let parts = ModelParts {
 //! #         name: "decay".into(), states: vec!["x".into()], inputs: vec![], noises: vec!["w".into()],
 //! #         input_box: vec![], initial: InitialSet::from_box(&[Bounds::new(0.9, 1.1)]),
 //! #         domain: vec![Bounds::ENTIRE], has_domain: false, affine: false, constant_diffusion: false, unsafe_sets: vec![], goals: vec![], analyses: vec![],
 //! #     };
-//! #     let constants = Constants::given(&info, vec![1.0], -1.0, 0.5, 0.0);
+//! #     let constants = Constants::given(&ModelInfo::from_parts(parts.clone()), vec![1.0], -1.0, 0.5, 0.0);
 //! #     let spec = AnalysisSpec { name: "contraction".into(), horizon: 2.0, ..AnalysisSpec::default() };
-//! #     info.analyses.push(Analysis { spec, constants: Ok(constants) });
-//! #     info
+//! #     ModelInfo::from_parts(ModelParts { analyses: vec![Analysis { spec, constants: Ok(constants) }], ..parts })
+//! # }
+//! # impl Model for Decay {
+//! #     fn info(&self) -> &ModelInfo {
+//! #         static INFO: std::sync::OnceLock<ModelInfo> = std::sync::OnceLock::new();
+//! #         INFO.get_or_init(info)
+//! #     }
 //! # }
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! let (sys, info) = (Decay, info());
 //! // Checks the analysis and its constants once.
-//! let reach = Reach::new(&sys, &info, "contraction")?;
+//! let reach = Reach::new(&Decay, "contraction")?;
 //! let mut radii = Vec::new();
 //! for x0 in [0.5, 1.0, 2.0] {
 //!     let prs = reach.from_box(&[Bounds::new(x0 - 0.1, x0 + 0.1)])?;
@@ -71,7 +75,7 @@
 pub use reachc_core::{
     engine, func, interval, kappa, lanes, model, probability, prs, simulate, system, table,
 };
-pub use reachc_core::{Bounds, InputPlan, Interval, ModelInfo, Prs, Reach, System, X8};
+pub use reachc_core::{Bounds, InputPlan, Interval, Model, ModelInfo, Prs, Reach, System, X8};
 
 #[cfg(feature = "app")]
 pub mod app;

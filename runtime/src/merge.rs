@@ -78,7 +78,7 @@ fn merge_reports(parts: &[PathBuf]) -> Result<Vec<SimReport>, String> {
             .entry(part.run.analysis.clone())
             .or_default()
             .add(&label, part)
-            .map_err(|e| e.0)?;
+            .map_err(|e| e.to_string())?;
     }
     groups
         .into_iter()

@@ -4,8 +4,8 @@ mod common;
 
 use reachc_runtime::app::{EXIT_FAILED, EXIT_OK, EXIT_USAGE};
 use reachc_runtime::model::{
-    Analysis, Bounds, Constants, GoalSet, Method, ModelInfo, Transform, TransformSource, UnsafeSet,
-    UnsafeShape,
+    Analysis, Bounds, Constants, GoalSet, Method, ModelInfo, ModelParts, Transform,
+    TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_runtime::{report, Reach};
 use reachc_test_support::models;
@@ -31,10 +31,10 @@ fn analysis(name: &str, method: Method, constants: bool) -> Analysis {
 }
 
 fn model(analyses: Vec<Analysis>) -> ModelInfo {
-    ModelInfo {
+    ModelInfo::from_parts(ModelParts {
         analyses,
-        ..models::model("decay", &["x"], &["w"], &[(0.9, 1.1)])
-    }
+        ..models::model("decay", &["x"], &["w"], &[(0.9, 1.1)]).into_parts()
+    })
 }
 
 fn tmp_dir(tag: &str) -> std::path::PathBuf {
@@ -125,8 +125,11 @@ fn results_render() {
         analysis("ball", Method::Contraction, true),
         analysis("boxes", Method::Interval, true),
     ]);
-    let ball = Reach::new(&DECAY, &info, "ball").unwrap().run().unwrap();
-    let boxes = Reach::new(&DECAY, &info, "boxes").unwrap().run().unwrap();
+    let ball = Reach::paired(&DECAY, &info, "ball").unwrap().run().unwrap();
+    let boxes = Reach::paired(&DECAY, &info, "boxes")
+        .unwrap()
+        .run()
+        .unwrap();
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&ball)).unwrap();
     assert_eq!(v["method"], "contraction");
     assert!(v.get("inclusion").is_none());
@@ -161,8 +164,11 @@ fn results_render() {
     );
     // An integrator the user asked for is labelled.
     let mut euler = info.clone();
-    euler.analyses[1].spec.integrator = reachc_runtime::model::Integrator::Euler;
-    let unvalidated = Reach::new(&DECAY, &euler, "boxes").unwrap().run().unwrap();
+    euler.analyses_mut()[1].spec.integrator = reachc_runtime::model::Integrator::Euler;
+    let unvalidated = Reach::paired(&DECAY, &euler, "boxes")
+        .unwrap()
+        .run()
+        .unwrap();
     let v: serde_json::Value = serde_json::from_str(&report::to_json(&unvalidated)).unwrap();
     assert!(v["validated"]["not_validated"][0]
         .as_str()
@@ -208,7 +214,7 @@ fn moving_sets_are_written_with_their_positions() {
         offset,
     };
     let high = UnsafeShape::Box(vec![(0, Bounds::new(3.0, f64::INFINITY))]);
-    info.unsafe_sets = vec![
+    *info.unsafe_sets_mut() = vec![
         UnsafeSet {
             name: "high".into(),
             shape: high.clone(),
@@ -221,14 +227,14 @@ fn moving_sets_are_written_with_their_positions() {
         },
     ];
     let near = |c: f64| vec![UnsafeShape::Box(vec![(0, Bounds::new(c - 0.5, c + 0.5))])];
-    info.goals = vec![GoalSet {
+    *info.goals_mut() = vec![GoalSet {
         name: "near".into(),
         parts: near(0.0),
         moving: vec![],
         window: None,
         stay: false,
     }];
-    let mut prs = Reach::new(&DECAY, &info, "ball").unwrap().run().unwrap();
+    let mut prs = Reach::paired(&DECAY, &info, "ball").unwrap().run().unwrap();
     let steps = prs.steps().len();
     assert!(steps > 2);
     // The wall moves out by 0.25 per report interval, the goal's centre by 0.125.
@@ -269,6 +275,6 @@ fn moving_sets_are_written_with_their_positions() {
         u.swept.clear();
     }
     prs.goals_mut()[0].swept.clear();
-    let fixed = Reach::new(&DECAY, &info, "ball").unwrap().run().unwrap();
+    let fixed = Reach::paired(&DECAY, &info, "ball").unwrap().run().unwrap();
     assert_eq!(report::to_json(&prs), report::to_json(&fixed));
 }

@@ -38,7 +38,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
     for i in 0..n {
         metric[i * n + i] = 1.0;
     }
-    let mut info = ModelInfo {
+    let mut info = ModelInfo::from_parts(ModelParts {
         states: (1..=n).map(|i| format!("x{i}")).collect(),
         noises: (1..=n).map(|i| format!("w{i}")).collect(),
         unsafe_sets: vec![UnsafeSet {
@@ -49,11 +49,11 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
             },
             moving: Vec::new(),
         }],
-        ..model("linear", &[], &[], &vec![(x0 - w, x0 + w); n])
-    };
+        ..model("linear", &[], &[], &vec![(x0 - w, x0 + w); n]).into_parts()
+    });
     if sys.b != 0.0 {
-        info.inputs = vec!["u".into()];
-        info.input_box = vec![Bounds::new(-h, h)];
+        *info.inputs_mut() = vec!["u".into()];
+        *info.input_box_mut() = vec![Bounds::new(-h, h)];
     }
     let constants = Constants::given(
         &info,
@@ -63,7 +63,7 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
         sys.s * sigma_factor,
         (sys.b * h * n as f64).abs(),
     );
-    info.analyses.push(Analysis {
+    info.analyses_mut().push(Analysis {
         spec: AnalysisSpec {
             name: "main".into(),
             delta,
@@ -78,11 +78,11 @@ fn info(sys: &Linear, x0: f64, w: f64, h: f64, delta: f64, sigma_factor: f64) ->
 }
 
 fn run(sys: &Linear, info: &ModelInfo) -> Prs {
-    engine::run(sys, info, &info.analyses[0]).unwrap()
+    engine::run_paired(sys, info, &info.analyses()[0]).unwrap()
 }
 
 fn simulate(sys: &Linear, info: &ModelInfo, r: &Prs, opts: &Options) -> SimReport {
-    simulate::simulate(sys, info, r, opts, &mut |_, _| {}).unwrap()
+    simulate::simulate_paired(sys, info, r, opts, &mut |_, _| {}).unwrap()
 }
 
 /// With X0 = 0, the Euler-Maruyama iterate is exactly Gaussian: per coordinate,
@@ -228,7 +228,7 @@ fn results_do_not_depend_on_the_thread_count() {
 #[test]
 fn simulated_paths_are_the_recorded_sample_paths() {
     let mut additive = info(&LINEAR, 0.3, 0.2, 0.0, 0.05, 1.0);
-    additive.unsafe_sets.clear();
+    additive.unsafe_sets_mut().clear();
     let general = info(&DRIVEN, 0.5, 0.2, 0.3, 0.05, 1.0);
     for (sys, info, dt) in [(&LINEAR, &additive, None), (&DRIVEN, &general, Some(0.004))] {
         let r = run(sys, info);
@@ -273,7 +273,7 @@ fn a_too_small_prs_fails_the_coverage_check() {
     };
     // The pointwise semantics (the tube's radii are larger: see below).
     let pointwise = |mut info: ModelInfo| {
-        info.analyses[0].spec.guarantee = Guarantee::Pointwise;
+        info.analyses_mut()[0].spec.guarantee = Guarantee::Pointwise;
         info
     };
     let good = pointwise(info(&LINEAR, 0.0, 0.0, 0.0, 0.01, 1.0));
@@ -329,7 +329,7 @@ fn reports_say_what_was_checked() {
     let sys = DRIVEN;
     let uniform = info(&sys, 0.5, 0.2, 0.3, 0.05, 1.0);
     let mut pointwise = uniform.clone();
-    pointwise.analyses[0].spec.guarantee = Guarantee::Pointwise;
+    pointwise.analyses_mut()[0].spec.guarantee = Guarantee::Pointwise;
     let opts = Options {
         paths: 2_000,
         seed: 3,
@@ -484,7 +484,7 @@ fn simulate_command_line() {
 
     // An analysis without constants has no PRS: skipped, not a failure.
     let mut none = good.clone();
-    none.analyses[0].constants = Err(reachc_runtime::model::NoConstants::NotCertified {
+    none.analyses_mut()[0].constants = Err(reachc_runtime::model::NoConstants::NotCertified {
         constant: "c".into(),
     });
     let (code, _, err) = cli(&none, &["simulate", "--paths", "10", "-o", d]);
@@ -522,10 +522,10 @@ fn shards_merge_into_the_unsharded_reports() {
     let dir = std::env::temp_dir().join(format!("reachc-simulate-shards-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let mut info = info(&LINEAR, 0.0, 0.0, 0.0, 0.05, 1.0);
-    let mut pointwise = info.analyses[0].clone();
+    let mut pointwise = info.analyses()[0].clone();
     pointwise.spec.name = "pointwise".into();
     pointwise.spec.guarantee = Guarantee::Pointwise;
-    info.analyses.push(pointwise);
+    info.analyses_mut().push(pointwise);
     let run = [
         "simulate", "--paths", "1000", "--seed", "4", "--dt", "0.005",
     ];

@@ -44,7 +44,7 @@ fn model() -> ModelInfo {
     );
     for (name, method) in [("ball", Method::Contraction), ("boxes", Method::Interval)] {
         let constants = Constants::given(&info, P.to_vec(), -1.0, 0.3, 0.0);
-        info.analyses
+        info.analyses_mut()
             .push(common::decay_analysis(name, method, Ok(constants)));
     }
     info
@@ -53,7 +53,7 @@ fn model() -> ModelInfo {
 /// The interval run with each box replaced by the zonotope of [`GENS`] around its centre plus
 /// a remainder of `0.5 r_t`.
 fn zonotopes() -> Prs {
-    let mut r = Reach::new(&DECAY, &model(), "boxes")
+    let mut r = Reach::paired(&DECAY, &model(), "boxes")
         .unwrap()
         .run()
         .unwrap();
@@ -83,7 +83,10 @@ fn zonotopes() -> Prs {
 
 /// The contraction run's ball alone (without the interval box it may be cut by).
 fn ball() -> Prs {
-    let mut r = Reach::new(&DECAY, &model(), "ball").unwrap().run().unwrap();
+    let mut r = Reach::paired(&DECAY, &model(), "ball")
+        .unwrap()
+        .run()
+        .unwrap();
     r.also_mut().clear();
     r
 }

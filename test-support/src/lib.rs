@@ -9,7 +9,7 @@
 //! crate's names from their parent module (the `use`s below) and nothing else from outside.
 
 use reachc_core::interval::Interval;
-use reachc_core::model::{Bounds, Constants, InitialSet, ModelInfo};
+use reachc_core::model::{Bounds, Constants, InitialSet, ModelInfo, ModelParts};
 use reachc_core::System;
 
 pub mod files;

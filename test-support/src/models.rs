@@ -4,16 +4,16 @@
 //! This file is also compiled into reachc-core's own unit tests (`core/src/test_support.rs`),
 //! so it takes the crate's names from its parent module.
 
-use super::{Bounds, Constants, InitialSet, ModelInfo};
+use super::{Bounds, Constants, InitialSet, ModelInfo, ModelParts};
 
 /// The model `name` with `states`, noise channels `noises` and the initial box `initial` (one
 /// range per state): no inputs, unsafe or goal sets, or analyses, and no domain (the whole
-/// space, one range per initial range). Tests set what else they need: `ModelInfo { inputs,
-/// ..model(...) }`.
+/// space, one range per initial range). Tests set what else they need:
+/// `ModelInfo::from_parts(ModelParts { inputs, ..model(...).into_parts() })`.
 pub fn model(name: &str, states: &[&str], noises: &[&str], initial: &[(f64, f64)]) -> ModelInfo {
     let names = |names: &[&str]| names.iter().map(|s| s.to_string()).collect();
     let initial: Vec<Bounds> = initial.iter().map(|&(a, b)| Bounds::new(a, b)).collect();
-    ModelInfo {
+    ModelInfo::from_parts(ModelParts {
         name: name.into(),
         states: names(states),
         inputs: vec![],
@@ -27,7 +27,7 @@ pub fn model(name: &str, states: &[&str], noises: &[&str], initial: &[(f64, f64)
         unsafe_sets: vec![],
         goals: vec![],
         analyses: vec![],
-    }
+    })
 }
 
 /// The paper's metric `P` for the pendulum (Sec. VIII-B), row-major.

@@ -21,15 +21,15 @@ fn main() {
     for spec in shipped_specs() {
         let model = reachc_compiler::driver::load(&spec).unwrap().model;
         let (sys, info) = interpreter_of(model);
-        if info.states.len() > 100 {
+        if info.states().len() > 100 {
             continue;
         }
-        for analysis in &info.analyses {
+        for analysis in info.analyses() {
             let mut row = Vec::new();
             for guarantee in [Guarantee::Pointwise, Guarantee::Uniform] {
                 let mut info = info.clone();
                 let a = info
-                    .analyses
+                    .analyses_mut()
                     .iter_mut()
                     .find(|a| a.spec.name == analysis.spec.name)
                     .unwrap();
@@ -39,7 +39,7 @@ fn main() {
                     a.spec.rate = Rate::Global;
                 }
                 let spec_a = a.spec.clone();
-                let Ok(prs) = Reach::new(&sys, &info, &spec_a.name).and_then(|r| r.run()) else {
+                let Ok(prs) = Reach::paired(&sys, &info, &spec_a.name).and_then(|r| r.run()) else {
                     continue;
                 };
                 let Some(hull) = prs.hull(prs.horizon()) else {
@@ -57,7 +57,7 @@ fn main() {
                 else {
                     continue;
                 };
-                let n = info.states.len();
+                let n = info.states().len();
                 let level = 1.0 - spec_a.delta.max(1e-3);
                 let mut half = Vec::new();
                 let mut quant = Vec::new();

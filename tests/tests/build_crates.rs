@@ -532,7 +532,8 @@ fn main() {{
         let (lx, lu): (Vec<X8>, Vec<X8>) = ((0..n).map(lane).collect(), (n..n + p).map(lane).collect());
         let lanes = (&lx[..], &lu[..]);
         let mut words: Vec<String> = Vec::new();
-        dump(&sys, (x, u, t), (&xi, &ui, ti), lanes, {crate_ident}::info().set_numbers(), &mut words);
+        let numbers = reachc_runtime::Model::info(&sys).set_numbers();
+        dump(&sys, (x, u, t), (&xi, &ui, ti), lanes, numbers, &mut words);
         let mut k = 0;
         while let Some(frame) = sys.frame(k) {{
             dump(frame, (x, u, t), (&xi, &ui, ti), lanes, 0, &mut words);

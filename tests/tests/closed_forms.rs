@@ -34,7 +34,7 @@ fn the_logistic_flow_lies_in_the_first_order_sets_and_fills_them() {
              drift {{\n x' = x * (1 - x)\n}}\ndiffusion {{\n x: 0 * w\n}}\n\
              analysis a {{\n method = {method}\n delta = 1e-3\n horizon = 4\n step = 0.05\n}}\n"
         ));
-        let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+        let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
         // The interval method keeps the member only where it cuts its box, which in one
         // dimension is already this tight.
         let first = prs.also().iter().find(|m| m.role() == Role::FirstOrder);
@@ -79,7 +79,7 @@ fn a_linear_time_varying_sde_gets_its_exact_image_and_variance() {
          analysis a {\n method = contraction\n metric = auto\n delta = 1e-3\n horizon = 3\n \
          step = 0.05\n}\n",
     );
-    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let (m, epochs) = linearised_member(&prs);
     let factor = reflection_factor(2, epochs, m.delta());
     // State (Phi row-major, Sigma_11, Sigma_12, Sigma_22), RK4 in time.

@@ -111,7 +111,7 @@ const SUB: usize = 1000;
 fn first_escape(sys: &dyn System, info: &ModelInfo, prs: &Prs) -> Option<String> {
     let n = sys.n();
     let boxes: Vec<(f64, f64)> = info
-        .initial
+        .initial()
         .boxes
         .iter()
         .map(|b| b.map(|b| (b.lo, b.hi)).expect("boxes only"))
@@ -129,7 +129,7 @@ fn first_escape(sys: &dyn System, info: &ModelInfo, prs: &Prs) -> Option<String>
         })
         .collect();
     starts.push(boxes.iter().map(|b| 0.5 * (b.0 + b.1)).collect());
-    let (lo, hi): (Vec<f64>, Vec<f64>) = info.input_box.iter().map(|b| (b.lo, b.hi)).unzip();
+    let (lo, hi): (Vec<f64>, Vec<f64>) = info.input_box().iter().map(|b| (b.lo, b.hi)).unzip();
     let plans: [&dyn Fn(usize) -> Vec<f64>; 3] = [&|_| lo.clone(), &|_| hi.clone(), &|k| {
         if k % 2 == 0 {
             lo.clone()
@@ -185,8 +185,8 @@ fn point_starts_noise_free_states_inputs_and_couplings_in_every_combination() {
     for v in Variant::all() {
         let source = v.spec();
         let (sys, info) = interpreter(&source);
-        assert_eq!(info.analyses.len(), 2);
-        for analysis in &info.analyses {
+        assert_eq!(info.analyses().len(), 2);
+        for analysis in info.analyses() {
             let name = format!("{v:?} / {}", analysis.spec.name);
             let prs = Reach::for_analysis(&sys, &info, analysis)
                 .and_then(|r| r.run())
@@ -223,7 +223,7 @@ fn point_starts_noise_free_states_inputs_and_couplings_in_every_combination() {
                     dt: Some(1e-3),
                     ..Options::default()
                 };
-                let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {})
+                let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {})
                     .unwrap_or_else(|e| panic!("{name}: {e}"));
                 assert!(report.passed(), "{name}: Monte Carlo check failed");
             } else {

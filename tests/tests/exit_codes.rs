@@ -22,10 +22,10 @@ fn scratch(name: &str) -> PathBuf {
 /// Runs the binary's command line `args` on `tests/good/SPEC`; its exit code and stderr.
 fn binary(spec: &str, args: &[&str]) -> (u8, String) {
     let path = workspace().join("tests/good").join(spec);
-    let (sys, info) = interpreter_of(load(&path).unwrap().model);
+    let (sys, _) = interpreter_of(load(&path).unwrap().model);
     let args: Vec<String> = args.iter().map(|a| a.to_string()).collect();
     let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = run_cli(&sys, &info, &args, &mut out, &mut err);
+    let code = run_cli(&sys, &args, &mut out, &mut err);
     (code, String::from_utf8_lossy(&err).into_owned())
 }
 

@@ -11,7 +11,7 @@ use reachc_test_support::rng::Rng;
 
 fn run(src: &str, analysis: &str) -> Prs {
     let (sys, info) = inline(src);
-    Reach::new(&sys, &info, analysis).unwrap().run().unwrap()
+    Reach::paired(&sys, &info, analysis).unwrap().run().unwrap()
 }
 
 /// `x' = -x` from `[0.9, 1.1]` (noise 1e-6): the PRS's box tops out at `1.1 e^-t`, so the goal
@@ -55,7 +55,7 @@ fn certified_probabilities_are_below_the_exact_law_and_the_paths() {
                goal hold box { x in [0.3, 1.7] } within [1, 2] stay\n\
                analysis a { method = contraction  delta = 0.05  horizon = 2  step = 0.01 }";
     let (sys, info) = inline(src);
-    let reach = Reach::new(&sys, &info, "a").unwrap();
+    let reach = Reach::paired(&sys, &info, "a").unwrap();
     let mean = |t: f64| 1.0 - (-t).exp();
     let sd = |t: f64| (0.02 * (1.0 - (-2.0 * t).exp())).sqrt();
     let up = reach.goal_probability(0).unwrap();
@@ -162,7 +162,7 @@ fn misses_say_why() {
 /// unsharded report exactly, goal counts included.
 #[test]
 fn simulate_counts_goal_events_and_tests_their_bounds() {
-    use reachc_runtime::simulate::{self, merge, run_part, Options, Shard};
+    use reachc_runtime::simulate::{self, merge, run_part_paired, Options, Shard};
     let src = "model push\nstate x = 0\nnoise w\ndrift { x' = 1 }\ndiffusion { x: 0.01 * w }\n\
                unsafe wall halfspace { x >= 1 }\n\
                goal pass box { x in [0.2, 0.8] } within [0, 1]\n\
@@ -171,13 +171,14 @@ fn simulate_counts_goal_events_and_tests_their_bounds() {
                goal start box { x in [-0.5, 0.5] } within [0, 0.3] stay\n\
                analysis a { horizon = 2.5  step = 0.01  delta = 1e-3 }";
     let (sys, info) = inline(src);
-    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let opts = |bounds: Vec<Option<f64>>| Options {
         paths: 500,
         goal_bounds: bounds,
         ..Options::default()
     };
-    let run = |o: &Options| simulate::simulate(&sys, &info, &prs, o, &mut |_, _| {}).unwrap();
+    let run =
+        |o: &Options| simulate::simulate_paired(&sys, &info, &prs, o, &mut |_, _| {}).unwrap();
     let report = run(&opts(vec![Some(0.99), Some(0.5), None, Some(0.05)]));
     let counts: Vec<u64> = report.goals.iter().map(|g| g.reached).collect();
     // `start`: in [-0.5, 0.5] from t = 0, but not to the horizon: no path.
@@ -190,7 +191,7 @@ fn simulate_counts_goal_events_and_tests_their_bounds() {
     let parts: Vec<(String, _)> = (0..3)
         .map(|i| {
             let shard = Shard::new(i, 3).unwrap();
-            let part = run_part(&sys, &info, &prs, &o, shard, &mut |_, _| {}).unwrap();
+            let part = run_part_paired(&sys, &info, &prs, &o, shard, &mut |_, _| {}).unwrap();
             (format!("part {i}"), part)
         })
         .collect();
@@ -213,7 +214,7 @@ fn reaching_alone_uses_the_pointwise_radius() {
     let mean = |t: f64| 1.0 - (-t).exp();
     let sd = |t: f64| (0.02 * (1.0 - (-2.0 * t).exp())).sqrt();
     for analysis in ["a", "p"] {
-        let reach = Reach::new(&sys, &info, analysis).unwrap();
+        let reach = Reach::paired(&sys, &info, analysis).unwrap();
         let prs = reach.run().unwrap();
         assert!(
             prs.goals()[0].reached(),

@@ -24,10 +24,10 @@ fn edited(file: &str, edits: &[(&str, &str)]) -> (Interpreter, ModelInfo) {
 /// The analysis from the spec's initial set, and from that set's bounding box (what `r1` was
 /// bounded over before).
 fn with_and_without_ball(sys: &Interpreter, info: &ModelInfo, analysis: &str) -> (Prs, Prs) {
-    let reach = Reach::new(sys, info, analysis).unwrap();
+    let reach = Reach::paired(sys, info, analysis).unwrap();
     let ball = reach.run().unwrap();
     let boxed = reach
-        .from_box(&info.initial.bounding_box().unwrap())
+        .from_box(&info.initial().bounding_box().unwrap())
         .unwrap();
     let (r1, before) = (ball.r1(), boxed.r1());
     let (end, end_before) = (

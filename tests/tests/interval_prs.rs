@@ -29,7 +29,7 @@ fn interpreter(path: &std::path::Path) -> (Interpreter, ModelInfo) {
 
 /// Placeholder constants: only the boxes are checked here, and they do not depend on them.
 fn placeholder(info: &ModelInfo) -> Constants {
-    let n = info.states.len();
+    let n = info.states().len();
     let identity = (0..n * n)
         .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
         .collect();
@@ -47,12 +47,12 @@ fn y_box(d: &DetSet) -> (&[f64], &[f64]) {
 /// A random initial state: uniform in the boxes, inside the balls.
 fn initial_state(info: &ModelInfo, rng: &mut Rng) -> Vec<f64> {
     let mut x: Vec<f64> = info
-        .initial
+        .initial()
         .boxes
         .iter()
         .map(|b| b.map_or(0.0, |b| rng.range(b.lo, b.hi)))
         .collect();
-    for ball in &info.initial.balls {
+    for ball in &info.initial().balls {
         let k = ball.states.len();
         let z: Vec<f64> = (0..k).map(|_| rng.normal()).collect();
         let m = |a: usize, b: usize| {
@@ -121,7 +121,7 @@ fn first_escape(
             }
             if k % hold == 0 {
                 for (j, uj) in u.iter_mut().enumerate() {
-                    let Bounds { lo, hi } = info.input_box[j];
+                    let Bounds { lo, hi } = info.input_box()[j];
                     // Corners half of the time: extreme inputs push the boxes' faces.
                     *uj = match rng.uniform() {
                         v if v < 0.25 => lo,
@@ -169,7 +169,7 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
             // is zero: neither a numerically integrated embedding nor the sampled "true"
             // trajectories are meaningful there. Start well off the reference (the error stays
             // away from 0 for the first second).
-            info.initial.boxes = [(5.3, 5.4), (4.6, 4.7), (-2.1, -2.0)]
+            info.initial_mut().boxes = [(5.3, 5.4), (4.6, 4.7), (-2.1, -2.0)]
                 .map(|(lo, hi)| Some(Bounds::new(lo, hi)))
                 .to_vec();
             horizon = Some(1.0);
@@ -180,14 +180,14 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
             // inclusion); the boxes' soundness is checked where they still say something.
             horizon = Some(0.25);
         }
-        for a in &info.analyses {
+        for a in info.analyses() {
             for inclusion in [Inclusion::Natural, Inclusion::Jacobian, Inclusion::Mixed] {
                 // Mixed costs one Jacobian per state per face; keep the big chain cheap.
                 if inclusion == Inclusion::Mixed && n > 100 {
                     continue;
                 }
                 // An empirical rate has no certified c: the interval method gets a placeholder.
-                let certified = a.constants.clone().ok().filter(|c| c.c.is_finite());
+                let certified = a.constants.clone().ok().filter(|c| c.c().is_finite());
                 let mut variant = Analysis {
                     constants: Ok(certified.unwrap_or_else(|| placeholder(&info))),
                     ..a.clone()
@@ -203,7 +203,7 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
                 }
                 let label = format!("{} / {} / {}", path.display(), v.name, inclusion.name());
                 let start = std::time::Instant::now();
-                match engine::run(&sys, &info, &variant) {
+                match engine::run_paired(&sys, &info, &variant) {
                     Ok(r) => {
                         let samples = if n > 100 { 3 } else { 30 };
                         if let Some(why) = first_escape(&sys, &info, &r, samples, 7) {
@@ -224,7 +224,7 @@ fn boxes_contain_sampled_trajectories_on_every_shipped_spec() {
 
 fn pendulum_interval(analysis: &str, inclusion: Inclusion) -> (Prs, Interpreter, ModelInfo) {
     let (sys, info) = interpreter(&workspace().join("specs/pendulum.sde"));
-    let r = Reach::new(&sys, &info, analysis)
+    let r = Reach::paired(&sys, &info, analysis)
         .unwrap()
         .with_inclusion(inclusion)
         .run()
@@ -346,15 +346,15 @@ fn final_half_widths(r: &Prs) -> Vec<f64> {
 fn automatic_transform_keeps_the_msd_box_with_the_contraction_prs() {
     let (sys, mut info) = interpreter(&workspace().join("specs/msd.sde"));
     let mut off = info
-        .analyses
+        .analyses()
         .iter()
         .find(|a| a.spec.name == "interval")
         .unwrap()
         .clone();
     off.spec.name = "interval_off".into();
     off.spec.first_order = false;
-    info.analyses.push(off);
-    let run = |name: &str| Reach::new(&sys, &info, name).unwrap().run().unwrap();
+    info.analyses_mut().push(off);
+    let run = |name: &str| Reach::paired(&sys, &info, name).unwrap().run().unwrap();
     let (contraction, first, auto) = (run("contraction"), run("interval"), run("interval_auto"));
     let plain = run("interval_off");
     let (hc, hf, hp, ha) = (

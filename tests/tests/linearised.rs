@@ -29,7 +29,7 @@ fn a_linear_system_gets_the_exact_image_and_covariance() {
          analysis a {\n method = contraction\n metric = auto\n delta = 1e-3\n horizon = 3\n \
          step = 0.05\n}\n",
     );
-    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let (m, epochs) = linearised_member(&prs);
     assert_eq!(prs.delta(), 1e-3);
     assert!(m.delta() <= 5e-4 && m.delta() > 4.99e-4, "{}", m.delta());
@@ -69,7 +69,7 @@ fn noise_free_flows_lie_in_the_member_and_fill_it() {
     let source = std::fs::read_to_string(workspace().join("specs/pendulum.sde")).unwrap();
     let source = source.replace("omega: 0.1 * w", "omega: 0 * w");
     let (sys, info) = inline(&source);
-    let prs = Reach::new(&sys, &info, "contraction")
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();
@@ -117,7 +117,7 @@ fn noise_free_flows_lie_in_the_member_and_fill_it() {
 fn the_default_analyses_split_delta_with_the_member() {
     let (sys, info) = shipped("pendulum.sde");
     for analysis in ["contraction", "interval"] {
-        let prs = Reach::new(&sys, &info, analysis).unwrap().run().unwrap();
+        let prs = Reach::paired(&sys, &info, analysis).unwrap().run().unwrap();
         let (m, epochs) = linearised_member(&prs);
         assert_eq!(prs.delta(), 1e-3);
         assert_eq!(m.delta(), (1e-3f64 / 2.0).next_down());
@@ -136,7 +136,7 @@ fn the_default_analyses_split_delta_with_the_member() {
         "    step = 0.01\n    first_order = off\n}",
     );
     let (sys, info) = inline(&source);
-    let prs = Reach::new(&sys, &info, "contraction")
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();
@@ -159,7 +159,7 @@ fn sampled_paths_stay_in_the_member_between_report_times() {
          diffusion {\n x: w\n}\nanalysis a {\n method = contraction\n metric = auto\n \
          delta = 0.2\n horizon = 2\n step = 0.05\n}\n",
     );
-    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let (m, _) = linearised_member(&prs);
     assert!(m.delta() <= 0.1);
     let (rate, dt, per) = (20.0f64, 1e-4f64, 500usize);
@@ -219,7 +219,7 @@ fn first_order_sets_that_lose_their_shape_say_so() {
          step = 0.05\n}\n";
     let loose = |source: &str| {
         let (sys, info) = inline(source);
-        let prs = Reach::new(&sys, &info, "c").unwrap().run().unwrap();
+        let prs = Reach::paired(&sys, &info, "c").unwrap().run().unwrap();
         prs.hints().iter().find_map(|h| match *h {
             Hint::FirstOrderLoose {
                 t,
@@ -241,7 +241,7 @@ fn first_order_sets_that_lose_their_shape_say_so() {
         .unwrap()
         .replace("split = [8, 8]", "");
     let (sys, info) = inline(&whole);
-    let prs = Reach::new(&sys, &info, "contraction")
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();
@@ -261,8 +261,8 @@ fn first_order_sets_that_lose_their_shape_say_so() {
 fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
     let path = workspace().join("specs/arch/laub_loomis.sde");
     let (sys, mut info) = interpreter_of(load(&path).unwrap().model);
-    info.analyses[0].spec.horizon = 4.0;
-    let prs = Reach::new(&sys, &info, "contraction")
+    info.analyses_mut()[0].spec.horizon = 4.0;
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();
@@ -313,7 +313,7 @@ fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
         seed: 3,
         ..Options::default()
     };
-    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
     assert!(report.passed(), "{}", summary(&report));
     assert_eq!(report.tube.as_ref().map(|t| t.outside), Some(0));
 }
@@ -326,7 +326,7 @@ fn the_linearised_set_alone_that_cannot_be_bounded_either_says_so() {
         "model blow\nstate x in [2, 3]\nnoise w\ndrift { x' = x^2 }\n\
          diffusion { x: 0.01 * w }\nanalysis a { horizon = 0.33 }\n",
     );
-    let err = Reach::new(&sys, &info, "a").unwrap().run().unwrap_err();
+    let err = Reach::paired(&sys, &info, "a").unwrap().run().unwrap_err();
     let text = err.to_string();
     assert!(
         text.contains(

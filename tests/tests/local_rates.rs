@@ -20,7 +20,7 @@ fn mu_p(p: &[f64], j: &[f64]) -> f64 {
 }
 
 fn run(sys: &Interpreter, info: &ModelInfo, analysis: &str) -> Prs {
-    let prs = Reach::new(sys, info, analysis).unwrap().run().unwrap();
+    let prs = Reach::paired(sys, info, analysis).unwrap().run().unwrap();
     assert_eq!(prs.rate().rate, Rate::Local);
     assert!(!prs.validation().conditional_on_domain);
     assert!(prs.validation().not_validated.is_empty());
@@ -121,24 +121,28 @@ fn local_rates_are_never_looser_than_the_global_rate() {
         .filter(|p| !p.ends_with("chain1000.sde"))
     {
         let (sys, info) = interpreter_of(load(&path).unwrap().model);
-        for analysis in info.analyses.iter().filter(|a| a.spec.rate == Rate::Local) {
+        for analysis in info
+            .analyses()
+            .iter()
+            .filter(|a| a.spec.rate == Rate::Local)
+        {
             let Ok(consts) = &analysis.constants else {
                 continue;
             };
             let name = format!("{} / {}", path.display(), analysis.spec.name);
-            let local = reachc_runtime::engine::run(&sys, &info, analysis).unwrap();
-            if !consts.c.is_finite() {
+            let local = reachc_runtime::engine::run_paired(&sys, &info, analysis).unwrap();
+            if !consts.c().is_finite() {
                 continue;
             }
             let mut global = analysis.clone();
             global.spec.rate = Rate::Global;
-            let global = reachc_runtime::engine::run(&sys, &info, &global).unwrap();
+            let global = reachc_runtime::engine::run_paired(&sys, &info, &global).unwrap();
             let (l, g) = (
                 local.steps().last().unwrap().prs_radius,
                 global.steps().last().unwrap().prs_radius,
             );
             assert!(l <= g * (1.0 + 1e-9), "{name}: {l} > {g}");
-            assert!(local.rate().max_c <= consts.c, "{name}");
+            assert!(local.rate().max_c <= consts.c(), "{name}");
         }
     }
 }

@@ -49,10 +49,10 @@ fn phi(x: f64) -> f64 {
 #[test]
 fn a_moving_wall_is_checked_where_it_is_nearest_over_each_interval() {
     let (sys, info) = inline(&brownian("x >= 1 + 0.5 * t", ""));
-    assert_eq!(info.unsafe_sets[0].moving[0].slot, Slot::Offset);
-    let moving = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    assert_eq!(info.unsafe_sets()[0].moving[0].slot, Slot::Offset);
+    let moving = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let (fixed_sys, fixed_info) = inline(&brownian("x >= 1", ""));
-    let fixed = Reach::new(&fixed_sys, &fixed_info, "a")
+    let fixed = Reach::paired(&fixed_sys, &fixed_info, "a")
         .unwrap()
         .run()
         .unwrap();
@@ -83,7 +83,7 @@ fn a_moving_wall_is_checked_where_it_is_nearest_over_each_interval() {
 #[test]
 fn the_probability_of_safety_holds_against_the_moving_line_crossing() {
     let (sys, info) = inline(&brownian("x >= 1 + 0.5 * t", ""));
-    let p = Reach::new(&sys, &info, "a")
+    let p = Reach::paired(&sys, &info, "a")
         .unwrap()
         .safety_probability()
         .unwrap();
@@ -100,7 +100,7 @@ fn the_probability_of_safety_holds_against_the_moving_line_crossing() {
     // A wall that stays at 1 is crossed more often: a smaller certified probability of safety
     // (a larger delta), or none.
     let (fixed_sys, fixed_info) = inline(&brownian("x >= 1", ""));
-    let fixed = Reach::new(&fixed_sys, &fixed_info, "a")
+    let fixed = Reach::paired(&fixed_sys, &fixed_info, "a")
         .unwrap()
         .safety_probability()
         .unwrap();
@@ -121,9 +121,9 @@ fn a_moving_goal_is_reached_where_it_is() {
         )
     };
     let (sys, info) = inline(&goal("[-2 + t, 2 + t]"));
-    let moving = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let moving = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let (fixed_sys, fixed_info) = inline(&goal("[-2, 2]"));
-    let fixed = Reach::new(&fixed_sys, &fixed_info, "a")
+    let fixed = Reach::paired(&fixed_sys, &fixed_info, "a")
         .unwrap()
         .run()
         .unwrap();
@@ -167,9 +167,9 @@ fn a_table_moves_a_set_as_the_same_expression_of_t_does() {
         ),
     );
     let (sys, info) = inline(&spec);
-    let table = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let table = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let (line_sys, line_info) = inline(&brownian("x >= 1 + 0.5 * t", ""));
-    let line = Reach::new(&line_sys, &line_info, "a")
+    let line = Reach::paired(&line_sys, &line_info, "a")
         .unwrap()
         .run()
         .unwrap();
@@ -186,7 +186,7 @@ fn a_table_moves_a_set_as_the_same_expression_of_t_does() {
 fn the_overtaking_spec_avoids_the_moving_lead_vehicle() {
     let (sys, info) = shipped("overtake.sde");
     assert!(info.has_moving_sets());
-    let reach = Reach::new(&sys, &info, "contraction").unwrap();
+    let reach = Reach::paired(&sys, &info, "contraction").unwrap();
     let prs = reach.run().unwrap();
     assert!(
         prs.unsafe_sets().iter().all(|u| u.safe),

@@ -29,9 +29,9 @@ fn scratch(name: &str) -> PathBuf {
 
 /// The binary's command line `args` on the interpreter of `spec`: exit code and stderr.
 fn interpreted(spec: &Path, args: &[String]) -> (u8, String) {
-    let (sys, info) = interpreter_of(load(spec).unwrap().model);
+    let (sys, _) = interpreter_of(load(spec).unwrap().model);
     let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = run_cli(&sys, &info, args, &mut out, &mut err);
+    let code = run_cli(&sys, args, &mut out, &mut err);
     (code, String::from_utf8_lossy(&err).into_owned())
 }
 

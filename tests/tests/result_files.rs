@@ -13,7 +13,7 @@ use serde_json::Value;
 #[test]
 fn members_over_budget_are_written_as_their_bounding_boxes() {
     let (sys, info) = shipped("pendulum.sde");
-    let prs = Reach::new(&sys, &info, "contraction")
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();

@@ -14,7 +14,7 @@ fn run(spec: &str, name: &str) -> (Prs, Interpreter, ModelInfo) {
     let prepared = prepare(&mut model);
     assert!(prepared.warnings.is_empty(), "{:#?}", prepared.warnings);
     let interp = Interpreter::new(model, &prepared);
-    let result = Reach::new(&interp, &prepared.info, name)
+    let result = Reach::paired(&interp, &prepared.info, name)
         .unwrap()
         .run()
         .unwrap();
@@ -98,7 +98,7 @@ fn pendulum_prs_covers_monte_carlo_paths() {
     let mut max_ratio = [0.0f64; 3];
     for _ in 0..paths {
         let mut x: Vec<f64> = info
-            .initial
+            .initial()
             .boxes
             .iter()
             .map(|b| {

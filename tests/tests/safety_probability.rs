@@ -49,7 +49,7 @@ fn crossing(mu: f64, s: f64, b: f64, horizon: f64) -> f64 {
 fn brownian_bounds_hold_against_the_reflection_principle() {
     for (mu, within) in [(0.0, 100.0), (0.5, 100.0)] {
         let (sys, info) = brownian(mu);
-        let p = Reach::new(&sys, &info, "a")
+        let p = Reach::paired(&sys, &info, "a")
             .unwrap()
             .safety_probability()
             .unwrap();
@@ -82,7 +82,7 @@ fn a_nonlinear_bound_holds_against_monte_carlo() {
          diffusion { x: 0.45 * w }\nunsafe high halfspace { x >= 1.3 }\n\
          analysis a { method = contraction  delta = 0.1  horizon = 2  step = 0.05 }\n",
     );
-    let p = Reach::new(&sys, &info, "a")
+    let p = Reach::paired(&sys, &info, "a")
         .unwrap()
         .safety_probability()
         .unwrap();
@@ -122,7 +122,7 @@ fn limits_and_refusals_are_reported() {
         )
     };
     let (sys, info) = inline(&spec(0.5, ""));
-    let p = Reach::new(&sys, &info, "a")
+    let p = Reach::paired(&sys, &info, "a")
         .unwrap()
         .safety_probability()
         .unwrap();
@@ -134,7 +134,7 @@ fn limits_and_refusals_are_reported() {
         other => panic!("{other:?}"),
     }
     let (sys, info) = inline(&spec(100.0, ""));
-    let p = Reach::new(&sys, &info, "a")
+    let p = Reach::paired(&sys, &info, "a")
         .unwrap()
         .safety_probability()
         .unwrap();
@@ -144,7 +144,9 @@ fn limits_and_refusals_are_reported() {
     );
     let (sys, info) = inline(&spec(100.0, "guarantee = pointwise"));
     assert!(matches!(
-        Reach::new(&sys, &info, "a").unwrap().safety_probability(),
+        Reach::paired(&sys, &info, "a")
+            .unwrap()
+            .safety_probability(),
         Err(RunError::Unsupported(_))
     ));
     let (sys, info) = inline(
@@ -152,7 +154,9 @@ fn limits_and_refusals_are_reported() {
          analysis a { method = contraction  horizon = 1  step = 0.1 }\n",
     );
     assert!(matches!(
-        Reach::new(&sys, &info, "a").unwrap().safety_probability(),
+        Reach::paired(&sys, &info, "a")
+            .unwrap()
+            .safety_probability(),
         Err(RunError::Unsupported(_))
     ));
 }
@@ -164,9 +168,9 @@ fn limits_and_refusals_are_reported() {
 #[test]
 fn simulate_checks_the_certified_bound_against_the_paths() {
     use reachc_runtime::report::simulation::{summary, to_json};
-    use reachc_runtime::simulate::{simulate, Options};
+    use reachc_runtime::simulate::{simulate_paired, Options};
     let (sys, info) = brownian(0.5);
-    let reach = Reach::new(&sys, &info, "a").unwrap();
+    let reach = Reach::paired(&sys, &info, "a").unwrap();
     let bound = reach.safety_probability().unwrap().lower_bound().unwrap();
     let prs = reach.run().unwrap();
     let check = |b: f64| {
@@ -176,7 +180,7 @@ fn simulate_checks_the_certified_bound_against_the_paths() {
             safety_bound: Some(b),
             ..Options::default()
         };
-        simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap()
+        simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap()
     };
     let rep = check(bound);
     let s = rep.safety.clone().expect("a model with unsafe sets");

@@ -45,7 +45,7 @@ fn report_round_trips(what: &str, text: &str) {
 fn the_analyses_of_shipped_specs_round_trip() {
     for spec in ["pendulum.sde", "linear.sde", "msd.sde"] {
         let (sys, info) = shipped(spec);
-        for analysis in &info.analyses {
+        for analysis in info.analyses() {
             let what = format!("{spec} / {}", analysis.spec.name);
             let prs = match Reach::for_analysis(&sys, &info, analysis).and_then(|r| r.run()) {
                 Ok(prs) => prs,
@@ -74,7 +74,7 @@ fn certified_probabilities_round_trip() {
          goal far halfspace { x >= 5 }\n\
          analysis a { method = contraction  delta = 0.05  horizon = 2  step = 0.05 }",
     );
-    let reach = Reach::new(&sys, &info, "a").unwrap();
+    let reach = Reach::paired(&sys, &info, "a").unwrap();
     let prs = reach.run().unwrap();
     let safety = reach.safety_probability().unwrap();
     let goals: Vec<_> = (0..3).map(|g| reach.goal_probability(g).unwrap()).collect();
@@ -101,7 +101,7 @@ fn a_split_round_trips() {
          analysis a {\n method = contraction\n metric = auto\n delta = 1e-2\n horizon = 1\n \
          step = 0.05\n split = [2, 2]\n}\n",
     );
-    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     assert_eq!(prs.pieces().len(), 4);
     result_round_trips("split", &to_json(&prs));
 }
@@ -134,7 +134,7 @@ fn moving() -> Prs {
          goal home box { x in [-2 + t, 2 + t] } within [0.5, 1]\n\
          analysis a { method = contraction  delta = 0.1  horizon = 1  step = 0.1 }\n",
     );
-    Reach::new(&sys, &info, "a").unwrap().run().unwrap()
+    Reach::paired(&sys, &info, "a").unwrap().run().unwrap()
 }
 
 /// Numbers that may be non-finite are written as `null` and read back as non-finite numbers
@@ -164,7 +164,7 @@ fn non_finite_numbers_round_trip() {
 #[test]
 fn monte_carlo_reports_round_trip() {
     let (sys, info) = shipped("pendulum.sde");
-    let prs = Reach::new(&sys, &info, "contraction")
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();
@@ -173,7 +173,7 @@ fn monte_carlo_reports_round_trip() {
         seed: 1,
         ..Options::default()
     };
-    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
     report_round_trips("pendulum", &simulation::to_json(&report));
 
     let (sys, info) = inline(
@@ -182,7 +182,7 @@ fn monte_carlo_reports_round_trip() {
          goal up halfspace { x >= 0.3 } within [0.5, 2]\n\
          analysis a { method = contraction  delta = 0.05  horizon = 2  step = 0.05 }",
     );
-    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let opts = Options {
         paths: 500,
         seed: 2,
@@ -190,7 +190,7 @@ fn monte_carlo_reports_round_trip() {
         goal_bounds: vec![Some(0.9)],
         ..Options::default()
     };
-    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
     let text = simulation::to_json(&report);
     assert!(text.contains("\"safety\": {") && text.contains("\"goals\""));
     report_round_trips("goals", &text);

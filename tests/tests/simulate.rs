@@ -19,8 +19,12 @@ fn every_shipped_spec_passes_the_coverage_check() {
         let info = prepared.info.clone();
         let interp = Interpreter::new(model, &prepared);
         // n = 1000: fewer paths keep the test short.
-        let paths = if info.states.len() > 100 { 200 } else { 1_000 };
-        for analysis in &info.analyses {
+        let paths = if info.states().len() > 100 {
+            200
+        } else {
+            1_000
+        };
+        for analysis in info.analyses() {
             let name = format!("{} / {}", relative(&spec), analysis.spec.name);
             let reach =
                 Reach::for_analysis(&interp, &info, analysis).and_then(|r| r.with_delta(0.01));
@@ -35,7 +39,7 @@ fn every_shipped_spec_passes_the_coverage_check() {
                 seed: 1,
                 ..Options::default()
             };
-            let report = simulate::simulate(&interp, &info, &result, &opts, &mut |_, _| {})
+            let report = simulate::simulate_paired(&interp, &info, &result, &opts, &mut |_, _| {})
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(report.passed(), "{name}:\n{}", summary(&report));
             // Not vacuous: the quantile is a sizeable part of the PRS radius somewhere.

@@ -3,7 +3,7 @@
 //! from the whole initial box and a Monte Carlo check of the union.
 
 use reachc_e2e::inline;
-use reachc_runtime::engine::{Culprit, RunError, Setting};
+use reachc_runtime::engine::{Culprit, Problem, RunError, Setting};
 use reachc_runtime::model::Split;
 use reachc_runtime::probability::SafetyLimit;
 use reachc_runtime::prs::{DetSet, Prs, Verdict};
@@ -26,7 +26,7 @@ fn spec(split: &str) -> String {
 
 fn run(split: &str) -> Prs {
     let (sys, info) = inline(&spec(split));
-    Reach::new(&sys, &info, "a").unwrap().run().unwrap()
+    Reach::paired(&sys, &info, "a").unwrap().run().unwrap()
 }
 
 /// `split = [1, 1]` is one piece: the unsplit result, bit for bit.
@@ -49,7 +49,7 @@ fn a_split_of_ones_is_the_unsplit_result() {
 #[test]
 fn the_union_holds_its_pieces_and_every_flow_and_is_tighter() {
     let (sys, info) = inline(&spec("split = [4, 3]"));
-    let union = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let union = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let plain = run("");
     assert_eq!(union.split(), &Split::Counts(vec![4, 3]));
     assert_eq!(union.pieces().len(), 12);
@@ -169,13 +169,13 @@ fn the_union_holds_its_pieces_and_every_flow_and_is_tighter() {
 #[test]
 fn the_union_passes_the_monte_carlo_check() {
     let (sys, info) = inline(&spec("split = [3, 2]"));
-    let union = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let union = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let opts = Options {
         paths: 2_000,
         seed: 3,
         ..Options::default()
     };
-    let report = simulate::simulate(&sys, &info, &union, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&sys, &info, &union, &opts, &mut |_, _| {}).unwrap();
     assert!(report.passed(), "{}", summary(&report));
     // Not vacuous: the paths' spread is a sizeable part of the union's set.
     let ratio = report
@@ -243,7 +243,7 @@ fn an_automatic_split_tiles_the_box_within_its_budget() {
 fn a_split_analysis_gets_a_probability_of_safety() {
     let source = spec("split = [4, 3]").replace("x >= 1.35", "x >= 1.38");
     let (sys, info) = inline(&source);
-    let reach = Reach::new(&sys, &info, "a").unwrap();
+    let reach = Reach::paired(&sys, &info, "a").unwrap();
     assert!(matches!(
         reach.run().unwrap().verdict(),
         Verdict::NotShownSafe { .. }
@@ -266,7 +266,7 @@ fn a_failing_piece_is_named() {
     let source = "model blow\nstate x in [0, 4]\nnoise w\ndrift { x' = x^2 }\n\
                   diffusion { x: 0.01 * w }\nanalysis a { horizon = 0.3  split = [4] }\n";
     let (sys, info) = inline(source);
-    let err = Reach::new(&sys, &info, "a").unwrap().run().unwrap_err();
+    let err = Reach::paired(&sys, &info, "a").unwrap().run().unwrap_err();
     let text = err.to_string();
     assert!(
         text.contains("(in the piece x in [2, 3] of the split initial box)"),
@@ -276,7 +276,7 @@ fn a_failing_piece_is_named() {
     let fine = source.replace("[0, 4]", "[0, 2]").replace("[4]", "[2]");
     let (sys, info) = inline(&fine);
     assert_eq!(
-        Reach::new(&sys, &info, "a")
+        Reach::paired(&sys, &info, "a")
             .unwrap()
             .run()
             .unwrap()
@@ -293,11 +293,11 @@ fn an_initial_ball_cannot_be_split() {
                   radius = 0.1 }\nnoise w\ndrift {\n x' = v\n v' = -x - v\n}\n\
                   diffusion {\n v: 0.05 * w\n}\nanalysis a {\n horizon = 1\n split = [2, 2]\n}\n";
     let (sys, info) = inline(source);
-    let Err(RunError::Unsupported(detail)) = Reach::new(&sys, &info, "a").unwrap().run() else {
+    let Err(RunError::Unsupported(detail)) = Reach::paired(&sys, &info, "a").unwrap().run() else {
         panic!("a ball cannot be split");
     };
     assert_eq!(detail.culprit, Some(Culprit::Setting(Setting::Split)));
-    assert!(detail.message.contains("not a box"), "{}", detail.message);
+    assert_eq!(*detail.problem, Problem::SplitNotABox, "{detail}");
 }
 
 /// `split = auto` cuts a piece that cannot run like one whose sets are infinite: `x' = x^2`
@@ -312,11 +312,17 @@ fn split_auto_cuts_pieces_that_cannot_run() {
                   analysis auto { horizon = 0.3  split = auto(pieces = 16) }\n\
                   analysis one { horizon = 0.3  split = auto(pieces = 1) }\n";
     let (sys, info) = inline(source);
-    let whole = Reach::new(&sys, &info, "whole").unwrap().run().unwrap_err();
-    let one = Reach::new(&sys, &info, "one").unwrap().run().unwrap_err();
+    let whole = Reach::paired(&sys, &info, "whole")
+        .unwrap()
+        .run()
+        .unwrap_err();
+    let one = Reach::paired(&sys, &info, "one")
+        .unwrap()
+        .run()
+        .unwrap_err();
     // (A budget of one piece is the unsplit run.)
     assert_eq!(one, whole);
-    let prs = Reach::new(&sys, &info, "auto").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "auto").unwrap().run().unwrap();
     assert!(
         prs.pieces().len() > 1 && prs.pieces().len() <= 16,
         "{}",

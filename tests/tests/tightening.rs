@@ -40,7 +40,7 @@ fn half_space_amounts(t: &Tightening, j: usize, bound: f64) -> Vec<f64> {
 #[test]
 fn pointwise_amounts_equal_the_exact_gaussian_quantile() {
     let (sys, info) = inline(OU);
-    let reach = Reach::new(&sys, &info, "pw").unwrap();
+    let reach = Reach::paired(&sys, &info, "pw").unwrap();
     let prs = reach.run().unwrap();
     let constraints = [
         Constraint::HalfSpace {
@@ -85,7 +85,7 @@ fn pointwise_amounts_equal_the_exact_gaussian_quantile() {
         amounts[40] / exact_one_sided
     );
     // The uniform amount holds over all of [0, 2] at once: larger.
-    let uni = Reach::new(&sys, &info, "uni").unwrap();
+    let uni = Reach::paired(&sys, &info, "uni").unwrap();
     let tu = uni.tighten(&uni.run().unwrap(), &constraints).unwrap();
     assert_eq!(tu.guarantee, Guarantee::Uniform);
     let uniform = half_space_amounts(&tu, 0, 1.0);
@@ -108,7 +108,7 @@ fn uniform_amounts_hold_against_monte_carlo_with_an_input_signal() {
          diffusion { x: 0.2 * w1\n y: 0.1 * w1 + 0.25 * w2 }\n\
          analysis a { method = contraction  delta = 0.1  horizon = 2  step = 0.05 }\n",
     );
-    let reach = Reach::new(&sys, &info, "a").unwrap();
+    let reach = Reach::paired(&sys, &info, "a").unwrap();
     let prs = reach.run().unwrap();
     let normal = [0.6, -0.8];
     let constraints = [
@@ -199,7 +199,7 @@ fn a_union_takes_the_largest_amount_of_its_pieces() {
          diffusion { x: 0.2 * w\n y: 0.1 * w * (1 + 0.2 * sin(x)) }\n\
          analysis a { method = contraction  delta = 0.1  horizon = 1  step = 0.1  split = [2, 1] }\n",
     );
-    let reach = Reach::new(&sys, &info, "a").unwrap();
+    let reach = Reach::paired(&sys, &info, "a").unwrap();
     let prs = reach.run().unwrap();
     assert_eq!(prs.pieces().len(), 2);
     let c = [Constraint::HalfSpace {
@@ -222,7 +222,7 @@ fn a_union_takes_the_largest_amount_of_its_pieces() {
 #[test]
 fn bad_constraints_and_results_without_a_ball_are_refused() {
     let (sys, info) = inline(OU);
-    let reach = Reach::new(&sys, &info, "uni").unwrap();
+    let reach = Reach::paired(&sys, &info, "uni").unwrap();
     let prs = reach.run().unwrap();
     let refused = |c: Constraint| reach.tighten(&prs, &[c]).unwrap_err();
     for (c, what) in [
@@ -272,7 +272,7 @@ fn the_tightening_csv_carries_the_api_values() {
         .chain([dir.display().to_string()])
         .collect();
     let (mut out, mut err) = (Vec::new(), Vec::new());
-    assert_eq!(run_cli(&sys, &info, &args, &mut out, &mut err), 0);
+    assert_eq!(run_cli(&sys, &args, &mut out, &mut err), 0);
     let text = String::from_utf8(out).unwrap();
     assert!(
         text.contains("unsafe sets inflated, `high` by up to 0.29"),
@@ -281,7 +281,7 @@ fn the_tightening_csv_carries_the_api_values() {
     let csv = std::fs::read_to_string(dir.join("pw.tightening.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some("t,high.offset,band.x_lo,band.x_hi"));
-    let reach = Reach::new(&sys, &info, "pw").unwrap();
+    let reach = Reach::paired(&sys, &info, "pw").unwrap();
     let t = reach.tighten(&reach.run().unwrap(), &[]).unwrap();
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())

@@ -24,7 +24,10 @@ fn log_volume(prs: &Prs) -> f64 {
 #[test]
 fn linear_pointwise_radius_is_the_exact_chi2_radius() {
     let (sys, info) = shipped("linear.sde");
-    let prs = Reach::new(&sys, &info, "amgf_rule").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "amgf_rule")
+        .unwrap()
+        .run()
+        .unwrap();
     assert!(prs.validation().rigorous.contains(&Proved::ExactGaussian));
     let q = -2.0 * 1e-3f64.ln();
     let g = prs.radius_rule().gaussian.expect("an affine system");
@@ -53,7 +56,7 @@ fn linear_pointwise_radius_is_the_exact_chi2_radius() {
 #[test]
 fn linear_exact_sets_are_missed_at_the_nominal_rate() {
     let (sys, info) = shipped("linear.sde");
-    let prs = Reach::new(&sys, &info, "amgf_rule")
+    let prs = Reach::paired(&sys, &info, "amgf_rule")
         .and_then(|r| r.with_delta(0.1))
         .and_then(|r| r.run())
         .unwrap();
@@ -64,7 +67,7 @@ fn linear_exact_sets_are_missed_at_the_nominal_rate() {
         dt: Some(0.001),
         ..Options::default()
     };
-    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
     for step in report.steps.iter().filter(|s| s.t > 0.2) {
         let (lo, hi) = (
             lower_bound(step.outside, paths, 1e-4),
@@ -91,7 +94,10 @@ fn the_mixture_bound_replaces_an_exploding_tube_and_holds() {
          diffusion {\n  x1: 0.1 * w1\n  x2: 0.1 * w2\n}\n\
          analysis uniform {\n  metric = identity\n  delta = 0.1\n  horizon = 2\n  step = 0.02\n}\n",
     );
-    let prs = Reach::new(&sys, &info, "uniform").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "uniform")
+        .unwrap()
+        .run()
+        .unwrap();
     let g = prs.radius_rule().gaussian.expect("an affine system");
     assert_eq!(g.uniform, Some(UniformBound::Mixture));
     assert!(prs
@@ -110,7 +116,7 @@ fn the_mixture_bound_replaces_an_exploding_tube_and_holds() {
         dt: Some(0.002),
         ..Options::default()
     };
-    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
     let tube = report.tube.as_ref().expect("a uniform result");
     assert!(tube.cp_lower <= 0.1, "{} paths left the tube", tube.outside);
     // Not vacuous: some paths do leave it at delta = 0.1.
@@ -124,8 +130,11 @@ fn the_mixture_bound_replaces_an_exploding_tube_and_holds() {
 #[test]
 fn metric_auto_is_never_worse_than_the_identity() {
     let (sys, info) = shipped("integrator_chain.sde");
-    let auto = Reach::new(&sys, &info, "auto").unwrap().run().unwrap();
-    let identity = Reach::new(&sys, &info, "identity").unwrap().run().unwrap();
+    let auto = Reach::paired(&sys, &info, "auto").unwrap().run().unwrap();
+    let identity = Reach::paired(&sys, &info, "identity")
+        .unwrap()
+        .run()
+        .unwrap();
     assert!(log_volume(&auto) <= log_volume(&identity) + 1e-9);
     let mut compared = Vec::new();
     for path in shipped_specs() {
@@ -143,11 +152,11 @@ fn metric_auto_is_never_worse_than_the_identity() {
             })
             .collect();
         let (id_sys, id_info) = inline(&identity.join("\n"));
-        for analysis in &info.analyses {
+        for analysis in info.analyses() {
             let name = &analysis.spec.name;
             let (Ok(a), Ok(b)) = (
-                Reach::new(&sys, &info, name).and_then(|r| r.run()),
-                Reach::new(&id_sys, &id_info, name).and_then(|r| r.run()),
+                Reach::paired(&sys, &info, name).and_then(|r| r.run()),
+                Reach::paired(&id_sys, &id_info, name).and_then(|r| r.run()),
             ) else {
                 continue;
             };
@@ -181,7 +190,7 @@ fn the_initial_box_is_the_set_at_time_zero() {
     let path = workspace().join("specs").join("vanderpol_feedback.sde");
     let source = std::fs::read_to_string(path).unwrap();
     let (sys, info) = inline(&source.replace("{ x >= 1.6 }", "{ x >= 1.12 }"));
-    let prs = Reach::new(&sys, &info, "contraction")
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();
@@ -206,7 +215,10 @@ fn the_initial_box_is_the_set_at_time_zero() {
 #[test]
 fn several_metrics_intersect_their_sets() {
     let (sys, info) = shipped("pendulum.sde");
-    let prs = Reach::new(&sys, &info, "per_state").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "per_state")
+        .unwrap()
+        .run()
+        .unwrap();
     // The second metric's ball, and each metric's first-order set (8.8); both keep the flow's
     // shape (remainder at most a tenth of the linear part, with the sliced mean-value Jacobian
     // of method.md 8.8), so neither run computes an interval box (section 8.7).
@@ -276,7 +288,7 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
         "    step = 0.01\n    first_order = off\n}",
     );
     let (sys, info) = inline(&source);
-    let reach = Reach::new(&sys, &info, "contraction").unwrap();
+    let reach = Reach::paired(&sys, &info, "contraction").unwrap();
     let prs = reach.run().unwrap();
     let roles = |p: &Prs| p.also().iter().map(|m| m.role()).collect::<Vec<_>>();
     assert_eq!(roles(&prs), [Role::Box]);
@@ -315,7 +327,7 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
         seed: 5,
         ..Options::default()
     };
-    let report = simulate::simulate(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
     for step in &report.steps {
         assert!(
             lower_bound(step.outside, paths, 1e-4) <= 0.1,
@@ -335,7 +347,7 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
 fn the_box_is_computed_only_where_first_order_sets_lose_their_shape() {
     let roles = |p: &Prs| p.also().iter().map(|m| m.role()).collect::<Vec<_>>();
     let (sys, info) = shipped("pendulum.sde");
-    let prs = Reach::new(&sys, &info, "contraction")
+    let prs = Reach::paired(&sys, &info, "contraction")
         .unwrap()
         .run()
         .unwrap();
@@ -346,7 +358,7 @@ fn the_box_is_computed_only_where_first_order_sets_lose_their_shape() {
          analysis c {\n method = contraction\n metric = auto\n delta = 1e-3\n horizon = 3\n \
          step = 0.05\n}\n",
     );
-    let prs = Reach::new(&sys, &info, "c").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "c").unwrap().run().unwrap();
     assert!(roles(&prs).contains(&Role::Box), "{:?}", roles(&prs));
 }
 
@@ -367,10 +379,10 @@ fn first_order_sets_are_on_by_default_and_can_be_turned_off() {
     let run = |extra: &str| {
         let (sys, info) = inline(&spec(extra));
         assert_eq!(
-            info.analyses[0].spec.first_order,
+            info.analyses()[0].spec.first_order,
             extra != "first_order = off"
         );
-        Reach::new(&sys, &info, "a").unwrap().run().unwrap()
+        Reach::paired(&sys, &info, "a").unwrap().run().unwrap()
     };
     let (on, written, off) = (run(""), run("first_order = on"), run("first_order = off"));
     let roles = |p: &Prs| p.also().iter().map(|m| m.role()).collect::<Vec<_>>();
@@ -405,7 +417,7 @@ fn a_point_start_keeps_its_interval_box_within_the_floor() {
          diffusion {\n  x: 0.05 * w\n  y: 0.05 * w\n}\n\
          analysis a { method = contraction  metric = auto  horizon = 2  step = 0.05 }\n",
     );
-    let prs = Reach::new(&sys, &info, "a").unwrap().run().unwrap();
+    let prs = Reach::paired(&sys, &info, "a").unwrap().run().unwrap();
     let boxes = prs
         .also()
         .iter()

@@ -10,10 +10,9 @@
 use std::path::{Path, PathBuf};
 
 use reachc_runtime::app::commit;
-use reachc_runtime::engine;
-use reachc_runtime::model::ModelInfo;
 use reachc_runtime::output::Files;
 use reachc_runtime::simulate::{self, SimReport};
+use reachc_runtime::{engine, Model as _};
 
 use super::{load_reporting, EXIT_USAGE};
 use crate::plot::input::{ResultFile, SimFile};
@@ -115,10 +114,9 @@ fn result_path(out_dir: &Path, analysis: &str) -> PathBuf {
 }
 
 /// The interpreter of a loaded spec, without printing its warnings again.
-pub(super) fn interpreter_quiet(mut loaded: Loaded) -> (Interpreter, ModelInfo) {
+pub(super) fn interpreter_quiet(mut loaded: Loaded) -> Interpreter {
     let prepared = prepare(&mut loaded.model);
-    let info = prepared.info.clone();
-    (Interpreter::new(loaded.model, &prepared), info)
+    Interpreter::new(loaded.model, &prepared)
 }
 
 /// Writes `files` whole or not at all and prints their names; the exit code of a failure.
@@ -219,9 +217,8 @@ pub fn run_plot(args: &PlotArgs) -> Result<(), u8> {
             .parent()
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf),
     };
-    let model = model.as_ref().map(|(sys, info)| Model {
+    let model = model.as_ref().map(|sys| Model {
         sys,
-        info,
         tables: &sys.model().tables,
     });
     let files = plot::plot_result(&result, model.as_ref(), quantile.as_ref(), &choice, &dir)
@@ -246,24 +243,18 @@ fn run_quantile(model: &Model<'_>, json: &Path, result: &ResultFile) -> Option<Q
         );
         return None;
     }
-    let analysis = model
-        .info
-        .analyses
-        .iter()
-        .find(|a| a.spec.name == result.analysis)?;
-    let computed = engine::run(model.sys, model.info, analysis).ok()?;
+    let computed = engine::run(model.sys, &result.analysis).ok()?;
     let opts = simulate::Options {
         paths: RUN_QUANTILE_PATHS,
         ..simulate::Options::default()
     };
-    let report: SimReport =
-        match simulate::simulate(model.sys, model.info, &computed, &opts, &mut |_, _| {}) {
-            Ok(r) => r,
-            Err(e) => {
-                eprintln!("note: no quantile for `{}`: {e}", result.analysis);
-                return None;
-            }
-        };
+    let report: SimReport = match simulate::simulate(model.sys, &computed, &opts, &mut |_, _| {}) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("note: no quantile for `{}`: {e}", result.analysis);
+            return None;
+        }
+    };
     Some(Quantile::of(
         &report,
         format!(
@@ -281,7 +272,7 @@ fn run_quantile(model: &Model<'_>, json: &Path, result: &ResultFile) -> Option<Q
 /// those without a result (skipped) are not plotted. Returns the exit code of a failure.
 pub(super) fn plot_after_run(
     args: &RunPlotArgs,
-    (sys, info): (&Interpreter, &ModelInfo),
+    sys: &Interpreter,
     analysis: Option<&str>,
     staging: &Path,
     out_dir: &Path,
@@ -300,7 +291,6 @@ pub(super) fn plot_after_run(
     };
     let model = Model {
         sys,
-        info,
         tables: &sys.model().tables,
     };
     let choice = Choice {
@@ -310,8 +300,9 @@ pub(super) fn plot_after_run(
         seed: 0,
         envelope: args.plot_envelope,
     };
-    for a in info
-        .analyses
+    for a in sys
+        .info()
+        .analyses()
         .iter()
         .filter(|a| analysis.is_none_or(|name| a.spec.name == name))
     {

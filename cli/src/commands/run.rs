@@ -16,7 +16,6 @@ use reachc_compiler::diagnostics::render;
 use reachc_compiler::driver::Loaded;
 use reachc_compiler::package::{Cache, Profile};
 use reachc_runtime::app::{RunOptions, DEFAULT_OUT_DIR, EXIT_OK};
-use reachc_runtime::model::ModelInfo;
 
 /// Which backend computes the sets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -77,18 +76,17 @@ pub fn run_spec(
     };
     let (code, model) = match backend {
         Backend::Interp => {
-            let (interp, info) = interpreter(loaded, color);
+            let interp = interpreter(loaded, color);
             let mut failures = Vec::new();
             let code = reachc_runtime::app::run_collecting(
                 &interp,
-                &info,
                 &opts,
                 &mut std::io::stdout().lock(),
                 &mut std::io::stderr().lock(),
                 &mut failures,
             );
             locator.print_collected(&failures, analysis.as_deref());
-            (code, (interp, info))
+            (code, interp)
         }
         Backend::Compiled => {
             let binary = compiled_binary(&mut loaded, color, quiet)?;
@@ -114,14 +112,7 @@ pub fn run_spec(
         // A usage error ran nothing. A failed run staged no results: only the analyses without
         // a PRS get their picture (sample paths and unsafe sets, to see why).
         let plotted = if code != EXIT_USAGE {
-            let (interp, info) = &model;
-            plot::plot_after_run(
-                plot,
-                (interp, info),
-                analysis.as_deref(),
-                &staging,
-                &out_dir,
-            )
+            plot::plot_after_run(plot, &model, analysis.as_deref(), &staging, &out_dir)
         } else {
             Ok(())
         };
@@ -142,7 +133,7 @@ pub(super) fn exit_code(status: std::process::ExitStatus) -> u8 {
 }
 
 /// The interpreter backend of a loaded spec and its model info (warnings printed to stderr).
-pub(super) fn interpreter(mut loaded: Loaded, color: bool) -> (Interpreter, ModelInfo) {
+pub(super) fn interpreter(mut loaded: Loaded, color: bool) -> Interpreter {
     let prepared = prepare(&mut loaded.model);
     if !prepared.warnings.is_empty() {
         let path = loaded.path.display().to_string();
@@ -151,8 +142,7 @@ pub(super) fn interpreter(mut loaded: Loaded, color: bool) -> (Interpreter, Mode
             render(&prepared.warnings, &path, &loaded.source, color)
         );
     }
-    let interp = Interpreter::new(loaded.model, &prepared);
-    (interp, prepared.info)
+    Interpreter::new(loaded.model, &prepared)
 }
 
 /// The binary of the spec's crate in reachc's cache (release profile): generated, and compiled

@@ -259,13 +259,12 @@ pub fn run_simulate(
     let mut opts = sim.options(out, loaded.source_hash());
     let code = match backend {
         Backend::Interp => {
-            let (interp, info) = interpreter(loaded, color);
+            let interp = interpreter(loaded, color);
             let mut bars = Bars::new(opts.shard);
             let mut progress = |a: &str, done: u64, total: u64| bars.update(a, done, total);
             let mut failures = Vec::new();
             let code = reachc_runtime::app::simulate_collecting(
                 &interp,
-                &info,
                 &opts,
                 (&mut std::io::stdout().lock(), &mut std::io::stderr().lock()),
                 show_bar.then_some(&mut progress as &mut dyn FnMut(&str, u64, u64)),

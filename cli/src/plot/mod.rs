@@ -28,7 +28,6 @@ use std::path::{Path, PathBuf};
 use reachc_runtime::model::{Analysis, ModelInfo};
 use reachc_runtime::output::Files;
 use reachc_runtime::simulate::{self, Options};
-use reachc_runtime::System;
 
 use geometry::{Plane, Point};
 use input::{MovingSet, ResultFile};
@@ -56,18 +55,23 @@ pub struct Choice {
 
 /// The spec's model, for sample paths, unsafe sets and reference trajectories.
 pub struct Model<'a> {
-    /// The system (the interpreter).
-    pub sys: &'a (dyn System + Sync),
-    /// Its sets and analyses.
-    pub info: &'a ModelInfo,
+    /// The system (the interpreter) with its sets and analyses.
+    pub sys: &'a dyn reachc_runtime::Model,
     /// Its tables: one with columns named as both plotted states is drawn as a reference.
     pub tables: &'a [Table],
+}
+
+impl Model<'_> {
+    /// Its sets and analyses.
+    fn info(&self) -> &ModelInfo {
+        self.sys.info()
+    }
 }
 
 /// The first table with columns named as the two plotted states, as a path in the plane with
 /// its legend label (e.g. a reference trajectory `ref.px`, `ref.py`).
 fn reference(model: &Model<'_>, plane: [usize; 2]) -> Option<(String, Vec<Point>)> {
-    let names = plane.map(|i| model.info.states[i].as_str());
+    let names = plane.map(|i| model.info().states()[i].as_str());
     model.tables.iter().find_map(|t| {
         let (a, b) = (t.column_index(names[0])?, t.column_index(names[1])?);
         let path = t.values[a]
@@ -163,7 +167,7 @@ fn unsafe_regions(
 ) -> Vec<(String, Region)> {
     let mut regions = Vec::new();
     let given = |name: &str| from_result.iter().any(|m| !m.goal && m.name == name);
-    for u in info.unsafe_sets.iter().filter(|u| !given(&u.name)) {
+    for u in info.unsafe_sets().iter().filter(|u| !given(&u.name)) {
         match Region::of(&u.shape, plane) {
             Some(r) => regions.push((spec_label(&u.name, !u.moving.is_empty()), r)),
             None => notes.push(scene::not_drawn("unsafe set", &u.name)),
@@ -183,7 +187,7 @@ fn goal_regions(
 ) -> Vec<(String, Vec<Region>)> {
     let mut goals = Vec::new();
     let given = |name: &str| from_result.iter().any(|m| m.goal && m.name == name);
-    for g in info.goals.iter().filter(|g| !given(&g.name)) {
+    for g in info.goals().iter().filter(|g| !given(&g.name)) {
         let parts: Vec<Region> = g
             .parts
             .iter()
@@ -211,7 +215,7 @@ fn sample(
         seed: choice.seed,
         ..Options::default()
     };
-    simulate::sample_paths(model.sys, model.info, times, center, &opts)
+    simulate::sample_paths(model.sys, model.info(), times, center, &opts)
         .map_err(|e| format!("cannot simulate sample paths: {e}"))
 }
 
@@ -256,11 +260,11 @@ pub fn plot_result(
 ) -> Result<Files, String> {
     font::register()?;
     if let Some(m) = model {
-        if m.info.name != result.model || m.info.states != result.states {
+        if m.info().name() != result.model || m.info().states() != result.states {
             return Err(format!(
                 "the spec's model `{}` ({} states) is not the result's model `{}` ({} states)",
-                m.info.name,
-                m.info.states.len(),
+                m.info().name(),
+                m.info().states().len(),
                 result.model,
                 result.states.len()
             ));
@@ -273,11 +277,11 @@ pub fn plot_result(
     let mut notes = Vec::new();
     let moving = result.moving_sets()?;
     let mut goals = model.map_or_else(Vec::new, |m| {
-        goal_regions(m.info, states, &moving, &mut notes)
+        goal_regions(m.info(), states, &moving, &mut notes)
     });
     let (mut regions, paths) = match model {
         Some(m) => (
-            unsafe_regions(m.info, states, &moving, &mut notes),
+            unsafe_regions(m.info(), states, &moving, &mut notes),
             sample(m, &result.times(), Some(&result.initial_center), choice)?,
         ),
         None => {
@@ -359,7 +363,7 @@ pub fn plot_without_result(
     dir: &Path,
 ) -> Result<Files, String> {
     font::register()?;
-    let info = model.info;
+    let info = model.info();
     let a = &analysis.spec;
     if !(a.step > 0.0 && a.horizon > 0.0 && a.horizon / a.step <= 1e7) {
         return Err(format!(
@@ -367,7 +371,7 @@ pub fn plot_without_result(
             a.name, a.horizon, a.step
         ));
     }
-    let states = select::pick_states(&info.states, &a.outputs, choice.states.as_deref())?;
+    let states = select::pick_states(info.states(), &a.outputs, choice.states.as_deref())?;
     let times = report_times(analysis);
     let picked = select::pick_times(&times, choice.times.as_deref())?;
     let plane = Plane::of_states(states);
@@ -384,7 +388,9 @@ pub fn plot_without_result(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use reachc_runtime::model::{Bounds, GoalSet, Moving, Slot, UnsafeSet, UnsafeShape};
+    use reachc_runtime::model::{
+        Bounds, GoalSet, ModelParts, Moving, Slot, UnsafeSet, UnsafeShape,
+    };
     use reachc_test_support::models::model;
 
     /// The spec's sets: fixed ones by name, a moving one the result does not give at its
@@ -402,7 +408,7 @@ mod tests {
             shape: bar(1.0),
             moving: moving.clone(),
         };
-        let info = ModelInfo {
+        let info = ModelInfo::from_parts(ModelParts {
             unsafe_sets: vec![
                 set("fixed", &vec![]),
                 set("slides", &moves),
@@ -415,8 +421,8 @@ mod tests {
                 window: None,
                 stay: false,
             }],
-            ..model("m", &["x", "y"], &[], &[(0.0, 0.0); 2])
-        };
+            ..model("m", &["x", "y"], &[], &[(0.0, 0.0); 2]).into_parts()
+        });
         let from_result = [MovingSet {
             name: "given".into(),
             goal: false,

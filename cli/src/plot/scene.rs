@@ -509,7 +509,7 @@ pub fn paths_scene(
     paths: &[Vec<f64>],
     regions: Vec<(String, Region)>,
 ) -> SetsScene {
-    let paths = project_paths(plane, info.states.len(), paths);
+    let paths = project_paths(plane, info.states().len(), paths);
     let [a, b] = plane.states;
     // The reason can be a long Jacobian entry: the warning printed with the spec shows it.
     let why = match analysis.constants.as_ref().err() {
@@ -518,8 +518,8 @@ pub fn paths_scene(
             .to_string(),
     };
     SetsScene {
-        title: format!("{} / {}: sample paths", info.name, analysis.spec.name),
-        axes: [info.states[a].clone(), info.states[b].clone()],
+        title: format!("{} / {}: sample paths", info.name(), analysis.spec.name),
+        axes: [info.states()[a].clone(), info.states()[b].clone()],
         slices: picked
             .iter()
             .map(|&k| Slice {

@@ -124,16 +124,16 @@ fn predicted(
     objective: Objective,
 ) -> f64 {
     let n = model.states.len();
-    let (c, t) = (k.c, spec.horizon);
-    if !(c.is_finite() && k.sigma.is_finite() && k.rho.is_finite()) {
+    let (c, t) = (k.c(), spec.horizon);
+    if !(c.is_finite() && k.sigma().is_finite() && k.rho().is_finite()) {
         return f64::INFINITY;
     }
     // (e^(x) - 1) / x, continuous at 0.
     let growth = |x: f64| if x.abs() < 1e-12 { 1.0 } else { x.exp_m1() / x };
-    let psi = k.sigma * k.sigma * t * growth(2.0 * c * t);
+    let psi = k.sigma() * k.sigma() * t * growth(2.0 * c * t);
     let r_t = (kappa * psi).sqrt();
     let det = match spec.method {
-        Method::Contraction => (c * t).exp() * r1(model, p) + k.rho * t * growth(c * t),
+        Method::Contraction => (c * t).exp() * r1(model, p) + k.rho() * t * growth(c * t),
         Method::Interval => 0.0,
     };
     let Some(chol) = DMatrix::from_row_slice(n, n, p).cholesky() else {

@@ -254,9 +254,13 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
 
     let struct_doc = docs::struct_doc(model);
     let lints = allow_lints();
-    let index_modules = indices::index_modules(&names);
+    let analyses: Vec<String> = (prepared.info.analyses().iter())
+        .map(|a| a.spec.name.clone())
+        .collect();
+    let index_modules = indices::index_modules(&names, &analyses);
     let statics = tables.statics(model);
     let info_fn = bake::info_fn(&prepared.info);
+    let info_doc = docs::info_doc(&prepared.info);
     let file = quote! {
         #struct_doc
         #lints
@@ -290,6 +294,15 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
             #bodies
             #frame_fn
             #set_numbers
+        }
+
+        #info_doc
+        impl reachc_runtime::Model for #name {
+            fn info(&self) -> &reachc_runtime::model::ModelInfo {
+                static INFO: std::sync::OnceLock<reachc_runtime::model::ModelInfo> =
+                    std::sync::OnceLock::new();
+                INFO.get_or_init(info)
+            }
         }
 
         #helpers
@@ -448,7 +461,7 @@ pub fn main_rs(crate_ident: &str, type_name: &str) -> String {
     generated_header("//")
         + &format_file(quote! {
             fn main() -> std::process::ExitCode {
-                reachc_runtime::app::main_with(&#krate::#ty, &#krate::info())
+                reachc_runtime::app::main_with(&#krate::#ty)
             }
         })
 }

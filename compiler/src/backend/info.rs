@@ -1,7 +1,7 @@
 //! What every backend needs: the Jacobians and the runtime's [`ModelInfo`], with the constants
 //! of Assumption 1 derived (and certified) for each analysis.
 
-use reachc_core::model::{Analysis, ModelInfo};
+use reachc_core::model::{Analysis, ModelInfo, ModelParts};
 
 use crate::analysis::{
     constants, constants_without_rate, metric_for_result, synthesize_metric,
@@ -14,7 +14,9 @@ use crate::ir::Names;
 const MAX_SHOWN: usize = 200;
 use crate::model::{self, MetricChoice, Model, Rate};
 use reachc_core::interval::Interval;
-use reachc_core::model::{AnalysisSpec, Constants, MetricRegion, NoConstants, Provenance};
+use reachc_core::model::{
+    AnalysisSpec, Constants, ConstantsParts, MetricRegion, NoConstants, Provenance,
+};
 
 /// A model ready for code generation or interpretation.
 #[derive(Clone, Debug)]
@@ -70,7 +72,7 @@ pub fn prepare(model: &mut Model) -> Prepared {
         });
     }
     let names = |v: &[model::Variable]| v.iter().map(|x| x.name.clone()).collect();
-    let info = ModelInfo {
+    let info = ModelInfo::from_parts(ModelParts {
         name: model.name.clone(),
         states: names(&model.states),
         inputs: names(&model.inputs),
@@ -88,7 +90,7 @@ pub fn prepare(model: &mut Model) -> Prepared {
         unsafe_sets: model.unsafe_sets.clone(),
         goals: model.goals.clone(),
         analyses,
-    };
+    });
     Prepared {
         derivatives,
         frames,
@@ -120,9 +122,9 @@ fn analysis_constants(
         .iter()
         .map(|&state| one_metric(model, d, spec, Objective::Extent { state, metrics }))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut first = all.remove(0);
+    let mut first = all.remove(0).into_parts();
     first.also = all;
-    Ok(first)
+    Ok(Constants::from_parts(first))
 }
 
 /// The constants of an analysis for one metric: given, or chosen by the compiler for
@@ -149,9 +151,11 @@ fn one_metric(
         Rate::Empirical { .. } => metric().and_then(|p| constants_without_rate(model, d, &p)),
         Rate::Local => return local_constants(model, d, spec, objective),
     };
-    derived.map(|c| Constants {
-        metric_region: region,
-        ..c
+    derived.map(|c| {
+        Constants::from_parts(ConstantsParts {
+            metric_region: region,
+            ..c.into_parts()
+        })
     })
 }
 
@@ -173,11 +177,11 @@ fn local_constants(
                 .map(|p| metric_for_result(model, d, spec, p, objective))
                 .and_then(|p| constants(model, d, &p));
             match global {
-                Ok(c) if c.c.is_finite() => {
-                    return Ok(Constants {
+                Ok(c) if c.c().is_finite() => {
+                    return Ok(Constants::from_parts(ConstantsParts {
                         metric_region: MetricRegion::Domain,
-                        ..c
-                    })
+                        ..c.into_parts()
+                    }))
                 }
                 _ => (
                     initial_metric(model, d, spec.step),
@@ -186,14 +190,14 @@ fn local_constants(
             }
         }
     };
-    let mut chosen = for_metric(model, d, metric, region)?;
+    let mut chosen = for_metric(model, d, metric, region)?.into_parts();
     // Constants over the initial set predict the PRS at the horizon too poorly to compare
     // metrics by: the engine runs the identity as well and keeps the smaller result.
     if region == MetricRegion::InitialSet && chosen.metric != identity(n) {
         let id = for_metric(model, d, identity(n), MetricRegion::IdentityAtRun)?;
         chosen.alternatives.push(id);
     }
-    Ok(chosen)
+    Ok(Constants::from_parts(chosen))
 }
 
 /// The constants of a local-rate analysis for `metric`: the compiler's global ones where it can
@@ -205,13 +209,13 @@ fn for_metric(
     region: MetricRegion,
 ) -> Result<Constants, ConstantsError> {
     match constants(model, d, &metric) {
-        Ok(c) => Ok(Constants {
+        Ok(c) => Ok(Constants::from_parts(ConstantsParts {
             metric_region: region,
-            ..c
-        }),
+            ..c.into_parts()
+        })),
         Err(e @ ConstantsError::Unbounded { .. }) => {
             let time = time_range(model);
-            Ok(Constants {
+            Ok(Constants::from_parts(ConstantsParts {
                 metric,
                 metric_region: region,
                 c: f64::INFINITY,
@@ -227,7 +231,7 @@ fn for_metric(
                     input_box: model.input_box.clone(),
                     time: reachc_core::model::Bounds::new(time.lo(), time.hi()),
                 },
-            })
+            }))
         }
         Err(e) => Err(e),
     }

@@ -3,7 +3,7 @@
 //! agree with generated code (the same operations in the same order; both use the runtime's
 //! special functions and table interpolation).
 
-use reachc_core::{Interval, System};
+use reachc_core::{Interval, ModelInfo, System};
 
 use std::sync::Arc;
 
@@ -29,10 +29,14 @@ impl Plan {
     }
 }
 
-/// A model evaluated by walking its IR.
+/// A model evaluated by walking its IR, with the model data prepared from it: a
+/// [`reachc_core::Model`] the engines run.
 #[derive(Debug)]
 pub struct Interpreter {
     model: Arc<Model>,
+    /// The model data [`super::prepare`] derived (shared with the transformed systems, which
+    /// are reached only as [`System::frame`]s).
+    info: Arc<ModelInfo>,
     drift: Plan,
     jac_x: Plan,
     /// The entries of `jac_x` where the drift depends on the state, and where they are.
@@ -51,20 +55,26 @@ impl Interpreter {
     /// derivatives and the transformed systems).
     pub fn new(model: Model, prepared: &Prepared) -> Self {
         let model = Arc::new(model);
+        let info = Arc::new(prepared.info.clone());
         let frames = prepared
             .frames
             .iter()
-            .map(|f| Interpreter::of(&model, &f.drift, &f.diffusion, &f.derivatives, Vec::new()))
+            .map(|f| {
+                let (drift, diffusion) = (&f.drift, &f.diffusion);
+                Interpreter::of(&model, &info, drift, diffusion, &f.derivatives, Vec::new())
+            })
             .collect();
         let drift = model.drift.clone();
         let diffusion = model.diffusion.clone();
-        let mut own = Interpreter::of(&model, &drift, &diffusion, &prepared.derivatives, frames);
+        let derivatives = &prepared.derivatives;
+        let mut own = Interpreter::of(&model, &info, &drift, &diffusion, derivatives, frames);
         own.set_numbers = Plan::new(&model, model.set_numbers.clone());
         own
     }
 
     fn of(
         model: &Arc<Model>,
+        info: &Arc<ModelInfo>,
         drift: &[ExprId],
         diffusion: &[Vec<ExprId>],
         derivatives: &Derivatives,
@@ -81,6 +91,7 @@ impl Interpreter {
             diffusion: Plan::new(model, flat(diffusion)),
             set_numbers: Plan::new(model, Vec::new()),
             model: Arc::clone(model),
+            info: Arc::clone(info),
             frames,
         }
     }
@@ -104,6 +115,12 @@ impl Interpreter {
                 .pool
                 .eval_ordered(&plan.order, &plan.roots, &vars, &self.model.tables);
         out.copy_from_slice(&values);
+    }
+}
+
+impl reachc_core::Model for Interpreter {
+    fn info(&self) -> &ModelInfo {
+        &self.info
     }
 }
 

@@ -164,7 +164,7 @@ pub fn generate_files(
     let main = codegen::main_rs(&crate_ident, &type_name);
     let analyses: Vec<&str> = prepared
         .info
-        .analyses
+        .analyses()
         .iter()
         .map(|a| a.spec.name.as_str())
         .collect();

@@ -4,7 +4,7 @@
 //! delta-PRS without any other set: no contraction rate, no domain, no tube region.
 
 use super::assemble::{assemble_with, constants_used, rate_used, Header, Radii};
-use super::{contraction, first_order, nominal, r1, radius, Run, RunError};
+use super::{contraction, first_order, nominal, r1, radius, Problem, Run, RunError};
 use crate::model::Method;
 use crate::prs::{Hint, Proved, Prs, Role};
 
@@ -19,7 +19,7 @@ pub(super) fn run(run: &Run, failed: &RunError) -> Result<Option<Prs>, RunError>
     }
     let metric = &run.setup.consts.metric;
     let (x0, half) = radius::initial_center_and_halfwidths(run.initial, n)
-        .map_err(|m| RunError::Invalid(m.into()))?;
+        .map_err(|e| RunError::Invalid(Problem::InitialSet(e).into()))?;
     let (r1, r1_bound) = r1::bound(metric, run.initial, &half);
     let grid = nominal::time_grid(spec.horizon, spec.step);
     let (inputs, r2) = run.nominal_inputs(&grid);

@@ -11,9 +11,9 @@ use super::embedding::Budget;
 use super::intersect::cut_by;
 use super::radius::expm1_over;
 use super::{
-    first_order, hints, interval, local, nominal, r1, radius, rates, Detail, Run, RunError, Setting,
+    first_order, hints, interval, local, nominal, r1, radius, rates, Detail, Problem, Run,
+    RunError, Setting,
 };
-use crate::decimal::time;
 use crate::interval::Interval;
 use crate::model::{Integrator, Method, Rate};
 use crate::prs::{DetSet, Proved, Prs, Role, Span, Unproved};
@@ -40,7 +40,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
 
     // Initial set and inputs.
     let (x0, half) = radius::initial_center_and_halfwidths(run.initial, n)
-        .map_err(|m| RunError::Invalid(m.into()))?;
+        .map_err(|e| RunError::Invalid(Problem::InitialSet(e).into()))?;
     let (r1, r1_bound) = r1::bound(metric, run.initial, &half);
     let grid = nominal::time_grid(spec.horizon, spec.step);
     let (inputs, r2) = run.nominal_inputs(&grid);
@@ -282,13 +282,11 @@ pub(super) fn nominal_steps(
     }
     let traj = nominal::integrate(run.sys, x0, inputs, grid, spec.integrator).map_err(|k| {
         RunError::NonFinite(
-            Detail::from(format!(
-                "the nominal trajectory is not finite at t = {} ({} integration, step {}; the \
-                 default validated integrator reports where and why a step fails)",
-                time(grid[k]),
-                spec.integrator.name(),
-                spec.step
-            ))
+            Detail::from(Problem::NominalNotFinite {
+                t: grid[k],
+                integrator: spec.integrator,
+                step: spec.step,
+            })
             .at_setting(Setting::Integrator),
         )
     })?;

@@ -2,6 +2,7 @@
 //! The CLI turns a [`Culprit`] into a source span (the state's declaration, the setting's line)
 //! and renders the failure like a compile-time diagnostic.
 
+use super::problem::{Note, Problem};
 use std::fmt;
 
 /// A setting of an `analysis` block (docs/language.md, "Analyses"): the one to change.
@@ -113,17 +114,21 @@ impl Culprit {
     }
 }
 
-/// Why an analysis could not run: the message, and what in the spec it points at.
+/// Why an analysis could not run: the problem, what in the spec it points at, and the
+/// circumstances (the piece of a split box, ...). Its `Display` (the words) is in
+/// `core/src/words.rs`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Detail {
-    /// What went wrong, and what may help.
-    pub message: String,
+    /// What went wrong, with what it is about (boxed: results stay small).
+    pub problem: Box<Problem>,
     /// The state or setting to look at, when the engine knows it.
     pub culprit: Option<Culprit>,
+    /// Circumstances, in the order they were added.
+    pub notes: Vec<Note>,
 }
 
 impl Detail {
-    /// The same message pointing at `culprit`.
+    /// The same problem pointing at `culprit`.
     pub fn at(self, culprit: Culprit) -> Detail {
         Detail {
             culprit: Some(culprit),
@@ -131,30 +136,19 @@ impl Detail {
         }
     }
 
-    /// The same message pointing at the setting `setting`.
+    /// The same problem pointing at the setting `setting`.
     pub fn at_setting(self, setting: Setting) -> Detail {
         self.at(Culprit::Setting(setting))
     }
 }
 
-impl From<String> for Detail {
-    fn from(message: String) -> Detail {
+impl From<Problem> for Detail {
+    fn from(problem: Problem) -> Detail {
         Detail {
-            message,
+            problem: Box::new(problem),
             culprit: None,
+            notes: Vec::new(),
         }
-    }
-}
-
-impl From<&str> for Detail {
-    fn from(message: &str) -> Detail {
-        Detail::from(message.to_string())
-    }
-}
-
-impl fmt::Display for Detail {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message)
     }
 }
 

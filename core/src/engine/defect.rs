@@ -13,8 +13,7 @@
 
 use super::hermite::Cubic;
 use super::radius::BoxRadius;
-use super::{Culprit, Detail, RunError, Setting};
-use crate::decimal::time;
+use super::{Culprit, Detail, Integrated, Problem, RunError, Setting};
 use crate::interval::Interval;
 use crate::system::System;
 
@@ -27,10 +26,8 @@ pub(crate) const MAX_STEPS_PER_REPORT: usize = 10_000;
 /// Counts a run's internal steps against [`MAX_STEPS`] and [`MAX_STEPS_PER_REPORT`], so that an
 /// enclosure creeping towards a blow-up stops early with a diagnostic.
 pub(crate) struct StepBudget {
-    /// What is integrated ("the nominal trajectory", "the embedding system").
-    what: &'static str,
-    /// What to try instead, for the diagnostic.
-    hint: &'static str,
+    /// What is integrated.
+    what: Integrated,
     total: usize,
     in_interval: usize,
     /// The most steps in all ([`MAX_STEPS`] unless [`StepBudget::at_most`] lowers it).
@@ -41,10 +38,9 @@ pub(crate) struct StepBudget {
 }
 
 impl StepBudget {
-    pub(crate) fn new(what: &'static str, hint: &'static str) -> Self {
+    pub(crate) fn new(what: Integrated) -> Self {
         StepBudget {
             what,
-            hint,
             total: 0,
             in_interval: 0,
             limit: MAX_STEPS,
@@ -69,28 +65,25 @@ impl StepBudget {
 
     /// Takes one step at `t` in the report interval `window`, or says why not.
     pub(crate) fn take(&mut self, t: f64, window: &[f64]) -> Result<(), RunError> {
-        let (what, hint) = (self.what, self.hint);
+        let what = self.what;
         if self.total >= self.limit {
             return Err(RunError::NonFinite(
-                Detail::from(format!(
-                    "{what} needs more than {} validated steps before t = {} ({hint})",
-                    self.limit,
-                    time(t)
-                ))
+                Detail::from(Problem::TooManySteps {
+                    what,
+                    limit: self.limit,
+                    t,
+                })
                 .at_setting(Setting::Horizon),
             ));
         }
         if self.in_interval >= self.interval_limit {
             return Err(RunError::NonFinite(
-                Detail::from(format!(
-                    "{what} needs more than {} validated steps in the \
-                     report interval [{}, {}] (at t = {}): it grows without bound there, or is \
-                     too stiff for this report step ({hint})",
-                    self.interval_limit,
-                    time(window[0]),
-                    time(window[1]),
-                    time(t)
-                ))
+                Detail::from(Problem::TooManyStepsInInterval {
+                    what,
+                    limit: self.interval_limit,
+                    window: [window[0], window[1]],
+                    t,
+                })
                 .at_setting(Setting::Step),
             ));
         }
@@ -162,10 +155,7 @@ impl<'a> Nominal<'a> {
         let mut x = x0.to_vec();
         let mut t = 0.0;
         let mut h = grid.get(1).copied().unwrap_or(0.0);
-        let mut budget = StepBudget::new(
-            "the nominal trajectory",
-            "a smaller report step or a shorter horizon may help",
-        );
+        let mut budget = StepBudget::new(Integrated::Nominal);
         for (k, w) in grid.windows(2).enumerate() {
             let end = w[1];
             budget.next_interval();
@@ -210,14 +200,8 @@ impl<'a> Nominal<'a> {
             h = 0.5 * h_used;
             if h < min_h {
                 return Err(RunError::NonFinite(
-                    Detail::from(format!(
-                        "the nominal trajectory cannot be validated at t = {}: the step shrank \
-                         below {min_h:e} without bounding the defect (the drift is too large \
-                         or not smooth here: a shorter horizon or a smaller report step may \
-                         help)",
-                        time(t)
-                    ))
-                    .at_setting(Setting::Horizon),
+                    Detail::from(Problem::NominalStepTooSmall { t, min_step: min_h })
+                        .at_setting(Setting::Horizon),
                 ));
             }
         }
@@ -273,12 +257,7 @@ impl<'a> Nominal<'a> {
         if let Some(domain) = self.domain {
             if let Some(i) = (0..n).find(|&i| lo[i] < domain[i].lo || hi[i] > domain[i].hi) {
                 return Err(RunError::Invalid(
-                    Detail::from(format!(
-                        "the nominal trajectory leaves the domain in state {i} near t = {}: the \
-                         constants hold only in the domain (enlarge it, or shorten the horizon)",
-                        time(t)
-                    ))
-                    .at(Culprit::State(i)),
+                    Detail::from(Problem::LeavesDomain { state: i, t }).at(Culprit::State(i)),
                 ));
             }
         }

@@ -13,8 +13,7 @@
 use super::defect::{StepBudget, MAX_STEPS, MAX_STEPS_PER_REPORT, MIN_STEP};
 use super::hermite::Cubic;
 use super::nominal::rk4_step;
-use super::{Detail, RunError, Setting};
-use crate::decimal::time;
+use super::{Detail, Integrated, Problem, RunError, Setting};
 use crate::interval::Interval;
 use crate::model::{Inclusion, Integrator};
 use crate::system::System;
@@ -239,12 +238,8 @@ impl<'a> Embedding<'a> {
         let (mut lo, mut hi) = (lo.to_vec(), hi.to_vec());
         let mut t = 0.0;
         let mut h = grid.get(1).copied().unwrap_or(0.0);
-        let mut steps = StepBudget::new(
-            "the embedding system",
-            "the other inclusion, a coordinate transform, the contraction method, a smaller \
-             report step or a shorter horizon may help",
-        )
-        .at_most(budget.steps, budget.per_interval);
+        let mut steps =
+            StepBudget::new(Integrated::Embedding).at_most(budget.steps, budget.per_interval);
         for (k, w) in grid.windows(2).enumerate() {
             if self.field.ubox != inputs[k] {
                 self.field.set_inputs(&inputs[k]);
@@ -338,14 +333,11 @@ impl<'a> Embedding<'a> {
             h = shrink * used;
             if h < min_h {
                 return Err(RunError::NonFinite(
-                    Detail::from(format!(
-                        "the embedding system cannot be validated at t = {}: the step would have \
-                     to be shorter than {min_h:e} (a millionth of the report step), with the \
-                     box {wmax:e} wide and growing without bound there (try the other \
-                     inclusion, a coordinate transform, the contraction method or a shorter \
-                     horizon)",
-                        time(t)
-                    ))
+                    Detail::from(Problem::EmbeddingStepTooSmall {
+                        t,
+                        min_step: min_h,
+                        width: wmax,
+                    })
                     .at_setting(Setting::Inclusion),
                 ));
             }

@@ -19,8 +19,7 @@
 
 use super::linalg::{self, lambda_max, product, symmetric_part};
 use super::uniform::{Scale, Tube};
-use super::{Detail, Run, RunError, Setting};
-use crate::decimal::time;
+use super::{Detail, JacobianEntry, Problem, Run, RunError, Setting};
 use crate::interval::Interval;
 use crate::model::Bounds;
 use crate::prs::RateRegion;
@@ -101,18 +100,15 @@ impl<'a> Certifier<'a> {
         let (sys, n, consts) = (run.sys, run.setup.n, run.setup.consts);
         let chol = linalg::cholesky(&linalg::to_intervals(&consts.metric), n).ok_or_else(|| {
             RunError::Invalid(
-                Detail::from("the metric is not positive definite").at_setting(Setting::Metric),
+                Detail::from(Problem::LocalMetricIndefinite).at_setting(Setting::Metric),
             )
         })?;
         let diagonal = (0..n).all(|i| (0..n).all(|j| i == j || consts.metric[i * n + j] == 0.0));
         let dense = n <= DENSE_MAX;
         if !dense && !diagonal {
             return Err(RunError::Unsupported(
-                Detail::from(format!(
-                    "local rates for more than {DENSE_MAX} states need a diagonal metric (give \
-                     `metric = identity` or `rate = global`)"
-                ))
-                .at_setting(Setting::Rate),
+                Detail::from(Problem::LocalRatesNeedDiagonal { max: DENSE_MAX })
+                    .at_setting(Setting::Rate),
             ));
         }
         let (r, r_inv) = if dense {
@@ -388,12 +384,7 @@ impl<'a> Certifier<'a> {
 
     /// The diagnostic for a region whose rates cannot be bounded or do not settle.
     fn explain(&self, t0: f64, x: &[Interval], grew: Option<Grew>) -> RunError {
-        let region: Vec<String> = self
-            .states
-            .iter()
-            .zip(x)
-            .map(|(s, v)| format!("{s} in [{:.4e}, {:.4e}]", v.lo(), v.hi()))
-            .collect();
+        let region = self.states.iter().cloned().zip(x.iter().copied()).collect();
         let entry = grew
             .and_then(|g| g.entry)
             .or_else(|| {
@@ -402,24 +393,17 @@ impl<'a> Certifier<'a> {
                     .jac_x_interval(x, &self.inputs, Interval::point(t0), &mut j);
                 largest(&j, self.n)
             })
-            .map(|(i, k, v)| {
-                format!(
-                    "; the Jacobian entry d f[{}] / d {} grew to [{:.4e}, {:.4e}] there",
-                    self.states[i],
-                    self.states[k],
-                    v.lo(),
-                    v.hi()
-                )
-            })
-            .unwrap_or_default();
+            .map(|(i, k, v)| JacobianEntry {
+                row: self.states[i].clone(),
+                col: self.states[k].clone(),
+                value: v,
+            });
         RunError::NonFinite(
-            Detail::from(format!(
-                "the local rates cannot be certified at t = {}: no region around the tube holds \
-                 the tube its own rates give (last region tried: {}){entry}. A shorter horizon, \
-                 a smaller initial set or less noise may help",
-                time(t0),
-                region.join(", ")
-            ))
+            Detail::from(Problem::LocalRates {
+                t: t0,
+                region,
+                entry,
+            })
             .at_setting(Setting::Horizon),
         )
     }

@@ -151,7 +151,7 @@ mod tests {
     #[test]
     fn forgets_the_oldest_beyond_its_capacity_and_keeps_errors() {
         let memo = Memo::<u32>::default();
-        let failed = RunError::Invalid(Detail::from("no".to_string()));
+        let failed = RunError::Invalid(Detail::from(crate::engine::Problem::NoStates));
         let first = memo.get_or(key(1e-3, 0.0, Inclusion::Jacobian), || {
             (Err(failed.clone()), CAPACITY / 2)
         });

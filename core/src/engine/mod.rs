@@ -36,6 +36,7 @@ mod linearised;
 mod local;
 mod memo;
 mod nominal;
+mod problem;
 mod r1;
 pub(crate) mod radius;
 mod rates;
@@ -50,19 +51,22 @@ pub(crate) use first_order::gaussian_wanted;
 pub use first_order::MAX_FIRST_ORDER_STATES;
 pub use hints::WRAPPING_FACTOR;
 pub use interval::interval_boxes;
+pub use problem::{
+    Constant, Coverage, InitialSetError, Integrated, JacobianEntry, NonFiniteQuantity, Note,
+    Problem, SetKind, SetPart, ThreadsError, UnsafeSetError, UnsafeSetFault,
+};
 pub use r1::MAX_BALL_STATES;
 pub use radius::MAX_VERTEX_COORDS;
 pub use tighten::{tighten, Constraint, TightStep, TightenError, Tightening};
 
 use crate::interval::Interval;
 use crate::model::{
-    Analysis, AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, NoConstants,
-    RadiusRule, Split, MAX_PIECES,
+    AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, NoConstants, RadiusRule, Split,
+    MAX_PIECES,
 };
 use crate::prs::Prs;
 use crate::reach::InputPlan;
-use crate::system::System;
-use std::fmt;
+use crate::system::{Model, System};
 
 /// Why an analysis could not run.
 #[derive(Clone, Debug, PartialEq)]
@@ -102,16 +106,16 @@ impl RunError {
 }
 
 impl RunError {
-    /// The same failure, said to be of `piece` (a part of a split initial set, in words).
-    pub(crate) fn in_piece(self, piece: &str) -> RunError {
-        self.noted(&format!("in the piece {piece} of the split initial box"))
+    /// The same failure, said to be of the piece of a split initial box with these ranges.
+    pub(crate) fn in_piece(self, piece: Vec<(String, Bounds)>) -> RunError {
+        self.noted(Note::Piece(piece))
     }
 
-    /// The same failure with `note` added to its message, in parentheses.
-    pub(crate) fn noted(self, note: &str) -> RunError {
-        let note = |d: Detail| Detail {
-            message: format!("{} ({note})", d.message),
-            culprit: d.culprit,
+    /// The same failure with `note` added to its circumstances.
+    pub(crate) fn noted(self, note: Note) -> RunError {
+        let note = |mut d: Detail| {
+            d.notes.push(note);
+            d
         };
         match self {
             RunError::UnknownAnalysis { .. } => self,
@@ -121,20 +125,15 @@ impl RunError {
             RunError::NonFinite(d) => RunError::NonFinite(note(d)),
         }
     }
-}
 
-impl fmt::Display for RunError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    /// The problem of the failure (`None` for [`RunError::UnknownAnalysis`]).
+    pub fn problem(&self) -> Option<&Problem> {
         match self {
-            RunError::UnknownAnalysis { name, available } => write!(
-                f,
-                "no analysis `{name}` (available: {})",
-                available.join(", ")
-            ),
-            RunError::Unsupported(m) => write!(f, "unsupported: {m}"),
-            RunError::NoConstants(m) => write!(f, "no constants: {m}"),
-            RunError::Invalid(m) => write!(f, "invalid analysis: {m}"),
-            RunError::NonFinite(m) => write!(f, "numerical failure: {m}"),
+            RunError::UnknownAnalysis { .. } => None,
+            RunError::Unsupported(d)
+            | RunError::NoConstants(d)
+            | RunError::Invalid(d)
+            | RunError::NonFinite(d) => Some(d.problem.as_ref()),
         }
     }
 }
@@ -173,17 +172,21 @@ impl<'a> Setup<'a> {
         needs: Needs,
     ) -> Result<Setup<'a>, RunError> {
         let consts = constants.as_ref().map_err(|why| {
-            let used: Vec<&str> = [("c", needs.c), ("sigma", needs.sigma), ("rho", needs.rho)]
-                .iter()
-                .filter(|(_, used)| *used)
-                .map(|(name, _)| *name)
-                .collect();
+            let needs = [
+                (Constant::C, needs.c),
+                (Constant::Sigma, needs.sigma),
+                (Constant::Rho, needs.rho),
+            ]
+            .iter()
+            .filter(|(_, used)| *used)
+            .map(|(name, _)| *name)
+            .collect();
             RunError::NoConstants(
-                format!(
-                    "analysis `{}` has no constants ({}): {why}",
-                    spec.name,
-                    used.join(", ")
-                )
+                Problem::MissingConstants {
+                    analysis: spec.name.clone(),
+                    needs,
+                    why: why.clone(),
+                }
                 .into(),
             )
         })?;
@@ -204,34 +207,35 @@ impl<'a> Setup<'a> {
         let metric = &consts.metric;
         if metric.len() != n * n {
             return Err(RunError::Invalid(
-                Detail::from(format!(
-                    "the metric has {} entries, expected {n} x {n}",
-                    metric.len()
-                ))
+                Detail::from(Problem::MetricSize {
+                    entries: metric.len(),
+                    n,
+                })
                 .at_setting(Setting::Metric),
             ));
         }
         for (what, v, used) in [
-            ("c", consts.c, needs.c),
-            ("sigma", consts.sigma, needs.sigma),
-            ("rho", consts.rho, needs.rho),
+            (Constant::C, consts.c, needs.c),
+            (Constant::Sigma, consts.sigma, needs.sigma),
+            (Constant::Rho, consts.rho, needs.rho),
         ] {
             if used && !v.is_finite() {
                 return Err(RunError::NoConstants(
-                    format!("{what} = {v} is not finite").into(),
+                    Problem::ConstantNotFinite {
+                        constant: what,
+                        value: v,
+                    }
+                    .into(),
                 ));
             }
         }
         // Rigorous factorisation of P, used by every P^-1 quantity.
         let chol = linalg::cholesky(&linalg::to_intervals(metric), n).ok_or_else(|| {
-            RunError::Invalid(
-                Detail::from("the metric P is not (certifiably) symmetric positive definite")
-                    .at_setting(Setting::Metric),
-            )
+            RunError::Invalid(Detail::from(Problem::MetricIndefinite).at_setting(Setting::Metric))
         })?;
         let p_inv_diag = linalg::inverse_diagonal(&chol, n);
         let checks = safety::Check::all(&info.unsafe_sets, n, &chol, &p_inv_diag)
-            .map_err(|m| RunError::Invalid(m.into()))?;
+            .map_err(|e| RunError::Invalid(Problem::UnsafeSet(e).into()))?;
         Ok(Setup {
             consts,
             n,
@@ -310,10 +314,22 @@ impl Run<'_> {
     }
 }
 
-/// Runs one analysis of the model as the spec wrote it (its initial set, inputs anywhere in
-/// the input box). The same as [`Reach::for_analysis`](crate::Reach::for_analysis) then
+/// Runs the analysis `name` of the model as the spec wrote it (its initial set, inputs
+/// anywhere in the input box). The same as [`Reach::new`](crate::Reach::new) then
 /// [`Reach::run`](crate::Reach::run).
-pub fn run(sys: &dyn System, info: &ModelInfo, analysis: &Analysis) -> Result<Prs, RunError> {
+pub fn run(model: &dyn Model, name: &str) -> Result<Prs, RunError> {
+    crate::Reach::new(model, name)?.run()
+}
+
+/// Runs `analysis` (one built by hand) of the system `sys` with the model data `info`: test
+/// support (feature `test-util`), for tests of what the engines do with unusual data.
+#[cfg(feature = "test-util")]
+#[doc(hidden)]
+pub fn run_paired(
+    sys: &dyn System,
+    info: &ModelInfo,
+    analysis: &crate::model::Analysis,
+) -> Result<Prs, RunError> {
     crate::Reach::for_analysis(sys, info, analysis)?.run()
 }
 
@@ -354,13 +370,17 @@ pub(crate) fn validate(
     n: usize,
     p: usize,
 ) -> Result<(), RunError> {
-    let bad = |m: String| Err(RunError::Invalid(m.into()));
-    let bad_setting = |s: Setting, m: String| Err(RunError::Invalid(Detail::from(m).at_setting(s)));
+    let bad = |m: Problem| Err(RunError::Invalid(m.into()));
+    let bad_setting =
+        |s: Setting, m: Problem| Err(RunError::Invalid(Detail::from(m).at_setting(s)));
     if let Split::Auto { pieces, .. } = a.split {
         if !(1..=MAX_PIECES).contains(&pieces) {
             return bad_setting(
                 Setting::Split,
-                format!("split = auto(pieces = {pieces}) must allow 1 to {MAX_PIECES} pieces"),
+                Problem::SplitPieces {
+                    pieces,
+                    max: MAX_PIECES,
+                },
             );
         }
     }
@@ -368,65 +388,54 @@ pub(crate) fn validate(
         if k.len() != n || k.contains(&0) || a.split.pieces() > MAX_PIECES {
             return bad_setting(
                 Setting::Split,
-                format!(
-                    "split = {k:?} must give one count of at least 1 per state ({n}), at most \
-                     {MAX_PIECES} pieces in all"
-                ),
+                Problem::SplitCounts {
+                    counts: k.clone(),
+                    n,
+                    max: MAX_PIECES,
+                },
             );
         }
     }
     if !(a.delta > 0.0 && a.delta < 1.0) {
-        return bad_setting(
-            Setting::Delta,
-            format!("delta = {} must lie in (0, 1)", a.delta),
-        );
+        return bad_setting(Setting::Delta, Problem::Delta(a.delta));
     }
     if !(a.step >= MIN_REPORT_STEP && a.step.is_finite()) {
         return bad_setting(
             Setting::Step,
-            format!(
-                "step = {} must be finite and at least {MIN_REPORT_STEP:e}",
-                a.step
-            ),
+            Problem::Step {
+                step: a.step,
+                min: MIN_REPORT_STEP,
+            },
         );
     }
     if !(a.horizon >= 0.0 && a.horizon.is_finite()) {
-        return bad_setting(
-            Setting::Horizon,
-            format!("horizon = {} must be non-negative and finite", a.horizon),
-        );
+        return bad_setting(Setting::Horizon, Problem::Horizon(a.horizon));
     }
     if a.horizon / a.step > 1e8 {
         return bad_setting(
             Setting::Step,
-            format!(
-                "horizon / step = {} report steps is too many",
-                a.horizon / a.step
-            ),
+            Problem::TooManyReportSteps(a.horizon / a.step),
         );
     }
     if let RadiusRule::Paper(eps) = a.radius {
         if !(eps > 0.0 && eps < 1.0) {
-            return bad_setting(
-                Setting::Radius,
-                format!("the paper rule's eps = {eps} must lie in (0, 1)"),
-            );
+            return bad_setting(Setting::Radius, Problem::PaperEps(eps));
         }
     }
     if n == 0 {
-        return bad("the model has no states".into());
+        return bad(Problem::NoStates);
     }
     if info.states.len() != n {
-        return bad(format!(
-            "the model info names {} states, the system has {n}",
-            info.states.len()
-        ));
+        return bad(Problem::StateNames {
+            names: info.states.len(),
+            n,
+        });
     }
     if info.input_box.len() != p {
-        return bad(format!(
-            "the input box has {} ranges, the system has {p} inputs",
-            info.input_box.len()
-        ));
+        return bad(Problem::InputRanges {
+            ranges: info.input_box.len(),
+            p,
+        });
     }
     let unsafe_parts = info
         .unsafe_sets
@@ -438,24 +447,19 @@ pub(crate) fn validate(
         .map(|g| (&g.name, &g.parts[..], &g.moving));
     for (name, parts, moving) in unsafe_parts.chain(goal_parts) {
         if !moving.iter().all(|m| crate::sweep::fits(m, parts)) {
-            return bad(format!(
-                "the moving numbers of set `{name}` do not fit its shape"
-            ));
+            return bad(Problem::MovingNumbers { set: name.clone() });
         }
     }
     for (j, b) in info.input_box.iter().enumerate() {
         if Interval::try_new(b.lo, b.hi).is_none_or(|iv| !iv.is_bounded()) {
-            return bad(format!(
-                "input box of input {j} is [{}, {}] (must be bounded)",
-                b.lo, b.hi
-            ));
+            return bad(Problem::UnboundedInput {
+                input: j,
+                range: *b,
+            });
         }
     }
     if let Some(&i) = a.outputs.iter().find(|&&i| i >= n) {
-        return bad_setting(
-            Setting::Outputs,
-            format!("output state index {i} is out of range (n = {n})"),
-        );
+        return bad_setting(Setting::Outputs, Problem::Output { index: i, n });
     }
     Ok(())
 }
@@ -466,20 +470,19 @@ pub(crate) fn validate(
 fn covered(info: &ModelInfo, spec: &AnalysisSpec, consts: &Constants) -> Result<(), RunError> {
     let region = &consts.region;
     let what = if region.domain != info.domain {
-        "domain"
+        Coverage::Domain
     } else if region.input_box != info.input_box {
-        "input box"
+        Coverage::InputBox
     } else if !(spec.horizon <= region.time.hi && region.time.lo <= 0.0) {
-        "time range"
+        Coverage::TimeRange
     } else {
         return Ok(());
     };
     Err(RunError::Invalid(
-        format!(
-            "the constants of analysis `{}` were certified for another {what} than the model's: \
-             change the spec and compile it again",
-            spec.name
-        )
+        Problem::NotCovered {
+            analysis: spec.name.clone(),
+            what,
+        }
         .into(),
     ))
 }
@@ -493,7 +496,7 @@ pub(crate) fn check_initial(
 ) -> Result<(), RunError> {
     let n = info.states.len();
     let (center, half) = radius::initial_center_and_halfwidths(initial, n)
-        .map_err(|m| RunError::Invalid(m.into()))?;
+        .map_err(|e| RunError::Invalid(Problem::InitialSet(e).into()))?;
     if info.has_domain && in_domain {
         for i in 0..n {
             // Boxes as given; ball coordinates by their bounding boxes (rounded outward).
@@ -504,11 +507,11 @@ pub(crate) fn check_initial(
             let domain = info.domain[i];
             if lo < domain.lo || hi > domain.hi {
                 return Err(RunError::Invalid(
-                    Detail::from(format!(
-                        "the initial set leaves the domain in state `{}` ([{lo}, {hi}] is not \
-                         in [{}, {}]): the constants hold only in the domain",
-                        info.states[i], domain.lo, domain.hi
-                    ))
+                    Detail::from(Problem::InitialOutsideDomain {
+                        state: info.states[i].clone(),
+                        range: Bounds { lo, hi },
+                        domain,
+                    })
                     .at(Culprit::State(i)),
                 ));
             }

@@ -3,6 +3,7 @@
 //! arithmetic with the upper ends kept.
 
 use super::linalg;
+use super::problem::InitialSetError;
 use crate::interval::{Interval, ELEM_ULPS};
 use crate::model::{AnalysisSpec, Bounds, InitialSet, RadiusRule};
 use crate::prs::RuleUsed;
@@ -109,12 +110,12 @@ impl PsiStep {
 pub(crate) fn initial_center_and_halfwidths(
     init: &InitialSet,
     n: usize,
-) -> Result<(Vec<f64>, Vec<f64>), String> {
+) -> Result<(Vec<f64>, Vec<f64>), InitialSetError> {
     if init.boxes.len() != n {
-        return Err(format!(
-            "the initial set has {} per-state entries, the model has {n} states",
-            init.boxes.len()
-        ));
+        return Err(InitialSetError::Entries {
+            entries: init.boxes.len(),
+            n,
+        });
     }
     let mut center = vec![f64::NAN; n];
     let mut half = vec![f64::NAN; n];
@@ -122,8 +123,9 @@ pub(crate) fn initial_center_and_halfwidths(
         if let Some(Bounds { lo, hi }) = *b {
             let iv = Interval::try_new(lo, hi)
                 .filter(|iv| iv.is_bounded())
-                .ok_or_else(|| {
-                    format!("initial box of state {i} is [{lo}, {hi}] (must be bounded)")
+                .ok_or(InitialSetError::UnboundedBox {
+                    state: i,
+                    range: Bounds { lo, hi },
                 })?;
             center[i] = iv.mid();
             half[i] = iv.rad();
@@ -132,33 +134,34 @@ pub(crate) fn initial_center_and_halfwidths(
     for (bi, ball) in init.balls.iter().enumerate() {
         let k = ball.states.len();
         if ball.center.len() != k || !ball.radius.is_finite() || ball.radius < 0.0 {
-            return Err(format!("initial ball #{bi} is malformed"));
+            return Err(InitialSetError::MalformedBall { ball: bi });
         }
         let diag_inv: Vec<Interval> = match &ball.metric {
             None => vec![Interval::ONE; k],
             Some(m) => {
                 if m.len() != k * k {
-                    return Err(format!("initial ball #{bi}: metric is not {k} x {k}"));
+                    return Err(InitialSetError::BallMetricSize { ball: bi, k });
                 }
-                let l = linalg::cholesky(&linalg::to_intervals(m), k).ok_or_else(|| {
-                    format!("initial ball #{bi}: metric is not (certifiably) positive definite")
-                })?;
+                let l = linalg::cholesky(&linalg::to_intervals(m), k)
+                    .ok_or(InitialSetError::BallMetricIndefinite { ball: bi })?;
                 let inv = linalg::inverse_block(&l, k, &(0..k).collect::<Vec<_>>());
                 (0..k).map(|i| inv[i * k + i]).collect()
             }
         };
         for (j, &s) in ball.states.iter().enumerate() {
             if s >= n {
-                return Err(format!("initial ball #{bi} refers to state {s} (n = {n})"));
+                return Err(InitialSetError::BallState {
+                    ball: bi,
+                    state: s,
+                    n,
+                });
             }
             center[s] = ball.center[j];
             half[s] = (Interval::point(ball.radius) * diag_inv[j].sqrt()).hi();
         }
     }
     if let Some(i) = (0..n).find(|&i| center[i].is_nan()) {
-        return Err(format!(
-            "state {i} is in neither an initial box nor an initial ball"
-        ));
+        return Err(InitialSetError::Missing { state: i });
     }
     Ok((center, half))
 }

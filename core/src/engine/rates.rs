@@ -3,8 +3,7 @@
 //! follow their per-step recursions with it (Proposition 2 and eq. Psi with piecewise-constant
 //! rates).
 
-use super::{Detail, Run, RunError, Setting};
-use crate::decimal::time;
+use super::{Detail, Problem, Run, RunError, Setting};
 use crate::model::ModelInfo;
 use crate::simulate::{self, InputMode};
 
@@ -41,8 +40,7 @@ pub(crate) fn empirical(
     };
     let sampled = simulate::sample_paths(sys, &info, grid, Some(&traj[0]), &opts).map_err(|e| {
         RunError::Invalid(
-            Detail::from(format!("sampling paths for the empirical rate: {e}"))
-                .at_setting(Setting::Rate),
+            Detail::from(Problem::EmpiricalSampling(Box::new(e))).at_setting(Setting::Rate),
         )
     })?;
     // Per report time, the pooled quotient over the paths.
@@ -56,11 +54,7 @@ pub(crate) fn empirical(
             let x = &path[k * n..(k + 1) * n];
             if x.iter().any(|v| !v.is_finite()) {
                 return Err(RunError::NonFinite(
-                    Detail::from(format!(
-                        "a sample path of the empirical rate estimate is not finite at t = {}",
-                        time(t)
-                    ))
-                    .at_setting(Setting::Rate),
+                    Detail::from(Problem::EmpiricalPathNotFinite(t)).at_setting(Setting::Rate),
                 ));
             }
             sys.drift(x, u_center, t, &mut fx);
@@ -91,12 +85,7 @@ pub(crate) fn empirical(
     }
     if let Some(k) = rates.iter().position(|c| !c.is_finite()) {
         return Err(RunError::NonFinite(
-            Detail::from(format!(
-                "no finite empirical rate at t = {} (every sample equals the nominal, or a drift \
-                 is not finite)",
-                time(grid[k])
-            ))
-            .at_setting(Setting::Rate),
+            Detail::from(Problem::EmpiricalRateNotFinite(grid[k])).at_setting(Setting::Rate),
         ));
     }
     Ok(rates)

@@ -8,6 +8,7 @@
 //! (the report marks how it was computed).
 
 use super::linalg;
+use super::problem::{UnsafeSetError, UnsafeSetFault};
 use crate::interval::Interval;
 use crate::model::{UnsafeSet, UnsafeShape};
 use crate::prs::{DetSet, Span, UnsafeKind};
@@ -150,7 +151,7 @@ impl Check {
         n: usize,
         l: &[Interval],
         p_inv_diag: &[Interval],
-    ) -> Result<Vec<Check>, String> {
+    ) -> Result<Vec<Check>, UnsafeSetError> {
         sets.iter()
             .map(|s| Check::new(s, n, l, p_inv_diag))
             .collect()
@@ -163,15 +164,18 @@ impl Check {
         n: usize,
         l: &[Interval],
         p_inv_diag: &[Interval],
-    ) -> Result<Check, String> {
-        let bad = |what: &str| format!("unsafe set `{}`: {what}", set.name);
+    ) -> Result<Check, UnsafeSetError> {
+        let bad = |fault: UnsafeSetFault| UnsafeSetError {
+            set: set.name.clone(),
+            fault,
+        };
         match &set.shape {
             UnsafeShape::HalfSpace { normal, offset } => {
                 if normal.len() != n {
-                    return Err(bad(&format!(
-                        "normal has {} entries, n = {n}",
-                        normal.len()
-                    )));
+                    return Err(bad(UnsafeSetFault::NormalLength {
+                        entries: normal.len(),
+                        n,
+                    }));
                 }
                 let q = linalg::inv_quad_form(l, n, normal);
                 let norm = normal
@@ -189,7 +193,7 @@ impl Check {
                 let mut out = Vec::with_capacity(coords.len());
                 for &(i, range) in coords {
                     if i >= n {
-                        return Err(bad(&format!("refers to state {i}, n = {n}")));
+                        return Err(bad(UnsafeSetFault::State { state: i, n }));
                     }
                     out.push((i, (range.lo, range.hi), p_inv_diag[i].sqrt().hi()));
                 }
@@ -202,7 +206,7 @@ impl Check {
             } => {
                 let k = states.len();
                 if center.len() != k || states.iter().any(|&s| s >= n) {
-                    return Err(bad("states and centre do not match the model"));
+                    return Err(bad(UnsafeSetFault::Ball));
                 }
                 let sub = linalg::inverse_block(l, n, states);
                 let lam = linalg::lambda_max_upper(&sub, k);

@@ -8,7 +8,6 @@ use super::safety::Check;
 use crate::interval::Interval;
 use crate::model::{Bounds, Guarantee, UnsafeSet, UnsafeShape};
 use crate::prs::{Prs, Role, Validation};
-use std::fmt;
 
 /// A state constraint of the stochastic system (a set the state must stay in).
 #[derive(Clone, Debug, PartialEq)]
@@ -75,22 +74,6 @@ pub enum TightenError {
     /// The result's metric could not be factorised (`P` not positive definite in interval
     /// arithmetic).
     Metric,
-}
-
-impl fmt::Display for TightenError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            TightenError::Malformed { index, what } => write!(f, "constraint {index}: {what}"),
-            TightenError::UnsafeSet(name) => {
-                write!(f, "unsafe set `{name}` does not fit the model")
-            }
-            TightenError::NoDeviationBound => f.write_str(
-                "the result is the linearised Gaussian set alone (method.md 8.12): it bounds the \
-                 state, not its distance from the nominal, so it gives no tightening",
-            ),
-            TightenError::Metric => f.write_str("the result's metric is not positive definite"),
-        }
-    }
 }
 
 impl std::error::Error for TightenError {}

@@ -11,7 +11,7 @@
 //! results' `contains` and the Monte Carlo check ask.
 
 use super::boxes::{nearest_in_box, rows};
-use crate::engine::{Detail, RunError, Setting};
+use crate::engine::{Detail, Problem, RunError, Setting};
 use crate::interval::Interval;
 use crate::model::{Transform, TransformSource};
 use crate::prs::TransformUsed;
@@ -54,18 +54,17 @@ impl Frame {
     pub(crate) fn new(tr: &Transform, n: usize) -> Result<Frame, RunError> {
         if tr.matrix.len() != n * n || tr.inverse.len() != n * n {
             return Err(RunError::Invalid(
-                Detail::from(format!(
-                    "the transform must be {n} x {n} (it has {} entries, its inverse {})",
-                    tr.matrix.len(),
-                    tr.inverse.len()
-                ))
+                Detail::from(Problem::TransformSize {
+                    n,
+                    matrix: tr.matrix.len(),
+                    inverse: tr.inverse.len(),
+                })
                 .at_setting(Setting::Transform),
             ));
         }
         if tr.matrix.iter().chain(&tr.inverse).any(|v| !v.is_finite()) {
             return Err(RunError::Invalid(
-                Detail::from("the transform or its inverse has non-finite entries")
-                    .at_setting(Setting::Transform),
+                Detail::from(Problem::TransformNotFinite).at_setting(Setting::Transform),
             ));
         }
         let pt = |v: &[f64]| -> Vec<Interval> { v.iter().map(|&x| Interval::point(x)).collect() };
@@ -86,11 +85,8 @@ impl Frame {
         let norm_r = inf_norm(&r, n);
         if norm_r >= 0.5 {
             return Err(RunError::Invalid(
-                Detail::from(format!(
-                    "the transform's inverse is inaccurate (|I - T^-1 T| = {norm_r:.3e}): T is \
-                     too ill-conditioned"
-                ))
-                .at_setting(Setting::Transform),
+                Detail::from(Problem::TransformIllConditioned(norm_r))
+                    .at_setting(Setting::Transform),
             ));
         }
         let e = if norm_r == 0.0 {

@@ -260,14 +260,15 @@ fn bound_on<S: System + ?Sized>(
 
 /// The number of Euler-Maruyama steps of each report interval of `times` and how they compare
 /// with the rule: equal steps of at most `dt_option` when given, the rule's otherwise. An error
-/// (a usage error) when `dt_option` gives more than `1e9` steps in one interval.
+/// (a usage error: the step, given or the rule's) when it gives more than `1e9` steps in one
+/// interval.
 pub(crate) fn choose<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
     result: &Prs,
     times: &[f64],
     dt_option: Option<f64>,
-) -> Result<(Vec<u32>, DtUsed), String> {
+) -> Result<(Vec<u32>, DtUsed), f64> {
     let mut used = DtUsed {
         source: dt_option.map_or(DtSource::Rule, |_| DtSource::Option),
         min: f64::INFINITY,
@@ -288,10 +289,7 @@ pub(crate) fn choose<S: System + ?Sized>(
             None => f64::from(MAX_STEPS),
         };
         if s.is_nan() || s > 1e9 {
-            return Err(format!(
-                "dt = {} gives too many Euler steps",
-                dt_option.unwrap_or(rule)
-            ));
+            return Err(dt_option.unwrap_or(rule));
         }
         let h = width / s;
         let hl = if l.is_finite() { h * l } else { f64::INFINITY };

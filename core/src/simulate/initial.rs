@@ -1,6 +1,7 @@
 //! Random initial states: uniform in the initial set (its boxes, and its balls, which are
 //! ellipsoids `{x_S : (x_S - c)' M (x_S - c) <= r^2}`).
 
+use super::error::InitialFault;
 use super::normal::Ziggurat;
 use super::report::InitialSampling;
 use super::rng::PathRng;
@@ -31,12 +32,12 @@ pub(crate) struct InitialSampler {
 
 impl InitialSampler {
     /// Checks the initial set (bounded, every state covered once) and prepares the sampler.
-    pub(crate) fn new(set: &InitialSet, n: usize) -> Result<Self, String> {
+    pub(crate) fn new(set: &InitialSet, n: usize) -> Result<Self, InitialFault> {
         if set.boxes.len() != n {
-            return Err(format!(
-                "the initial set has {} entries, the system has {n} states",
-                set.boxes.len()
-            ));
+            return Err(InitialFault::Entries {
+                entries: set.boxes.len(),
+                n,
+            });
         }
         let mut covered = vec![false; n];
         let mut base = vec![0.0; n];
@@ -44,9 +45,10 @@ impl InitialSampler {
         for (i, b) in set.boxes.iter().enumerate() {
             if let Some(crate::model::Bounds { lo, hi }) = *b {
                 if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
-                    return Err(format!(
-                        "the initial box of state {i} is [{lo}, {hi}]: it must be bounded"
-                    ));
+                    return Err(InitialFault::UnboundedBox {
+                        state: i,
+                        range: crate::model::Bounds { lo, hi },
+                    });
                 }
                 covered[i] = true;
                 base[i] = lo;
@@ -59,21 +61,17 @@ impl InitialSampler {
         for ball in &set.balls {
             let k = ball.states.len();
             if ball.center.len() != k || !(ball.radius.is_finite() && ball.radius >= 0.0) {
-                return Err("an initial ball has a bad centre or radius".into());
+                return Err(InitialFault::Ball);
             }
             for &i in &ball.states {
                 if i >= n || covered[i] {
-                    return Err(format!(
-                        "state {i} is in more than one part of the initial set"
-                    ));
+                    return Err(InitialFault::Repeated { state: i });
                 }
                 covered[i] = true;
             }
             let chol = match &ball.metric {
                 None => None,
-                Some(m) => Some(cholesky(m, k).ok_or_else(|| {
-                    "an initial ball's metric is not positive definite".to_string()
-                })?),
+                Some(m) => Some(cholesky(m, k).ok_or(InitialFault::BallMetric)?),
             };
             balls.push(Ball {
                 states: ball.states.clone(),
@@ -83,7 +81,7 @@ impl InitialSampler {
             });
         }
         if let Some(i) = covered.iter().position(|c| !c) {
-            return Err(format!("state {i} has no initial value"));
+            return Err(InitialFault::Missing { state: i });
         }
         let max_ball = balls.iter().map(|b| b.states.len()).max().unwrap_or(0);
         Ok(InitialSampler {
@@ -218,15 +216,17 @@ mod tests {
             boxes: vec![Some(Bounds::new(0.0, f64::INFINITY))],
             balls: vec![],
         };
-        assert!(InitialSampler::new(&set, 1)
-            .unwrap_err()
-            .contains("bounded"));
+        assert!(matches!(
+            InitialSampler::new(&set, 1),
+            Err(InitialFault::UnboundedBox { state: 0, .. })
+        ));
         let set = InitialSet {
             boxes: vec![None],
             balls: vec![],
         };
-        assert!(InitialSampler::new(&set, 1)
-            .unwrap_err()
-            .contains("no initial value"));
+        assert!(matches!(
+            InitialSampler::new(&set, 1),
+            Err(InitialFault::Missing { state: 0 })
+        ));
     }
 }

@@ -4,6 +4,7 @@
 //! part merged alone, so a merged report is the unsharded one to the bit.
 
 use super::binomial;
+use super::error::{MergeError, RunDifference, RunOption};
 use super::part::{Part, PartStats, RunInfo};
 use super::part_file::run_bytes;
 use super::report::{
@@ -15,20 +16,6 @@ use super::topk::TopK;
 use super::{InputMode, QUANTILE_BYTES};
 use crate::model::Guarantee;
 use std::collections::BTreeMap;
-use std::fmt;
-
-/// Why parts cannot be merged: a message naming the offending parts by their labels (file
-/// names, for `reachc simulate merge`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct MergeError(pub String);
-
-impl fmt::Display for MergeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for MergeError {}
 
 /// The parts of one run, added one at a time (memory: the largest `j` distances per report
 /// time, twice at most, whatever the number of parts).
@@ -63,9 +50,12 @@ impl Merger {
     /// Adds the part `label` (how errors name it): refused when malformed, from another run
     /// than the parts before it, or of a shard already added.
     pub fn add(&mut self, label: &str, part: Part) -> Result<(), MergeError> {
-        let err = |m: String| Err(MergeError(m));
-        if let Some(why) = part.malformed() {
-            return err(format!("`{label}` is not a valid part: {why}"));
+        let err = Err;
+        if let Some(fault) = part.malformed() {
+            return err(MergeError::Malformed {
+                label: label.to_string(),
+                fault,
+            });
         }
         match &self.first {
             None => {
@@ -73,12 +63,13 @@ impl Merger {
                 let (steps, n) = (run.steps.len(), run.states.len());
                 let buffers = steps as u64 * (1 + n as u64);
                 if run.quantile_rank.saturating_mul(16 * buffers) > QUANTILE_BYTES {
-                    return err(format!(
-                        "`{label}`: exact quantiles of rank {} over {steps} report times and {n} \
-                         states need more than {} GiB",
-                        run.quantile_rank,
-                        QUANTILE_BYTES >> 30
-                    ));
+                    return err(MergeError::QuantileMemory {
+                        label: label.to_string(),
+                        rank: run.quantile_rank,
+                        steps,
+                        n,
+                        max_gib: QUANTILE_BYTES >> 30,
+                    });
                 }
                 let j = usize::try_from(run.quantile_rank).unwrap_or(usize::MAX);
                 self.topk = Some((TopK::new(steps, j), TopK::new(steps * n, j)));
@@ -90,24 +81,29 @@ impl Merger {
                 ));
             }
             Some((first, run, bytes, count)) => {
-                if let Some(what) = difference(run, &part.run, bytes) {
-                    return err(format!(
-                        "`{label}` and `{first}` are not parts of the same simulation: {what}"
-                    ));
+                if let Some(difference) = difference(run, &part.run, bytes) {
+                    return err(MergeError::OtherRun {
+                        label: label.to_string(),
+                        first: first.clone(),
+                        difference,
+                    });
                 }
                 if part.shard.count != *count {
-                    return err(format!(
-                        "`{label}` is shard {} but `{first}` is one of {count} shards",
-                        part.shard
-                    ));
+                    return err(MergeError::ShardCount {
+                        label: label.to_string(),
+                        shard: part.shard,
+                        first: first.clone(),
+                        count: *count,
+                    });
                 }
             }
         }
         if let Some(other) = self.seen.get(&part.shard.index) {
-            return err(format!(
-                "`{label}` and `{other}` are both shard {}",
-                part.shard
-            ));
+            return err(MergeError::Repeated {
+                label: label.to_string(),
+                other: other.clone(),
+                shard: part.shard,
+            });
         }
         self.seen.insert(part.shard.index, label.to_string());
         match &mut self.stats {
@@ -130,26 +126,21 @@ impl Merger {
         let (Some((_, run, _, count)), Some(stats), Some((mut topk, mut state_topk))) =
             (self.first, self.stats, self.topk)
         else {
-            return Err(MergeError("no parts to merge".into()));
+            return Err(MergeError::NoParts);
         };
-        let missing: Vec<String> = (0..count)
+        let missing: Vec<Shard> = (0..count)
             .filter(|i| !self.seen.contains_key(i))
             .take(10)
-            .map(|i| Shard { index: i, count }.to_string())
+            .map(|i| Shard { index: i, count })
             .collect();
         if !missing.is_empty() {
             let more = count - self.seen.len() as u64 - missing.len() as u64;
-            let more = if more > 0 {
-                format!(" and {more} more")
-            } else {
-                String::new()
-            };
-            return Err(MergeError(format!(
-                "missing shard{} {}{more} (have {} of {count})",
-                if missing.len() > 1 { "s" } else { "" },
-                missing.join(", "),
-                self.seen.len()
-            )));
+            return Err(MergeError::Missing {
+                missing,
+                more,
+                have: self.seen.len(),
+                count,
+            });
         }
         Ok(report(&run, &stats, &mut topk, &mut state_topk))
     }
@@ -166,47 +157,58 @@ pub fn merge(parts: impl IntoIterator<Item = (String, Part)>) -> Result<SimRepor
 
 /// What differs between two runs, `a` of bytes `a_bytes` (as a part file holds them): the first
 /// option that does, by name, or the analysis' result; `None` if they are the same to the bit.
-fn difference(a: &RunInfo, b: &RunInfo, a_bytes: &[u8]) -> Option<String> {
+fn difference(a: &RunInfo, b: &RunInfo, a_bytes: &[u8]) -> Option<RunDifference> {
     let named = [
-        ("reachc version", a.version.clone(), b.version.clone()),
-        ("spec (SHA-256)", a.spec_hash.clone(), b.spec_hash.clone()),
-        ("model", a.model.clone(), b.model.clone()),
-        ("analysis", a.analysis.clone(), b.analysis.clone()),
-        ("paths", a.paths.to_string(), b.paths.to_string()),
-        ("seed", a.seed.to_string(), b.seed.to_string()),
-        ("delta", format!("{:?}", a.delta), format!("{:?}", b.delta)),
+        (RunOption::Version, a.version.clone(), b.version.clone()),
+        (RunOption::Spec, a.spec_hash.clone(), b.spec_hash.clone()),
+        (RunOption::Model, a.model.clone(), b.model.clone()),
+        (RunOption::Analysis, a.analysis.clone(), b.analysis.clone()),
+        (RunOption::Paths, a.paths.to_string(), b.paths.to_string()),
+        (RunOption::Seed, a.seed.to_string(), b.seed.to_string()),
         (
-            "dt",
+            RunOption::Delta,
+            format!("{:?}", a.delta),
+            format!("{:?}", b.delta),
+        ),
+        (
+            RunOption::Dt,
             format!("{:?}", a.dt_option),
             format!("{:?}", b.dt_option),
         ),
-        ("inputs", a.inputs.name().into(), b.inputs.name().into()),
         (
-            "hold",
+            RunOption::Inputs,
+            a.inputs.name().into(),
+            b.inputs.name().into(),
+        ),
+        (
+            RunOption::Hold,
             format!("{:?}", a.hold_option),
             format!("{:?}", b.hold_option),
         ),
         (
-            "confidence",
+            RunOption::Confidence,
             format!("{:?}", a.confidence),
             format!("{:?}", b.confidence),
         ),
         (
-            "probability bound",
+            RunOption::ProbabilityBound,
             format!("{:?}", a.safety_bound),
             format!("{:?}", b.safety_bound),
         ),
         (
-            "goal probability bounds",
+            RunOption::GoalBounds,
             format!("{:?}", a.goals),
             format!("{:?}", b.goals),
         ),
     ];
-    if let Some((what, x, y)) = named.into_iter().find(|(_, x, y)| x != y) {
-        return Some(format!("{what} {y} there, {x} in the first part"));
+    if let Some((option, x, y)) = named.into_iter().find(|(_, x, y)| x != y) {
+        return Some(RunDifference::Option {
+            option,
+            there: y,
+            first: x,
+        });
     }
-    (run_bytes(b) != a_bytes)
-        .then(|| "the analysis' results or the sampling differ (same options)".to_string())
+    (run_bytes(b) != a_bytes).then_some(RunDifference::Results)
 }
 
 /// Quantiles, Clopper-Pearson bounds and the verdict from the merged statistics (`topk`: the
@@ -379,7 +381,7 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut To
 mod tests {
     use super::super::part_file::FORMAT_VERSION;
     use super::super::tests::{info, narrow, sys};
-    use super::super::{run_part, simulate, Options};
+    use super::super::{run_part_paired, simulate_paired, Options};
     use super::*;
     use crate::engine;
     use crate::prs::Prs;
@@ -391,7 +393,7 @@ mod tests {
         (0..shards)
             .map(|i| {
                 let shard = Shard::new(i, shards).unwrap();
-                let part = run_part(sys, &info, r, opts, shard, &mut |_, _| {}).unwrap();
+                let part = run_part_paired(sys, &info, r, opts, shard, &mut |_, _| {}).unwrap();
                 let bytes = part.to_bytes();
                 let read = Part::from_bytes(&bytes).unwrap();
                 assert_eq!(read, part);
@@ -409,7 +411,7 @@ mod tests {
     fn sharded_runs_merge_into_the_unsharded_report() {
         for b in [0.0, 1.0] {
             let (sys, info) = (sys(b), info(b));
-            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             let mut pointwise = narrow(&r, 0.5);
             pointwise.guarantee = Guarantee::Pointwise;
             for r in [narrow(&r, 0.5), pointwise] {
@@ -419,7 +421,7 @@ mod tests {
                     dt: Some(0.005),
                     ..Options::default()
                 };
-                let whole = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+                let whole = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
                 assert_eq!(whole.quantile_rank, 51);
                 if r.guarantee == Guarantee::Uniform {
                     assert!(whole.tube.as_ref().unwrap().outside > 30);
@@ -435,7 +437,7 @@ mod tests {
     }
 
     fn merge_error(parts: Vec<(String, Part)>) -> String {
-        merge(parts).unwrap_err().0
+        merge(parts).unwrap_err().to_string()
     }
 
     /// Missing and repeated shards, parts of other runs (seed, paths, shard count, analysis
@@ -443,7 +445,7 @@ mod tests {
     #[test]
     fn merge_refuses_parts_that_do_not_belong_together() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 200,
             ..Options::default()
@@ -507,7 +509,7 @@ mod tests {
     #[test]
     fn malformed_parts_are_refused() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 100,
             ..Options::default()
@@ -542,14 +544,14 @@ mod tests {
     #[test]
     fn bad_part_files_are_refused() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 50,
             ..Options::default()
         };
         let mut part = parts(&sys, &r, &opts, 1).remove(0).1;
         let bytes = part.to_bytes();
-        let read = |b: &[u8]| Part::from_bytes(b).unwrap_err();
+        let read = |b: &[u8]| Part::from_bytes(b).unwrap_err().to_string();
         // A shard that cannot be (index 5 of 3), with a good checksum: refused as it is read.
         part.shard = Shard { index: 5, count: 3 };
         assert_eq!(

@@ -32,6 +32,7 @@
 mod avx512;
 mod binomial;
 mod dt;
+mod error;
 mod initial;
 mod inputs;
 mod merge;
@@ -51,8 +52,12 @@ mod topk;
 pub use crate::workers::thread_count;
 pub use binomial::{lower_bound as clopper_pearson_lower, upper_bound as clopper_pearson_upper};
 pub use dt::{DtSource, DtUsed, ACCURACY as DT_ACCURACY, MAX_STEPS, RULE as DT_RULE};
+pub use error::{
+    Coded, InitialFault, MergeError, PartFault, PartFileError, RegionFault, RunDifference,
+    RunOption, SimError, SimInvalid, SimUsage, SpanFault,
+};
 pub use inputs::InputMode;
-pub use merge::{merge, MergeError, Merger};
+pub use merge::{merge, Merger};
 pub use part::{Part, PartStats, RunInfo, StepInfo};
 pub use part_file::{FORMAT_VERSION, MAGIC};
 pub use report::{
@@ -60,15 +65,14 @@ pub use report::{
     SimReport, SimStep, StateSpread, TubeReport, UnsafeHits,
 };
 pub use sample::{result_paths, result_substeps, sample_paths, Substeps, MAX_SAMPLE_PATHS};
-pub use shard::Shard;
+pub use shard::{Shard, ShardError};
 
 use crate::interval::Interval;
 use crate::model::{Guarantee, ModelInfo};
 use crate::prs::{Prs, UnsafeKind};
-use crate::system::System;
+use crate::system::{Model, System};
 use crate::workers::Workers;
 use paths::{ChunkStats, Plan, Span, Thresholds};
-use std::fmt;
 
 /// The version of reachc that simulates (recorded in parts: only parts of one version merge).
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -128,47 +132,78 @@ impl Default for Options {
     }
 }
 
-/// Why a simulation could not run.
-#[derive(Clone, Debug, PartialEq)]
-pub enum SimError {
-    /// Bad options (a usage error).
-    Usage(String),
-    /// The model or result cannot be simulated (inconsistent data, unbounded initial set...).
-    Invalid(String),
-}
-
-impl fmt::Display for SimError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            SimError::Usage(m) | SimError::Invalid(m) => f.write_str(m),
-        }
-    }
-}
-
-impl std::error::Error for SimError {}
-
-/// Simulates `opts.paths` sample paths of `sys` and checks them against `result` (an analysis
-/// of `info` computed by [`engine::run`](crate::engine::run)). `progress(done, total)` is called
-/// after each batch of paths, on the calling thread. The paths run on a pool of
+/// Simulates `opts.paths` sample paths of `model` and checks them against `result` (one of its
+/// analyses, computed by [`engine::run`](crate::engine::run)). `progress(done, total)` is
+/// called after each batch of paths, on the calling thread. The paths run on a pool of
 /// `opts.threads` threads, or on the current rayon pool.
 ///
 /// This is [`run_part`] of all the paths ([`Shard::WHOLE`]) merged alone ([`merge`]): the
 /// parts of a sharded run merge into this very report.
-pub fn simulate<S: System + Sync + ?Sized>(
+pub fn simulate<M: Model + ?Sized>(
+    model: &M,
+    result: &Prs,
+    opts: &Options,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<SimReport, SimError> {
+    whole(model, model.info(), result, opts, progress)
+}
+
+/// Simulates the paths of `shard` (of `opts.paths`) of `model` and returns their exact
+/// statistics, with what the report needs besides them ([`Part`]; its `run.spec_hash` is
+/// empty: the caller knows the spec). `progress(done, total)` counts the shard's paths.
+pub fn run_part<M: Model + ?Sized>(
+    model: &M,
+    result: &Prs,
+    opts: &Options,
+    shard: Shard,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Part, SimError> {
+    part(model, model.info(), result, opts, shard, progress)
+}
+
+/// [`simulate`] of the system `sys` with the model data `info`: test support (feature
+/// `test-util`), for tests of hand-written systems and data.
+#[cfg(feature = "test-util")]
+#[doc(hidden)]
+pub fn simulate_paired<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
     result: &Prs,
     opts: &Options,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<SimReport, SimError> {
-    let part = run_part(sys, info, result, opts, Shard::WHOLE, progress)?;
-    merge([(String::new(), part)]).map_err(|e| SimError::Invalid(e.0))
+    whole(sys, info, result, opts, progress)
 }
 
-/// Simulates the paths of `shard` (of `opts.paths`) and returns their exact statistics, with
-/// what the report needs besides them ([`Part`]; its `run.spec_hash` is empty: the caller
-/// knows the spec). `progress(done, total)` counts the shard's paths.
-pub fn run_part<S: System + Sync + ?Sized>(
+/// [`run_part`] of the system `sys` with the model data `info`: test support (feature
+/// `test-util`).
+#[cfg(feature = "test-util")]
+#[doc(hidden)]
+pub fn run_part_paired<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+    shard: Shard,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Part, SimError> {
+    part(sys, info, result, opts, shard, progress)
+}
+
+/// [`simulate`] of `sys` with its model data `info`.
+fn whole<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    result: &Prs,
+    opts: &Options,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<SimReport, SimError> {
+    let part = part(sys, info, result, opts, Shard::WHOLE, progress)?;
+    merge([(String::new(), part)]).map_err(|e| SimError::Invalid(SimInvalid::Merge(e)))
+}
+
+/// [`run_part`] of `sys` with its model data `info`.
+fn part<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
     result: &Prs,
@@ -181,10 +216,10 @@ pub fn run_part<S: System + Sync + ?Sized>(
     let n_paths = opts.paths;
     // (`index < count` holds by construction.)
     if shard.count > n_paths {
-        return Err(SimError::Usage(format!(
-            "shard {shard} of {n_paths} paths: the number of shards must be at most the number \
-             of paths"
-        )));
+        return Err(SimError::Usage(SimUsage::Shards {
+            shard,
+            paths: n_paths,
+        }));
     }
     // j-th largest = ceil((1 - delta) N)-th smallest; the slack keeps delta * N = 1000 (say)
     // from rounding down to 999. N is the whole run's: every part keeps the same j.
@@ -194,13 +229,14 @@ pub fn run_part<S: System + Sync + ?Sized>(
     let buffers = steps as u64 * (1 + n as u64);
     let quantile_bytes = 16u64.saturating_mul(j).saturating_mul(buffers);
     if quantile_bytes > QUANTILE_BYTES {
-        return Err(SimError::Usage(format!(
-            "exact quantiles of {n_paths} paths at delta = {} over {steps} report times and \
-             {n} states need {:.1} GiB (more than {} GiB): use fewer paths",
-            result.delta,
-            quantile_bytes as f64 / f64::from(1u32 << 30),
-            QUANTILE_BYTES >> 30
-        )));
+        return Err(SimError::Usage(SimUsage::QuantileMemory {
+            paths: n_paths,
+            delta: result.delta,
+            steps,
+            n,
+            bytes: quantile_bytes,
+            max_gib: QUANTILE_BYTES >> 30,
+        }));
     }
     // Batches: many chunks per batch for the threads, few enough candidates in memory. Until a
     // buffer has `j` values every path's distances are candidates (one per state and report
@@ -214,7 +250,8 @@ pub fn run_part<S: System + Sync + ?Sized>(
         .clamp(chunk, MAX_BATCH)
         .div_ceil(chunk)
         * chunk;
-    let workers = Workers::new(opts.threads).map_err(SimError::Invalid)?;
+    let workers =
+        Workers::new(opts.threads).map_err(|e| SimError::Invalid(SimInvalid::Threads(e)))?;
     let j = usize::try_from(j).unwrap_or(usize::MAX);
     let (mut topk, mut state_topk) = (topk::TopK::new(steps, j), topk::TopK::new(steps * n, j));
     let sets = &plan.sets;
@@ -352,71 +389,67 @@ fn make_plan<'a, S: System + ?Sized>(
     result: &'a Prs,
     opts: &Options,
 ) -> Result<Plan<'a, S>, SimError> {
-    let usage = |m: String| Err(SimError::Usage(m));
+    let usage = |m: SimUsage| Err(SimError::Usage(m));
     if opts.paths == 0 || opts.paths > rng::MAX_PATHS {
-        return usage(format!(
-            "the number of paths must be between 1 and {}, not {}",
-            rng::MAX_PATHS,
-            opts.paths
-        ));
+        return usage(SimUsage::Paths {
+            paths: opts.paths,
+            max: rng::MAX_PATHS,
+        });
     }
     if let Some(dt) = opts.dt.filter(|dt| !(*dt > 0.0 && dt.is_finite())) {
-        return usage(format!("dt = {dt} must be positive and finite"));
+        return usage(SimUsage::Dt(dt));
     }
     let hold = opts.hold.unwrap_or(result.step);
     if !(hold > 0.0 && hold.is_finite()) {
-        return usage(format!("the hold time {hold} must be positive and finite"));
+        return usage(SimUsage::Hold(hold));
     }
     let bounds = opts
         .safety_bound
         .iter()
         .chain(opts.goal_bounds.iter().flatten());
     if let Some(b) = bounds.copied().find(|b| !(0.0..=1.0).contains(b)) {
-        return usage(format!("the probability bound {b} must lie in [0, 1]"));
+        return usage(SimUsage::ProbabilityBound(b));
     }
     if !opts.goal_bounds.is_empty() && opts.goal_bounds.len() != info.goals.len() {
-        return usage(format!(
-            "{} goal probability bounds for {} goal sets",
-            opts.goal_bounds.len(),
-            info.goals.len()
-        ));
+        return usage(SimUsage::GoalBounds {
+            bounds: opts.goal_bounds.len(),
+            goals: info.goals.len(),
+        });
     }
     if !(opts.confidence > 0.0 && opts.confidence < 1.0) {
-        return usage(format!(
-            "the confidence {} must lie in (0, 1)",
-            opts.confidence
-        ));
+        return usage(SimUsage::Confidence(opts.confidence));
     }
-    let invalid = |m: String| Err(SimError::Invalid(m));
+    let invalid = |m: SimInvalid| Err(SimError::Invalid(m));
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
     if result.states.len() != n || result.steps.is_empty() {
-        return invalid(format!(
-            "the result has {} states and {} steps; the system has {n} states",
-            result.states.len(),
-            result.steps.len()
-        ));
+        return invalid(SimInvalid::ResultSize {
+            states: result.states.len(),
+            steps: result.steps.len(),
+            n,
+        });
     }
     if result.constants.metric.len() != n * n {
-        return invalid("the result's metric is not n x n".into());
+        return invalid(SimInvalid::MetricSize);
     }
     if result.input_plan.is_some() {
-        return invalid("sets under an input plan cannot be simulated (the paths draw inputs from the input box)".into());
+        return invalid(SimInvalid::InputPlan);
     }
     if info.input_box.len() != p {
-        return invalid(format!(
-            "the input box has {} ranges, the system has {p} inputs",
-            info.input_box.len()
-        ));
+        return invalid(SimInvalid::InputRanges {
+            ranges: info.input_box.len(),
+            p,
+        });
     }
     if let Some(b) = info
         .input_box
         .iter()
         .find(|r| !(r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi))
     {
-        return invalid(format!("the input box [{}, {}] is not bounded", b.lo, b.hi));
+        return invalid(SimInvalid::UnboundedInput(*b));
     }
     let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
-    let (steps, dt) = dt::choose(sys, info, result, &times, opts.dt).map_err(SimError::Usage)?;
+    let (steps, dt) = dt::choose(sys, info, result, &times, opts.dt)
+        .map_err(|dt| SimError::Usage(SimUsage::DtSteps(dt)))?;
     let spans: Vec<Span> = times
         .windows(2)
         .zip(steps)
@@ -425,9 +458,10 @@ fn make_plan<'a, S: System + ?Sized>(
     let per_path: u64 = spans.iter().map(|s| u64::from(s.steps)).sum();
     // Draws per Euler step: m normals (about 1% need a second draw), p inputs at most.
     if per_path.saturating_mul(2 * (m + p + 1) as u64) >= rng::DRAWS_PER_PATH {
-        return usage(format!(
-            "{per_path} Euler steps of {m} noise channels are too many random numbers per path"
-        ));
+        return usage(SimUsage::TooManyDraws {
+            steps: per_path,
+            channels: m,
+        });
     }
     let nominal: Vec<f64> = result
         .steps
@@ -435,10 +469,11 @@ fn make_plan<'a, S: System + ?Sized>(
         .flat_map(|s| s.nominal().iter().copied())
         .collect();
     if nominal.len() != n * times.len() {
-        return invalid("a nominal state has the wrong dimension".into());
+        return invalid(SimInvalid::NominalSize);
     }
     let metric = prs::Metric::new(&result.constants.metric, n);
-    let sets = regions::SetRegions::new(info, n, result.horizon).map_err(SimError::Invalid)?;
+    let sets = regions::SetRegions::new(info, n, result.horizon)
+        .map_err(|e| SimError::Invalid(SimInvalid::UnsafeSet(e)))?;
     let tube = match result.guarantee {
         Guarantee::Uniform => Some(prs::Tube::new(result, &metric).map_err(SimError::Invalid)?),
         Guarantee::Pointwise => None,
@@ -453,7 +488,8 @@ fn make_plan<'a, S: System + ?Sized>(
         tube,
         metric,
         // The paths start where the sets start.
-        initial: initial::InitialSampler::new(&result.initial, n).map_err(SimError::Invalid)?,
+        initial: initial::InitialSampler::new(&result.initial, n)
+            .map_err(|e| SimError::Invalid(SimInvalid::Initial(e)))?,
         inputs: inputs::InputSchedule::new(&info.input_box, opts.inputs, hold),
         noise: noise::Noise::new(sys, *times.last().unwrap_or(&0.0), &result.initial_center),
         sets,
@@ -562,7 +598,7 @@ mod tests {
             (0.0, &skewed, 0.05, 0.6),
         ] {
             let (sys, info) = (sys(b), info_in(b, metric.clone()));
-            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             let mut pointwise = r.clone();
             pointwise.guarantee = Guarantee::Pointwise;
             for (tube, r) in [
@@ -661,7 +697,7 @@ mod tests {
     #[test]
     fn a_path_leaving_the_tube_between_report_times_is_counted() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 1,
             seed: 3,
@@ -687,7 +723,7 @@ mod tests {
         assert!(hand_made.span_contains(k, end));
         assert!((0..9).any(|j| !hand_made.span_contains(k, state(j))));
 
-        let simulate = |r: &Prs| simulate(&sys, &info, r, &opts, &mut |_, _| {}).unwrap();
+        let simulate = |r: &Prs| simulate_paired(&sys, &info, r, &opts, &mut |_, _| {}).unwrap();
         let computed = simulate(&r);
         assert_eq!(computed.tube.as_ref().unwrap().outside, 0);
         let rep = simulate(&hand_made);
@@ -721,7 +757,7 @@ mod tests {
             (1.0, &identity, 0.4),
         ] {
             let (sys, info) = (sys(b), info_in(b, metric.clone()));
-            let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             for (factor, r) in [(1.0, r.clone()), (factor, narrow(&r, factor))] {
                 let opts = Options {
                     paths: 300,
@@ -730,7 +766,7 @@ mod tests {
                     hold: Some(0.05),
                     ..Options::default()
                 };
-                let rep = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+                let rep = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
                 let (left, between) = recount(&sys, &info, &r, &opts);
                 let case = format!("b = {b}, metric {metric:?}, spans x {factor}");
                 let counted: Vec<u64> = rep.steps.iter().map(|s| s.left_tube.unwrap()).collect();
@@ -759,7 +795,7 @@ mod tests {
     #[test]
     fn the_uniform_verdict_is_decided_by_the_tube() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let run = |r: &Prs, threads: usize| {
             let opts = Options {
                 paths: 3_000,
@@ -768,7 +804,7 @@ mod tests {
                 threads: Some(threads),
                 ..Options::default()
             };
-            simulate(&sys, &info, r, &opts, &mut |_, _| {}).unwrap()
+            simulate_paired(&sys, &info, r, &opts, &mut |_, _| {}).unwrap()
         };
         let computed = run(&r, 2);
         assert_eq!(computed, run(&r, 1));
@@ -814,11 +850,11 @@ mod tests {
         let sorted = ChunkStats::sorted;
         for metric in [vec![1.0, 0.0, 0.0, 1.0], vec![2.0, 0.7, 0.7, 1.0]] {
             let (sys, info) = (sys(0.0), info_in(0.0, metric.clone()));
-            let mut r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+            let mut r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
             r.guarantee = Guarantee::Pointwise;
             let mut boxes = info.clone();
             boxes.analyses[0].spec.method = Method::Interval;
-            let b = engine::run(&sys, &boxes, &boxes.analyses[0]).unwrap();
+            let b = engine::run_paired(&sys, &boxes, &boxes.analyses[0]).unwrap();
             r.also = vec![prs::tests::boxes_to_zonotopes(b, prs::tests::SQUARE, 0.2)];
             let opts = Options {
                 paths: 300,
@@ -837,7 +873,7 @@ mod tests {
                 assert_eq!(detected, baseline, "{metric:?}, {threshold}");
                 assert_eq!(avx2, baseline, "{metric:?}, {threshold}");
             }
-            let rep = simulate(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+            let rep = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
             let paths = result_paths(&sys, &info, &r, &opts).unwrap();
             let outside: Vec<u64> = (0..r.steps.len())
                 .map(|k| {
@@ -861,7 +897,7 @@ mod tests {
     #[test]
     fn malformed_spans_are_refused() {
         let (sys, info) = (sys(0.0), info(0.0));
-        let r = engine::run(&sys, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&sys, &info, &info.analyses[0]).unwrap();
         let opts = Options {
             paths: 10,
             ..Options::default()
@@ -877,9 +913,9 @@ mod tests {
         ] {
             let mut bad = r.clone();
             change(&mut bad.steps[3].span);
-            match simulate(&sys, &info, &bad, &opts, &mut |_, _| {}) {
-                Err(SimError::Invalid(m)) => {
-                    assert!(m.contains("report step 3") && m.contains(what), "{m}")
+            match simulate_paired(&sys, &info, &bad, &opts, &mut |_, _| {}) {
+                Err(SimError::Invalid(m @ SimInvalid::Span { step: 3, .. })) => {
+                    assert!(m.to_string().contains(what), "{m}")
                 }
                 other => panic!("{other:?}"),
             }
@@ -971,8 +1007,8 @@ mod tests {
 
     /// The report of `opts.paths` paths of `sys` checked against `info`'s sets.
     fn simulate_sets(sys: &Brownian, info: &ModelInfo, opts: &Options) -> SimReport {
-        let r = engine::run(sys, info, &info.analyses[0]).unwrap();
-        simulate(sys, info, &r, opts, &mut |_, _| {}).unwrap()
+        let r = engine::run_paired(sys, info, &info.analyses[0]).unwrap();
+        simulate_paired(sys, info, &r, opts, &mut |_, _| {}).unwrap()
     }
 
     /// The unsafe half-space `x >= offset` (at `t = 0`), its offset moving number `number`.
@@ -1101,10 +1137,10 @@ mod tests {
         };
         let moving = sys(0.0, lines);
         let rep = simulate_sets(&moving, &info, &opts);
-        let r = engine::run(&moving, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&moving, &info, &info.analyses[0]).unwrap();
         let parts = (0..3).map(|i| {
             let shard = Shard::new(i, 3).unwrap();
-            let part = run_part(&moving, &info, &r, &opts, shard, &mut |_, _| {}).unwrap();
+            let part = run_part_paired(&moving, &info, &r, &opts, shard, &mut |_, _| {}).unwrap();
             (i.to_string(), Part::from_bytes(&part.to_bytes()).unwrap())
         });
         assert_eq!(merge(parts).unwrap(), rep);

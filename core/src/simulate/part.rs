@@ -3,6 +3,7 @@
 //! report without the system (see `merge.rs`; the file format is in `part_file.rs`).
 
 use super::dt::DtUsed;
+use super::error::PartFault;
 use super::inputs::InputMode;
 use super::paths::ChunkStats;
 use super::report::{InitialSampling, NoiseKind};
@@ -170,16 +171,19 @@ impl Part {
     /// Why this part is not well formed (vectors of the wrong length, counts above its paths,
     /// quantile buffers out of order), or `None`. Merging checks every part with it, so a part
     /// read from a file or built by hand never makes the report panic or lie.
-    pub fn malformed(&self) -> Option<String> {
+    pub fn malformed(&self) -> Option<PartFault> {
         let (run, st) = (&self.run, &self.stats);
         if run.paths == 0 || self.shard.count == 0 || self.shard.index >= self.shard.count {
-            return Some(format!("shard {} of {} paths", self.shard, run.paths));
+            return Some(PartFault::Shard {
+                shard: self.shard,
+                paths: run.paths,
+            });
         }
         if !(run.confidence > 0.0 && run.confidence < 1.0 && run.delta > 0.0) {
-            return Some(format!(
-                "confidence {} or delta {} out of range",
-                run.confidence, run.delta
-            ));
+            return Some(PartFault::Range {
+                confidence: run.confidence,
+                delta: run.delta,
+            });
         }
         let n = self.shard.paths(run.paths);
         let mine = n.end - n.start;
@@ -196,13 +200,13 @@ impl Part {
             || st.first_hit.len() != sets
             || st.goal_reached.len() != run.goals.len()
         {
-            return Some("its statistics do not match its report times or unsafe sets".into());
+            return Some(PartFault::Statistics);
         }
         if run.quantile_rank == 0 || run.quantile_rank > run.paths {
-            return Some(format!(
-                "quantile rank {} of {} paths",
-                run.quantile_rank, run.paths
-            ));
+            return Some(PartFault::Rank {
+                rank: run.quantile_rank,
+                paths: run.paths,
+            });
         }
         let counts = st
             .outside
@@ -219,7 +223,7 @@ impl Part {
         if counts.chain(&totals).any(|&c| c > mine)
             || st.left_tube.iter().sum::<u64>() != st.outside_tube
         {
-            return Some(format!("counts inconsistent with its {mine} paths"));
+            return Some(PartFault::Counts { paths: mine });
         }
         let kept = run.quantile_rank.min(mine);
         let buffers = self.top.iter().enumerate().map(|(k, top)| (k, None, top));
@@ -229,17 +233,16 @@ impl Part {
             .enumerate()
             .map(|(s, top)| (s / n, Some(s % n), top));
         for (k, state, top) in buffers.chain(per_state) {
-            let of = state.map_or(String::new(), |i| format!(" of state {i}"));
             if top.len() as u64 != kept {
-                return Some(format!(
-                    "{} distances{of} at report time {k}, expected {kept}",
-                    top.len()
-                ));
+                return Some(PartFault::Distances {
+                    count: top.len(),
+                    state,
+                    step: k,
+                    kept,
+                });
             }
             if top.iter().any(|d| d.is_nan() || *d < 0.0) || top.windows(2).any(|w| w[0] < w[1]) {
-                return Some(format!(
-                    "the distances{of} at report time {k} are not sorted"
-                ));
+                return Some(PartFault::Unsorted { state, step: k });
             }
         }
         None

@@ -10,6 +10,7 @@
 //! refuses.
 
 use super::dt::{DtSource, DtUsed};
+use super::error::{Coded, PartFileError};
 use super::inputs::InputMode;
 use super::part::{Part, PartStats, RunInfo, StepInfo};
 use super::report::{InitialSampling, NoiseKind};
@@ -70,66 +71,75 @@ struct Reader<'a> {
 }
 
 impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], PartFileError> {
         let rest = &self.bytes[self.at..];
         if rest.len() < n {
-            return Err(format!("truncated: {n} bytes needed at byte {}", self.at));
+            return Err(PartFileError::Truncated {
+                needed: n,
+                at: self.at,
+            });
         }
         self.at += n;
         Ok(&rest[..n])
     }
-    fn u8(&mut self) -> Result<u8, String> {
+    fn u8(&mut self) -> Result<u8, PartFileError> {
         Ok(self.take(1)?[0])
     }
-    fn u64(&mut self) -> Result<u64, String> {
+    fn u64(&mut self) -> Result<u64, PartFileError> {
         let b = self.take(8)?;
         let mut a = [0; 8];
         a.copy_from_slice(b);
         Ok(u64::from_le_bytes(a))
     }
-    fn f64(&mut self) -> Result<f64, String> {
+    fn f64(&mut self) -> Result<f64, PartFileError> {
         Ok(f64::from_bits(self.u64()?))
     }
-    fn bool(&mut self) -> Result<bool, String> {
+    fn bool(&mut self) -> Result<bool, PartFileError> {
         match self.u8()? {
             0 => Ok(false),
             1 => Ok(true),
-            b => Err(format!("byte {b} at {} is not a flag", self.at - 1)),
+            byte => Err(PartFileError::Flag {
+                byte,
+                at: self.at - 1,
+            }),
         }
     }
     /// A length of items of `size` bytes, checked against the bytes left.
-    fn len(&mut self, size: usize) -> Result<usize, String> {
+    fn len(&mut self, size: usize) -> Result<usize, PartFileError> {
         let at = self.at;
         let n = self.u64()?;
         let left = (self.bytes.len() - self.at) as u64;
         if n.saturating_mul(size as u64) > left {
-            return Err(format!("a length of {n} at byte {at} exceeds the file"));
+            return Err(PartFileError::Length { length: n, at });
         }
         Ok(n as usize)
     }
-    fn str(&mut self) -> Result<String, String> {
+    fn str(&mut self) -> Result<String, PartFileError> {
         let n = self.len(1)?;
         let at = self.at;
-        String::from_utf8(self.take(n)?.to_vec())
-            .map_err(|_| format!("the text at byte {at} is not UTF-8"))
+        String::from_utf8(self.take(n)?.to_vec()).map_err(|_| PartFileError::Utf8 { at })
     }
-    fn opt_f64(&mut self) -> Result<Option<f64>, String> {
+    fn opt_f64(&mut self) -> Result<Option<f64>, PartFileError> {
         let some = self.bool()?;
         let v = self.f64()?;
         Ok(some.then_some(v))
     }
-    fn u64s(&mut self) -> Result<Vec<u64>, String> {
+    fn u64s(&mut self) -> Result<Vec<u64>, PartFileError> {
         (0..self.len(8)?).map(|_| self.u64()).collect()
     }
-    fn f64s(&mut self) -> Result<Vec<f64>, String> {
+    fn f64s(&mut self) -> Result<Vec<f64>, PartFileError> {
         (0..self.len(8)?).map(|_| self.f64()).collect()
     }
     /// The enum of code `u8` among `all` (in code order).
-    fn code<T: Copy>(&mut self, what: &str, all: &[T]) -> Result<T, String> {
-        let c = self.u8()?;
-        all.get(usize::from(c))
+    fn code<T: Copy>(&mut self, what: Coded, all: &[T]) -> Result<T, PartFileError> {
+        let code = self.u8()?;
+        all.get(usize::from(code))
             .copied()
-            .ok_or_else(|| format!("unknown {what} code {c} at byte {}", self.at - 1))
+            .ok_or(PartFileError::Code {
+                what,
+                code,
+                at: Some(self.at - 1),
+            })
     }
 }
 
@@ -180,11 +190,9 @@ impl Part {
 
     /// Reads a part file's bytes, or says why they are not one (not a part file, another
     /// format version, truncated, corrupt).
-    pub fn from_bytes(bytes: &[u8]) -> Result<Part, String> {
+    pub fn from_bytes(bytes: &[u8]) -> Result<Part, PartFileError> {
         if !bytes.starts_with(MAGIC) {
-            return Err(
-                "not a reachc simulate part file (no `reachc simulate part` header)".into(),
-            );
+            return Err(PartFileError::NotAPart);
         }
         let mut r = Reader { bytes, at: 0 };
         r.take(MAGIC.len())?;
@@ -192,17 +200,18 @@ impl Part {
         v.copy_from_slice(r.take(4)?);
         let version = u32::from_le_bytes(v);
         if version != FORMAT_VERSION {
-            return Err(format!(
-                "part file format version {version}; this reachc reads version {FORMAT_VERSION}"
-            ));
+            return Err(PartFileError::Version {
+                found: version,
+                reads: FORMAT_VERSION,
+            });
         }
         let Some(body) = bytes.len().checked_sub(8).filter(|&b| b >= r.at) else {
-            return Err("truncated: no checksum".into());
+            return Err(PartFileError::NoChecksum);
         };
         let mut stored = [0; 8];
         stored.copy_from_slice(&bytes[body..]);
         if u64::from_le_bytes(stored) != checksum(&bytes[..body]) {
-            return Err("corrupt or truncated: the checksum does not match".into());
+            return Err(PartFileError::Checksum);
         }
         let mut r = Reader {
             bytes: &bytes[..body],
@@ -210,7 +219,7 @@ impl Part {
         };
         let run = read_run(&mut r)?;
         let (index, count) = (r.u64()?, r.u64()?);
-        let shard = Shard::new(index, count).map_err(|e| e.to_string())?;
+        let shard = Shard::new(index, count).map_err(PartFileError::Shard)?;
         let stats = PartStats {
             outside: r.u64s()?,
             outside_any: r.u64()?,
@@ -226,10 +235,7 @@ impl Part {
         let top = (0..r.len(8)?).map(|_| r.f64s()).collect::<Result<_, _>>()?;
         let state_top = (0..r.len(8)?).map(|_| r.f64s()).collect::<Result<_, _>>()?;
         if r.at != body {
-            return Err(format!(
-                "{} unexpected bytes before the checksum",
-                body - r.at
-            ));
+            return Err(PartFileError::Unexpected(body - r.at));
         }
         Ok(Part {
             run,
@@ -301,26 +307,26 @@ fn write_run(w: &mut Writer, run: &RunInfo) {
     w.u64(run.digest);
 }
 
-fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
+fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, PartFileError> {
     Ok(RunInfo {
         version: r.str()?,
         spec_hash: r.str()?,
         model: r.str()?,
         analysis: r.str()?,
         states: (0..r.len(8)?).map(|_| r.str()).collect::<Result<_, _>>()?,
-        method: r.code("method", &METHODS)?,
+        method: r.code(Coded::Method, &METHODS)?,
         delta: r.f64()?,
-        guarantee: r.code("guarantee", &GUARANTEES)?,
+        guarantee: r.code(Coded::Guarantee, &GUARANTEES)?,
         step: r.f64()?,
         paths: r.u64()?,
         seed: r.u64()?,
         dt_option: r.opt_f64()?,
-        inputs: r.code("inputs", &INPUTS)?,
+        inputs: r.code(Coded::Inputs, &INPUTS)?,
         hold_option: r.opt_f64()?,
         confidence: r.f64()?,
         safety_bound: r.opt_f64()?,
         dt: DtUsed {
-            source: r.code("dt source", &DT_SOURCES)?,
+            source: r.code(Coded::DtSource, &DT_SOURCES)?,
             min: r.f64()?,
             max: r.f64()?,
             rule_min: r.f64()?,
@@ -329,26 +335,32 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
             coarse: r.u64()?,
         },
         steps_per_path: r.u64()?,
-        initial_states: r.code("initial sampling", &INITIAL)?,
+        initial_states: r.code(Coded::InitialSampling, &INITIAL)?,
         noise: {
             let code = r.u8()?;
-            let entries = usize::try_from(r.u64()?).map_err(|_| "noise entries overflow")?;
+            let entries = usize::try_from(r.u64()?).map_err(|_| PartFileError::NoiseEntries)?;
             match code {
                 0 => NoiseKind::AdditiveDiagonal,
                 1 => NoiseKind::Additive { entries },
                 2 => NoiseKind::StateDependent { entries },
-                c => return Err(format!("unknown noise code {c}")),
+                code => {
+                    return Err(PartFileError::Code {
+                        what: Coded::Noise,
+                        code,
+                        at: None,
+                    })
+                }
             }
         },
         has_inputs: r.bool()?,
         tube: r.bool()?,
         has_domain: r.bool()?,
         unsafe_sets: (0..r.len(9)?)
-            .map(|_| Ok((r.str()?, r.code("unsafe set", &UNSAFE)?)))
-            .collect::<Result<_, String>>()?,
+            .map(|_| Ok((r.str()?, r.code(Coded::UnsafeSet, &UNSAFE)?)))
+            .collect::<Result<_, PartFileError>>()?,
         goals: (0..r.len(9)?)
             .map(|_| Ok((r.str()?, r.opt_f64()?)))
-            .collect::<Result<_, String>>()?,
+            .collect::<Result<_, PartFileError>>()?,
         quantile_rank: r.u64()?,
         steps: (0..r.len(32)?)
             .map(|_| {
@@ -359,7 +371,7 @@ fn read_run(r: &mut Reader<'_>) -> Result<RunInfo, String> {
                     hull: r.f64s()?,
                 })
             })
-            .collect::<Result<_, String>>()?,
+            .collect::<Result<_, PartFileError>>()?,
         digest: r.u64()?,
     })
 }

@@ -1323,7 +1323,7 @@ mod tests {
     fn lane_kernels_step_as_the_scalar_loop() {
         use crate::test_support::rng::Rng;
         let info = pendulum(Method::Interval);
-        let r = engine::run(&PENDULUM, &info, &info.analyses[0]).unwrap();
+        let r = engine::run_paired(&PENDULUM, &info, &info.analyses[0]).unwrap();
         let regions = with_regions(&info, true);
         let forced = with_input(&regions);
         let modes = [InputMode::Random, InputMode::Corners, InputMode::Centre];
@@ -1460,7 +1460,7 @@ mod tests {
         for method in [Method::Contraction, Method::Interval] {
             for guarantee in [Guarantee::Uniform, Guarantee::Pointwise] {
                 let info = pendulum(method);
-                let mut r = engine::run(&PENDULUM, &info, &info.analyses[0]).unwrap();
+                let mut r = engine::run_paired(&PENDULUM, &info, &info.analyses[0]).unwrap();
                 r.guarantee = guarantee;
                 if method == Method::Contraction {
                     assert!(!r.also.is_empty(), "an intersection");

@@ -47,6 +47,7 @@
 //! sound on its own (an "inside" is proved by a point of the box), so a state is never counted
 //! inside the tube when it is not.
 
+use super::error::{SimInvalid, SpanFault};
 use super::paths::SMALL;
 use crate::interval::Interval;
 use crate::lanes::{Real, X8};
@@ -500,8 +501,8 @@ impl<'a> Membership<'a> {
 /// `make` builds of it and that metric.
 fn members<'a, T>(
     result: &'a Prs,
-    make: impl Fn(&'a Prs, &Metric) -> Result<T, String>,
-) -> Result<Vec<(Metric, T)>, String> {
+    make: impl Fn(&'a Prs, &Metric) -> Result<T, SimInvalid>,
+) -> Result<Vec<(Metric, T)>, SimInvalid> {
     let n = result.states.len();
     result
         .also
@@ -901,7 +902,7 @@ pub(crate) struct Tube<'a> {
 impl<'a> Tube<'a> {
     /// The tube of `result`'s spans, with `metric` built from its metric; `Err` when a span is
     /// malformed (a corner of the wrong length, NaN, `lo > hi`, a negative or NaN radius).
-    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Result<Tube<'a>, String> {
+    pub(crate) fn new(result: &'a Prs, metric: &Metric) -> Result<Tube<'a>, SimInvalid> {
         let also = members(result, OneSpan::new)?;
         Ok(Tube {
             own: OneSpan::new(result, metric)?,
@@ -915,7 +916,7 @@ impl<'a> Tube<'a> {
                         Tube::new(p, metric)?,
                     ))
                 })
-                .collect::<Result<_, String>>()?,
+                .collect::<Result<_, SimInvalid>>()?,
         })
     }
 
@@ -1011,7 +1012,7 @@ struct OneSpan<'a> {
 impl<'a> OneSpan<'a> {
     /// The spans of `result`'s own set, with `metric` built from its metric; `Err` as for
     /// [`Tube::new`].
-    fn new(result: &'a Prs, metric: &Metric) -> Result<OneSpan<'a>, String> {
+    fn new(result: &'a Prs, metric: &Metric) -> Result<OneSpan<'a>, SimInvalid> {
         let n = result.states.len();
         let steps = result.steps.len();
         let mut tube = OneSpan {
@@ -1029,19 +1030,19 @@ impl<'a> OneSpan<'a> {
         let eps16 = 16.0 * f64::EPSILON;
         for (k, st) in result.steps.iter().enumerate() {
             let s = &st.span;
-            let bad = |what: &str| Err(format!("the span of report step {k} has {what}"));
+            let bad = |fault| Err(SimInvalid::Span { step: k, fault });
             if s.lo.len() != n || s.hi.len() != n {
-                return bad("a corner of the wrong dimension");
+                return bad(SpanFault::Dimension);
             }
             if s.lo
                 .iter()
                 .zip(&s.hi)
                 .any(|(l, h)| l.is_nan() || h.is_nan() || l > h)
             {
-                return bad("a lower corner that is not below its upper corner");
+                return bad(SpanFault::Corners);
             }
             if s.radius.is_nan() || s.radius < 0.0 {
-                return bad(&format!("the radius {}", s.radius));
+                return bad(SpanFault::Radius(s.radius));
             }
             tube.lo.extend_from_slice(&s.lo);
             tube.hi.extend_from_slice(&s.hi);
@@ -1270,7 +1271,7 @@ pub(super) mod tests {
             // Valid for P = I and for the skewed P below (generous c, sigma).
             constants: Ok(Constants::given(&info, metric, -0.2, 0.5, 0.0)),
         };
-        let mut r = engine::run(&Sys, &info, &analysis).unwrap();
+        let mut r = engine::run_paired(&Sys, &info, &analysis).unwrap();
         if members {
             assert!(!r.also.is_empty(), "{method:?}: an intersection");
         } else {

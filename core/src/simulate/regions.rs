@@ -2,6 +2,7 @@
 //! enter an unsafe set, reach a goal or leave the domain. Sets are closed (a point on the
 //! boundary is in the set).
 
+use super::error::RegionFault;
 use super::prs::lanes;
 use crate::interval::Interval;
 use crate::lanes::X8;
@@ -36,7 +37,7 @@ pub(crate) struct GoalEvent {
 impl SetRegions {
     /// The regions of `info`'s sets over `n` states as the model gives them (a moving set: at
     /// `t = 0`), goal windows defaulting to `[0, horizon]`; `Err` for malformed data.
-    pub(crate) fn new(info: &ModelInfo, n: usize, horizon: f64) -> Result<Self, String> {
+    pub(crate) fn new(info: &ModelInfo, n: usize, horizon: f64) -> Result<Self, RegionFault> {
         let unsafe_sets = info
             .unsafe_sets
             .iter()
@@ -58,7 +59,7 @@ impl SetRegions {
                     stay: g.stay,
                 })
             })
-            .collect::<Result<Vec<_>, String>>()?;
+            .collect::<Result<Vec<_>, RegionFault>>()?;
         Ok(SetRegions {
             unsafe_sets,
             goals,
@@ -107,20 +108,18 @@ pub(crate) enum Region {
 
 impl Region {
     /// The region of an unsafe set over `n` states; `Err` for malformed data.
-    pub(crate) fn unsafe_set(shape: &UnsafeShape, n: usize) -> Result<Region, String> {
-        let bad = |what: &str| Err(format!("an unsafe set has {what}"));
+    pub(crate) fn unsafe_set(shape: &UnsafeShape, n: usize) -> Result<Region, RegionFault> {
+        let bad = Err;
         match shape {
             UnsafeShape::Box(ranges) if ranges.iter().any(|&(i, _)| i >= n) => {
-                bad("a state index out of range")
+                bad(RegionFault::State)
             }
             UnsafeShape::Ball { states, center, .. }
                 if states.iter().any(|&i| i >= n) || center.len() != states.len() =>
             {
-                bad("a bad centre or state index")
+                bad(RegionFault::Ball)
             }
-            UnsafeShape::HalfSpace { normal, .. } if normal.len() != n => {
-                bad("a normal of the wrong dimension")
-            }
+            UnsafeShape::HalfSpace { normal, .. } if normal.len() != n => bad(RegionFault::Normal),
             _ => Ok(Region::of(shape)),
         }
     }

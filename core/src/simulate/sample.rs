@@ -8,7 +8,7 @@ use super::inputs::InputSchedule;
 use super::noise::Noise;
 use super::normal::Ziggurat;
 use super::rng::{PathRng, DRAWS_PER_PATH, MAX_PATHS};
-use super::{dt, Options, SimError};
+use super::{dt, Options, SimError, SimInvalid, SimUsage};
 use crate::model::ModelInfo;
 use crate::prs::Prs;
 use crate::system::System;
@@ -53,9 +53,7 @@ pub fn sample_paths<S: System + ?Sized>(
     let step = times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
     let dt = opts.dt.unwrap_or(step);
     if times.len() > 1 && !(dt > 0.0 && dt.is_finite()) {
-        return Err(SimError::Usage(format!(
-            "dt = {dt} must be positive and finite"
-        )));
+        return Err(SimError::Usage(SimUsage::Dt(dt)));
     }
     let substeps = times
         .windows(2)
@@ -101,7 +99,8 @@ fn of_result<S: System + ?Sized>(
 ) -> Result<Substeps, SimError> {
     let times: Vec<f64> = result.steps.iter().map(|s| s.t).collect();
     check_times(&times)?;
-    let (substeps, _) = dt::choose(sys, info, result, &times, opts.dt).map_err(SimError::Usage)?;
+    let (substeps, _) = dt::choose(sys, info, result, &times, opts.dt)
+        .map_err(|dt| SimError::Usage(SimUsage::DtSteps(dt)))?;
     let center = Some(&result.initial_center[..]);
     record(sys, info, &times, center, opts, substeps, every_step)
 }
@@ -113,9 +112,7 @@ fn check_times(times: &[f64]) -> Result<(), SimError> {
             .windows(2)
             .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
     {
-        return Err(SimError::Invalid(
-            "the report times must start at 0 and increase".into(),
-        ));
+        return Err(SimError::Invalid(SimInvalid::Times));
     }
     Ok(())
 }
@@ -131,18 +128,18 @@ fn record<S: System + ?Sized>(
     substeps: Vec<u32>,
     every_step: bool,
 ) -> Result<Substeps, SimError> {
-    let usage = |m: String| Err(SimError::Usage(m));
+    let usage = |m: SimUsage| Err(SimError::Usage(m));
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
     if opts.paths > MAX_SAMPLE_PATHS.min(MAX_PATHS) {
-        return usage(format!(
-            "at most {MAX_SAMPLE_PATHS} paths can be recorded, not {}",
-            opts.paths
-        ));
+        return usage(SimUsage::RecordedPaths {
+            paths: opts.paths,
+            max: MAX_SAMPLE_PATHS,
+        });
     }
     let step = times.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
     let hold = opts.hold.unwrap_or(step);
     if times.len() > 1 && !(hold > 0.0 && hold.is_finite()) {
-        return usage(format!("the hold time {hold} must be positive and finite"));
+        return usage(SimUsage::Hold(hold));
     }
     if info.input_box.len() != p
         || info
@@ -150,13 +147,11 @@ fn record<S: System + ?Sized>(
             .iter()
             .any(|r| !(r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi))
     {
-        return Err(SimError::Invalid(
-            "the input box must be bounded, one range per input".into(),
-        ));
+        return Err(SimError::Invalid(SimInvalid::InputBox));
     }
     let per_path: u64 = substeps.iter().map(|&s| u64::from(s)).sum();
     if per_path.saturating_mul(2 * (m + p + 1) as u64) >= DRAWS_PER_PATH {
-        return usage(format!("{per_path} Euler steps per path are too many"));
+        return usage(SimUsage::TooManyRecordedSteps(per_path));
     }
     let kept = if every_step {
         per_path + 1
@@ -164,12 +159,14 @@ fn record<S: System + ?Sized>(
         times.len() as u64
     };
     if every_step && kept.saturating_mul(n as u64).saturating_mul(opts.paths) > MAX_SUBSTEP_VALUES {
-        return usage(format!(
-            "{} paths of {kept} states of {n} coordinates are too many values to record",
-            opts.paths
-        ));
+        return usage(SimUsage::TooManyValues {
+            paths: opts.paths,
+            kept,
+            n,
+        });
     }
-    let initial = InitialSampler::new(&info.initial, n).map_err(SimError::Invalid)?;
+    let initial = InitialSampler::new(&info.initial, n)
+        .map_err(|e| SimError::Invalid(SimInvalid::Initial(e)))?;
     let inputs = InputSchedule::new(&info.input_box, opts.inputs, hold);
     let zig = Ziggurat::get();
     let (mut x, mut f, mut u) = (vec![0.0; n], vec![0.0; n], vec![0.0; p]);

@@ -38,24 +38,6 @@ pub enum ShardError {
     },
 }
 
-impl fmt::Display for ShardError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ShardError::NoShards => write!(f, "the number of shards must be at least 1"),
-            ShardError::IndexTooLarge { index, count } => write!(
-                f,
-                "shard {index}/{count}: the index must be below the number of shards (0-based)"
-            ),
-            ShardError::Syntax { text } => {
-                write!(
-                    f,
-                    "shard `{text}`: expected I/K with whole numbers, e.g. 0/8"
-                )
-            }
-        }
-    }
-}
-
 impl std::error::Error for ShardError {}
 
 impl Shard {

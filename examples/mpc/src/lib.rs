@@ -75,8 +75,8 @@ pub struct Planner<'a> {
 impl<'a> Planner<'a> {
     /// A planner on the analysis `plan` of the cart, with `count` candidate forces evenly
     /// spread over the input box `[-1, 1]`.
-    pub fn new(sys: &'a Cart, info: &'a reachc_runtime::ModelInfo, count: usize) -> Self {
-        let reach = Reach::new(sys, info, "plan").expect("the spec has the analysis `plan`");
+    pub fn new(sys: &'a Cart, count: usize) -> Self {
+        let reach = Reach::new(sys, analysis::PLAN).expect("the spec has the analysis `plan`");
         let candidates = (0..count)
             .map(|i| -1.0 + 2.0 * i as f64 / (count - 1) as f64)
             .collect();
@@ -243,13 +243,8 @@ pub struct Summary {
 }
 
 /// `periods` control periods of the closed loop from rest, the plant's noise seeded by `seed`.
-pub fn closed_loop(
-    sys: &Cart,
-    info: &reachc_runtime::ModelInfo,
-    periods: usize,
-    seed: u64,
-) -> Result<Summary, PlanError> {
-    let planner = Planner::new(sys, info, 21);
+pub fn closed_loop(sys: &Cart, periods: usize, seed: u64) -> Result<Summary, PlanError> {
+    let planner = Planner::new(sys, 21);
     let mut plant = Plant::new([0.0, 0.0], seed, 1e-3);
     let mut s = Summary::default();
     for _ in 0..periods {

@@ -1,11 +1,10 @@
 //! Runs the stochastic cart under the model-predictive controller for 6 s and reports the time
 //! per reachability call and the constraint violations: `cargo run --release -p mpc`.
 
-use mpc::{closed_loop, info, Cart};
+use mpc::{closed_loop, Cart};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let (sys, info) = (Cart, info());
-    let s = closed_loop(&sys, &info, 60, 1)?;
+    let s = closed_loop(&Cart, 60, 1)?;
     let mut times: Vec<f64> = s
         .reach_times
         .iter()

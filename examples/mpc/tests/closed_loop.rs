@@ -1,7 +1,7 @@
 //! The controller on the stochastic cart: one plan's guarantee against Monte Carlo (and the
 //! untightened plan's failure, so the check can fail), and the closed loop.
 
-use mpc::{closed_loop, info, violation, Cart, Planner, Plant, SPEED};
+use mpc::{closed_loop, violation, Cart, Planner, Plant, SPEED};
 use reachc_runtime::engine::Constraint;
 use reachc_runtime::Bounds;
 
@@ -11,8 +11,8 @@ use reachc_runtime::Bounds;
 /// the untightened constraints only, fails far more often.
 #[test]
 fn a_plan_meets_its_constraints_with_probability_one_minus_delta() {
-    let (sys, info) = (Cart, info());
-    let planner = Planner::new(&sys, &info, 21);
+    let sys = Cart;
+    let planner = Planner::new(&sys, 21);
     let x = [0.6, 0.3];
     let plan = planner.plan(&sys, x).unwrap();
     assert!(plan.feasible);
@@ -56,8 +56,7 @@ fn a_plan_meets_its_constraints_with_probability_one_minus_delta() {
 /// between the tightened wall's distance and the wall.
 #[test]
 fn the_closed_loop_approaches_the_tightened_wall() {
-    let (sys, info) = (Cart, info());
-    let s = closed_loop(&sys, &info, 30, 7).unwrap();
+    let s = closed_loop(&Cart, 30, 7).unwrap();
     assert_eq!((s.periods, s.infeasible, s.violations), (30, 0, 0));
     let wall = s.walls[29];
     assert!(wall > 0.5 && wall < 0.8, "{wall}");

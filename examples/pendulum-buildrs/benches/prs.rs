@@ -4,7 +4,9 @@
 //! in docs/benchmarks.md) and reachc's default (`interval`, validated steps). Compare with
 //! `cargo bench -p reachc-compiler --bench prs` (the interpreter).
 
-use pendulum_buildrs::{info, Pendulum};
+use pendulum_buildrs::{analysis, Pendulum};
+use reachc_runtime::model::Inclusion;
+use reachc_runtime::{Model, Reach};
 
 fn main() {
     divan::main();
@@ -12,10 +14,8 @@ fn main() {
 
 #[divan::bench]
 fn contraction_prs_compiled(bencher: divan::Bencher) {
-    let info = info();
-    let analysis = info.analysis("contraction").unwrap();
     bencher.bench(|| {
-        reachc_runtime::engine::run(&Pendulum, &info, analysis)
+        reachc_runtime::engine::run(&Pendulum, analysis::CONTRACTION)
             .unwrap()
             .steps()
             .len()
@@ -27,21 +27,23 @@ fn contraction_prs_compiled(bencher: divan::Bencher) {
 /// report).
 #[divan::bench(args = ["natural", "jacobian", "mixed"])]
 fn interval_prs_compiled(bencher: divan::Bencher, inclusion: &str) {
-    interval_prs(bencher, "paper_interval", inclusion);
+    interval_prs(bencher, analysis::PAPER_INTERVAL, inclusion);
 }
 
 /// [`interval_prs_compiled`] on validated steps (the spec's `interval`, time-uniform).
 #[divan::bench(args = ["natural", "jacobian", "mixed"])]
 fn validated_interval_prs_compiled(bencher: divan::Bencher, inclusion: &str) {
-    interval_prs(bencher, "interval", inclusion);
+    interval_prs(bencher, analysis::INTERVAL, inclusion);
 }
 
 /// One whole interval analysis `name` with `inclusion`, timed.
 fn interval_prs(bencher: divan::Bencher, name: &str, inclusion: &str) {
-    let info = info();
-    let analysis = interval_analysis(&info, name, inclusion);
+    let inclusion = inclusion_named(inclusion);
     bencher.bench(|| {
-        reachc_runtime::engine::run(&Pendulum, &info, &analysis)
+        Reach::new(&Pendulum, name)
+            .unwrap()
+            .with_inclusion(inclusion)
+            .run()
             .unwrap()
             .steps()
             .len()
@@ -52,29 +54,27 @@ fn interval_prs(bencher: divan::Bencher, name: &str, inclusion: &str) {
 /// y = T x), per inclusion function: what immrax computes per reach.
 #[divan::bench(args = ["natural", "jacobian", "mixed"])]
 fn interval_reach_compiled(bencher: divan::Bencher, inclusion: &str) {
-    let info = info();
-    let analysis = interval_analysis(&info, "paper_interval", inclusion);
+    let info = Pendulum.info();
+    let mut spec = info
+        .analysis(analysis::PAPER_INTERVAL)
+        .unwrap()
+        .spec
+        .clone();
+    spec.inclusion = inclusion_named(inclusion);
     bencher.bench(|| {
-        reachc_runtime::engine::interval_boxes(&Pendulum, &info, &analysis.spec)
+        reachc_runtime::engine::interval_boxes(&Pendulum, info, &spec)
             .unwrap()
             .len()
     });
 }
 
-/// The pendulum's analysis `name` with the given inclusion function.
-fn interval_analysis(
-    info: &reachc_runtime::ModelInfo,
-    name: &str,
-    inclusion: &str,
-) -> reachc_runtime::model::Analysis {
-    use reachc_runtime::model::Inclusion;
-    let mut analysis = info.analysis(name).unwrap().clone();
-    analysis.spec.inclusion = match inclusion {
+/// The inclusion function named `name`.
+fn inclusion_named(name: &str) -> Inclusion {
+    match name {
         "natural" => Inclusion::Natural,
         "mixed" => Inclusion::Mixed,
         _ => Inclusion::Jacobian,
-    };
-    analysis
+    }
 }
 
 /// One drift evaluation (the nominal trajectory's inner loop).

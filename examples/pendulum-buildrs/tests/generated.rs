@@ -1,6 +1,7 @@
 //! The code `build.rs` generated from `specs/pendulum.sde` evaluates the spec's model.
 
-use pendulum_buildrs::{info, Pendulum};
+use pendulum_buildrs::{analysis, Pendulum};
+use reachc_runtime::Model;
 use reachc_runtime::{Interval, System};
 
 #[test]
@@ -35,10 +36,14 @@ fn sizes_and_diffusion_follow_the_spec() {
 
 #[test]
 fn info_lists_the_analyses() {
-    let info = info();
-    assert_eq!(info.name, "pendulum");
-    assert_eq!(info.states, ["theta", "omega"]);
-    let names: Vec<&str> = info.analyses.iter().map(|a| a.spec.name.as_str()).collect();
+    let info = Pendulum.info();
+    assert_eq!(info.name(), "pendulum");
+    assert_eq!(info.states(), ["theta", "omega"]);
+    let names: Vec<&str> = info
+        .analyses()
+        .iter()
+        .map(|a| a.spec.name.as_str())
+        .collect();
     assert_eq!(
         names,
         [
@@ -49,5 +54,14 @@ fn info_lists_the_analyses() {
             "per_state",
             "per_state_uniform"
         ]
+    );
+    // The generated constants name them.
+    assert_eq!(
+        [
+            analysis::CONTRACTION,
+            analysis::PAPER_INTERVAL,
+            analysis::PER_STATE_UNIFORM
+        ],
+        ["contraction", "paper_interval", "per_state_uniform"]
     );
 }

@@ -4,6 +4,7 @@
 
 use reachc_runtime::app::run_cli;
 use reachc_runtime::model::{Analysis, AnalysisSpec, Constants, Method, ModelInfo, NoConstants};
+use reachc_runtime::system::Paired;
 use reachc_runtime::System;
 
 /// The analysis `name` of the decay models (`dx = -x dt + s dW` from about 1): `method` over
@@ -35,7 +36,7 @@ pub fn run_main<S: System + Sync>(
 ) -> (u8, String, String) {
     let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
     let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = run_cli(sys, info, &args, &mut out, &mut err);
+    let code = run_cli(&Paired::new(sys, info), &args, &mut out, &mut err);
     (
         code,
         String::from_utf8(out).unwrap(),

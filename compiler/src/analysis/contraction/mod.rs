@@ -29,7 +29,7 @@ pub(crate) use vertices::{decompose, jacobian_set, semidefinite_atoms, MatrixSet
 use std::fmt;
 
 use reachc_core::interval::Interval;
-use reachc_core::model::{Bounds, Constants, MetricRegion, Provenance, Region};
+use reachc_core::model::{Bounds, Constants, ConstantsParts, MetricRegion, Provenance, Region};
 
 use super::psd::IMat;
 use super::{time_range, Derivatives};
@@ -109,12 +109,12 @@ pub fn constants(
     let jac = decompose(model, &d.jac_x, "D_x f", time_range(model))?;
     let jac = jacobian_set(&jac, &p);
     let c = contraction_rate(&jac, &p, metric)?;
-    let mut consts = noise_and_input(model, d, metric, &p)?;
+    let mut consts = noise_and_input(model, d, metric, &p)?.into_parts();
     consts.c = c;
     if let Provenance::Certified { c, .. } = &mut consts.provenance {
         *c = Some(jac.bound());
     }
-    Ok(consts)
+    Ok(Constants::from_parts(consts))
 }
 
 /// The constants of Assumption 1 without the contraction rate, for analyses whose rate is
@@ -151,7 +151,7 @@ fn noise_and_input(
         })
         .collect();
     let (rho, gain) = input_gain(&jac_u, p, &h)?;
-    Ok(Constants {
+    Ok(Constants::from_parts(ConstantsParts {
         metric: metric.to_vec(),
         // A caller that synthesised the metric says where.
         metric_region: MetricRegion::Given,
@@ -170,7 +170,7 @@ fn noise_and_input(
             input_box: model.input_box.clone(),
             time: Bounds::new(time.lo(), time.hi()),
         },
-    })
+    }))
 }
 
 #[cfg(test)]
@@ -200,18 +200,22 @@ mod tests {
             .as_f64()
             .unwrap();
         // (The reference is for the decimal P, the model uses its nearest floats: 1e-14.)
-        assert!(k.c >= mu - 1e-14 && k.c < mu + 1e-9, "c = {} vs {mu}", k.c);
+        assert!(
+            k.c() >= mu - 1e-14 && k.c() < mu + 1e-9,
+            "c = {} vs {mu}",
+            k.c()
+        );
         let exact = checked["sigma_with_paper_P"].as_f64().unwrap();
         assert!(
-            k.sigma >= exact * (1.0 - 1e-14) && k.sigma < exact * (1.0 + 1e-14),
+            k.sigma() >= exact * (1.0 - 1e-14) && k.sigma() < exact * (1.0 + 1e-14),
             "{}",
-            k.sigma
+            k.sigma()
         );
-        assert_eq!(k.rho, 0.0);
+        assert_eq!(k.rho(), 0.0);
         assert!(
-            k.provenance.to_string().contains("2 vertex matrices"),
+            k.provenance().to_string().contains("2 vertex matrices"),
             "{}",
-            k.provenance
+            k.provenance()
         );
     }
 
@@ -219,9 +223,13 @@ mod tests {
     fn linear_is_exact() {
         let (model, d) = model_of(&spec("linear.sde"));
         let k = constants(&model, &d, &[1.0, 0.0, 0.0, 1.0]).unwrap();
-        assert_eq!(k.c, -0.4);
+        assert_eq!(k.c(), -0.4);
         let s = 2f64.sqrt();
-        assert!(k.sigma >= s && (k.sigma - s) / s <= 1e-15, "{}", k.sigma);
+        assert!(
+            k.sigma() >= s && (k.sigma() - s) / s <= 1e-15,
+            "{}",
+            k.sigma()
+        );
     }
 
     #[test]
@@ -231,9 +239,9 @@ mod tests {
              drift {\n x' = -x + 2 * u\n}\n",
         );
         let k = constants(&model, &d, &[1.0]).unwrap();
-        assert_eq!(k.rho, 1.0);
-        assert_eq!(k.c, -1.0);
-        assert_eq!(k.sigma, 0.0);
+        assert_eq!(k.rho(), 1.0);
+        assert_eq!(k.c(), -1.0);
+        assert_eq!(k.sigma(), 0.0);
         // Two inputs: |B diag(h) s|_P over the corners, B = [[1, 1], [0, 3]], h = [1, 0.5].
         let (model, d) = model_of(
             "model u2\nstate x in [0, 1]\nstate y in [0, 1]\ninput u in [-1, 1]\n\
@@ -242,7 +250,7 @@ mod tests {
         let k = constants(&model, &d, &[1.0, 0.0, 0.0, 1.0]).unwrap();
         // Corners (1, 0.5) -> (1.5, 1.5), (1, -0.5) -> (0.5, -1.5): max norm sqrt(4.5).
         let exact = 4.5f64.sqrt();
-        assert!(k.rho >= exact && k.rho < exact * (1.0 + 1e-15));
+        assert!(k.rho() >= exact && k.rho() < exact * (1.0 + 1e-15));
     }
 
     #[test]
@@ -261,7 +269,7 @@ mod tests {
              domain {\n x in [-2, 2]\n}\n",
         );
         let k = constants(&model, &d, &[1.0]).unwrap();
-        assert_eq!(k.c, 0.0);
+        assert_eq!(k.c(), 0.0);
     }
 
     #[test]

@@ -301,23 +301,23 @@ pub(super) fn info_doc(info: &ModelInfo) -> TokenStream {
     let mut text = format!(
         "Names, sets and analyses of the model `{}`, with the constants of Assumption 1\n\
          the compiler derived for each analysis (and how).",
-        info.name.replace('`', "'")
+        info.name().replace('`', "'")
     );
     let one_line = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
     let mut list = Vec::new();
-    for a in &info.analyses {
+    for a in info.analyses() {
         let method = a.spec.method.name();
         let what = match &a.constants {
             Ok(c) => format!(
                 "c = {}, sigma = {}, rho = {}\n    {}",
                 match a.spec.rate {
-                    Rate::Global => short(c.c),
-                    Rate::Local => format!("local (global {})", short(c.c)),
+                    Rate::Global => short(c.c()),
+                    Rate::Local => format!("local (global {})", short(c.c())),
                     Rate::Empirical { paths } => format!("empirical ({paths} paths)"),
                 },
-                short(c.sigma),
-                short(c.rho),
-                one_line(&c.provenance.to_string())
+                short(c.sigma()),
+                short(c.rho()),
+                one_line(&c.provenance().to_string())
             ),
             Err(e) => format!("no constants\n    {}", one_line(&e.to_string())),
         };

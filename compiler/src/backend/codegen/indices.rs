@@ -1,7 +1,9 @@
 //! The index constants of a generated model, by spec name: `pub mod state { pub const THETA:
 //! usize = 0; ... }`, and `input` and `noise` likewise, so that code using the model can write
-//! `x[state::THETA]`. One module per kind, so that names of different kinds cannot clash; the
-//! names are [`mangle::const_names`], distinct within a kind.
+//! `x[state::THETA]`; and the names of its analyses, `pub mod analysis { pub const
+//! CONTRACTION: &str = "contraction"; ... }`, for `Reach::new(&Model, analysis::CONTRACTION)`.
+//! One module per kind, so that names of different kinds cannot clash; the names are
+//! [`mangle::const_names`], distinct within a kind.
 
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
@@ -42,9 +44,16 @@ const NOISE: IndexKind = IndexKind {
     doc: "The index of each noise channel by spec name: its column of `G`.",
 };
 
-/// The modules `state`, `input` and `noise` of the model with these names (a kind without
-/// names has none).
-pub(super) fn index_modules(names: &Names<'_>) -> TokenStream {
+const ANALYSIS: IndexKind = IndexKind {
+    module: "analysis",
+    fallback: "ANALYSIS",
+    label: "Analysis",
+    doc: "The name of each analysis, for `Reach::new` and `engine::run`.",
+};
+
+/// The modules `state`, `input` and `noise` of the model with these names, and `analysis` of
+/// its analyses' names (a kind without names has none).
+pub(super) fn index_modules(names: &Names<'_>, analyses: &[String]) -> TokenStream {
     [
         (&STATE, names.states),
         (&INPUT, names.inputs),
@@ -52,13 +61,21 @@ pub(super) fn index_modules(names: &Names<'_>) -> TokenStream {
     ]
     .into_iter()
     .filter(|(_, names)| !names.is_empty())
-    .map(|(kind, names)| index_module(kind, names))
+    .map(|(kind, names)| index_module(kind, names, |i, _| quote!(usize = #i)))
+    .chain(
+        (!analyses.is_empty())
+            .then(|| index_module(&ANALYSIS, analyses, |_, name| quote!(&str = #name))),
+    )
     .collect()
 }
 
-/// `pub mod MODULE { pub const NAME: usize = i; ... }`, each constant documented with the
-/// spec name.
-fn index_module(kind: &IndexKind, names: &[String]) -> TokenStream {
+/// `pub mod MODULE { pub const NAME: TYPE = VALUE; ... }`, each constant documented with the
+/// spec name; `value(i, name)` is `TYPE = VALUE` of the `i`-th name.
+fn index_module(
+    kind: &IndexKind,
+    names: &[String],
+    value: impl Fn(proc_macro2::Literal, &str) -> TokenStream,
+) -> TokenStream {
     let consts = mangle::const_names(names, kind.fallback)
         .into_iter()
         .zip(names)
@@ -66,10 +83,10 @@ fn index_module(kind: &IndexKind, names: &[String]) -> TokenStream {
         .map(|(i, (ident, name))| {
             let ident = format_ident!("{ident}");
             let doc = doc_attrs(&format!("{} `{}`.", kind.label, name.replace('`', "'")));
-            let i = int(i);
+            let value = value(int(i), name);
             quote! {
                 #doc
-                pub const #ident: usize = #i;
+                pub const #ident: #value;
             }
         });
     let (module, doc) = (format_ident!("{}", kind.module), doc_attrs(kind.doc));

@@ -506,7 +506,12 @@ impl Checker<'_> {
             balls: self.balls.iter().map(|(b, _)| b.clone()).collect(),
         };
         let centre = |b: &Bounds| Interval::new(b.lo, b.hi).mid();
-        let x: Vec<f64> = initial.bounding_box()?.iter().map(centre).collect();
+        let x: Vec<f64> = initial
+            .bounding_box()
+            .map_err(|e| e.to_string())?
+            .iter()
+            .map(centre)
+            .collect();
         let u: Vec<f64> = self
             .input_box
             .iter()

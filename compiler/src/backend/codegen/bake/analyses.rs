@@ -5,9 +5,9 @@
 use proc_macro2::TokenStream;
 use quote::quote;
 use reachc_core::model::{
-    Analysis, AnalysisSpec, AutoFit, Constants, Guarantee, Inclusion, InputGain, Integrator,
-    MatrixBound, Method, MetricChoice, MetricRegion, NoConstants, Provenance, RadiusRule, Rate,
-    Region, Split, Transform, TransformSource,
+    Analysis, AnalysisSpec, AutoFit, Constants, ConstantsParts, Guarantee, Inclusion, InputGain,
+    Integrator, MatrixBound, Method, MetricChoice, MetricRegion, NoConstants, Provenance,
+    RadiusRule, Rate, Region, Split, Transform, TransformSource,
 };
 
 use super::{variant, Bake, Baker};
@@ -114,10 +114,11 @@ impl Bake for Split {
     }
 }
 
-/// `Constants { .. }`, with the further metrics' constants in `also` and `alternatives`.
+/// `Constants::from_parts(ConstantsParts { .. })`, with the further metrics' constants in `also`
+/// and `alternatives`.
 impl Bake for Constants {
     fn bake(&self, baker: &mut Baker<'_>) -> TokenStream {
-        let Constants {
+        let ConstantsParts {
             metric,
             metric_region,
             c,
@@ -127,7 +128,7 @@ impl Bake for Constants {
             region,
             also,
             alternatives,
-        } = self;
+        } = self.clone().into_parts();
         // The nested constants first: the `DATA_k` statics are numbered in this order.
         let also = also.bake(baker);
         let alternatives = alternatives.bake(baker);
@@ -137,7 +138,7 @@ impl Bake for Constants {
         let region = region.bake(baker);
         let metric_region = metric_region.bake(baker);
         quote! {
-            Constants {
+            Constants::from_parts(ConstantsParts {
                 metric: #metric,
                 metric_region: #metric_region,
                 c: #c,
@@ -147,7 +148,7 @@ impl Bake for Constants {
                 region: #region,
                 also: #also,
                 alternatives: #alternatives,
-            }
+            })
         }
     }
 }

@@ -13,10 +13,9 @@
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
-use reachc_core::model::{Bounds, ModelInfo};
+use reachc_core::model::{Bounds, ModelInfo, ModelParts};
 
 use super::allow_lints;
-use super::docs::info_doc;
 
 /// `PATH { a: .., b: .. }` from the bindings `a`, `b`, ... (the fields of a value just
 /// destructured), each baked with `baker` in the order listed: the order in which the
@@ -108,8 +107,8 @@ impl<'a> Baker<'a> {
     /// A baker for the `info()` of the model `info`.
     fn new(info: &'a ModelInfo) -> Self {
         Baker {
-            domain: &info.domain,
-            input_box: &info.input_box,
+            domain: info.domain(),
+            input_box: info.input_box(),
             statics: TokenStream::new(),
             count: 0,
             uses_sparse: false,
@@ -182,24 +181,23 @@ impl<'a> Baker<'a> {
     }
 }
 
-/// `pub fn info() -> ModelInfo`, the given `info` as a literal.
+/// `fn info() -> ModelInfo`, the given `info` built through its hidden constructor: the
+/// model type's `Model::info` calls it once.
 pub(super) fn info_fn(info: &ModelInfo) -> TokenStream {
-    let doc = info_doc(info);
     let lints = allow_lints();
     let body = info.bake(&mut Baker::new(info));
     quote! {
-        #doc
+        /// The model data, built once by `Model::info`.
         #lints
-        #[must_use]
-        pub fn info() -> reachc_runtime::model::ModelInfo #body
+        fn info() -> reachc_runtime::model::ModelInfo #body
     }
 }
 
 /// A block: the `use` of the model types, the statics, the bindings `domain` and `input_box`,
-/// then the `ModelInfo` literal. Baked with the [`Baker`] made for this model.
+/// then the `ModelInfo` through its hidden constructor. Baked with the [`Baker`] made for this model.
 impl Bake for ModelInfo {
     fn bake(&self, baker: &mut Baker<'_>) -> TokenStream {
-        let ModelInfo {
+        let ModelParts {
             name,
             states,
             inputs,
@@ -213,12 +211,12 @@ impl Bake for ModelInfo {
             unsafe_sets,
             goals,
             analyses,
-        } = self;
+        } = self.clone().into_parts();
         let name = name.bake(baker);
         let (states, inputs, noises) = (
-            baker.names("STATES", states),
-            baker.names("INPUTS", inputs),
-            baker.names("NOISES", noises),
+            baker.names("STATES", &states),
+            baker.names("INPUTS", &inputs),
+            baker.names("NOISES", &noises),
         );
         let input_box = input_box.bake(baker);
         let initial = initial.bake(baker);
@@ -235,7 +233,7 @@ impl Bake for ModelInfo {
             #statics
             let domain: Vec<Bounds> = #domain;
             let input_box: Vec<Bounds> = #input_box;
-            ModelInfo {
+            ModelInfo::from_parts(ModelParts {
                 name: #name,
                 states: #states,
                 inputs: #inputs,
@@ -249,7 +247,7 @@ impl Bake for ModelInfo {
                 unsafe_sets: #unsafe_sets,
                 goals: #goals,
                 analyses: #analyses,
-            }
+            })
         })
     }
 }
