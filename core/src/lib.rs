@@ -14,6 +14,7 @@ pub mod model;
 pub mod probability;
 pub mod prs;
 mod reach;
+mod sets;
 pub mod simulate;
 pub mod sweep;
 pub mod system;

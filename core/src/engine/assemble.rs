@@ -7,7 +7,6 @@ use super::gaussian;
 use super::local::Found;
 use super::radius::Stochastic;
 use super::safety::{Check, Context};
-use super::transform::Frame;
 use super::uniform::{Scale, Tube};
 use super::Run;
 use crate::interval::Interval;
@@ -16,6 +15,7 @@ use crate::prs::{
     ConstantsUsed, DetSet, GaussianUsed, Proved, Prs, R1Bound, RateUsed, Role, RuleUsed, Span,
     Step, TransformUsed, UniformBound, Unproved, UnsafeVerdict, Validation, Verdict,
 };
+use crate::sets::parallelotope::Frame;
 use crate::sweep;
 use std::borrow::Cow;
 

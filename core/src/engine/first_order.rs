@@ -26,10 +26,11 @@ use super::linalg::{product, product_point};
 use super::linearised::{sliced_jacobian, StepData, Tracker};
 use super::local::Certifier;
 use super::radius::{expm1_over, BoxRadius};
-use super::{zonotope, Run};
+use super::Run;
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Guarantee, InitialSet, Integrator, ModelInfo};
 use crate::prs::{DetSet, Proved, Prs, Role, Span};
+use crate::sets::zonotope;
 
 /// The most terms of the Taylor series of `exp(A tau)` before the remainder bound.
 const TAYLOR_TERMS: usize = 12;

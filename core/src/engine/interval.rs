@@ -31,14 +31,14 @@ use super::assemble::{
 };
 use super::embedding::{BoxStep, Budget, Embedding};
 use super::intersect::cut_by;
-use super::transform::{self, with_buffer, Frame};
 use super::{
     contraction, first_order, hints, local, memo, nominal, r1, radius, validate, Detail, Problem,
     Run, RunError, Setting,
 };
 use crate::interval::Interval;
 use crate::model::{AnalysisSpec, Inclusion, InitialSet, Integrator, Method, ModelInfo, Rate};
-use crate::prs::{DetSet, Proved, Prs, R1Bound, Span, TransformUsed, Unproved};
+use crate::prs::{DetSet, Proved, Prs, R1Bound, Span, Unproved};
+use crate::sets::parallelotope::Frame;
 use crate::system::System;
 
 /// The interval PRS of a run with the given inclusion function.
@@ -420,130 +420,4 @@ pub fn interval_boxes(
             .map(|s| (s.t1, s.lo, s.hi)),
     );
     Ok(out)
-}
-
-/// Whether `x` lies in `[lo, hi] (+) B_P(r)` (`p` the `n x n` metric, row-major): `true` only
-/// if certainly (a point `y` of the box, found by projected coordinate descent, is certified in
-/// interval arithmetic to satisfy `|x - y|_P <= r`).
-pub(crate) fn box_contains(p: &[f64], n: usize, x: &[f64], lo: &[f64], hi: &[f64], r: f64) -> bool {
-    let p = rows(p, n);
-    let mut y = vec![0.0; n];
-    nearest_in_box(&p, x, lo, hi, &mut y);
-    let d: Vec<Interval> = x
-        .iter()
-        .zip(&y)
-        .map(|(&a, &b)| Interval::point(a) - Interval::point(b))
-        .collect();
-    transform::quad_form_at_most(&p, &d, r)
-}
-
-/// Whether `x` lies in `T^-1 [lo, hi] (+) B_P(r)` for the transform `tr`: `true` only if
-/// certainly (inside the parallelotope, or a point `y` of the box certified to satisfy
-/// `|x - T^-1 y|_P <= r`).
-pub(crate) fn parallelotope_contains(
-    p: &[f64],
-    tr: &TransformUsed,
-    x: &[f64],
-    lo: &[f64],
-    hi: &[f64],
-    r: f64,
-) -> bool {
-    ParallelotopeTest::new(p, tr, x.len()).contains(x, lo, hi, r)
-}
-
-/// [`parallelotope_contains`] for one metric and transform, with everything that depends on
-/// them alone (the enclosure of `T^-1` and the metric in `y`) computed once: the same answers,
-/// for callers that test many states (the Monte Carlo check).
-#[derive(Clone, Debug)]
-pub(crate) struct ParallelotopeTest {
-    /// `T` by rows.
-    t: Vec<Vec<f64>>,
-    /// `P` by rows.
-    p: Vec<Vec<f64>>,
-    /// `T` with its inverse's enclosure and the metric `S' P S` of `y`; `None` when the
-    /// transform cannot be used (then only the parallelotope itself is certain).
-    frame: Option<(Frame, Vec<Vec<f64>>)>,
-}
-
-impl ParallelotopeTest {
-    /// For the metric `p` (`n x n` row-major) and the transform `tr`.
-    pub(crate) fn new(p: &[f64], tr: &TransformUsed, n: usize) -> Self {
-        let transform = crate::model::Transform {
-            matrix: tr.matrix.clone(),
-            inverse: tr.inverse.clone(),
-            frame: 0,
-            source: tr.source,
-        };
-        let p = rows(p, n);
-        let frame = Frame::new(&transform, n).ok().map(|f| {
-            let q = f.y_metric(&p);
-            (f, q)
-        });
-        ParallelotopeTest {
-            t: rows(&tr.matrix, n),
-            p,
-            frame,
-        }
-    }
-
-    /// Whether `x` lies in `T^-1 [lo, hi] (+) B_P(r)` (see [`parallelotope_contains`]).
-    pub(crate) fn contains(&self, x: &[f64], lo: &[f64], hi: &[f64], r: f64) -> bool {
-        // Inside the parallelotope (the common case): distance 0, no inverse needed.
-        if transform::inside(&self.t, x, lo, hi) {
-            return true;
-        }
-        let Some((f, q)) = &self.frame else {
-            return false;
-        };
-        // In y the distance is |y - T x|_Q with Q = T^-T P T^-1 (approximately).
-        let n = x.len();
-        with_buffer(2 * n, 0.0, |buf| {
-            let (tx, y) = buf.split_at_mut(n);
-            f.to_y_point(x, tx);
-            nearest_in_box(q, tx, lo, hi, y);
-            // Floating point first: it says `true` only where `certify` would, and settles
-            // most of the states the Monte Carlo check asks about without interval arithmetic.
-            f.clearly_within(&self.p, x, y, r) || f.certify(&self.p, x, y, r)
-        })
-    }
-}
-
-/// A row-major `n x n` matrix by rows.
-fn rows(m: &[f64], n: usize) -> Vec<Vec<f64>> {
-    m.chunks(n).map(<[f64]>::to_vec).collect()
-}
-
-/// A point `y` of the box `[lo, hi]` near the minimiser of `(y - x)' P (y - x)` (projected
-/// coordinate descent; the problem is convex, and any point of the box is a valid candidate, so
-/// a few sweeps suffice).
-///
-/// A sweep is a function of `y`'s bits alone: once one leaves them all unchanged, so would the
-/// rest of the 50, and the loop stops there with the same point (the Monte Carlo check calls
-/// this for every sample state near a set's boundary, most of which converge in a few sweeps).
-fn nearest_in_box(p: &[Vec<f64>], x: &[f64], lo: &[f64], hi: &[f64], y: &mut [f64]) {
-    let n = x.len();
-    for i in 0..n {
-        y[i] = x[i].clamp(lo[i], hi[i]);
-    }
-    for _ in 0..50 {
-        let mut moved = false;
-        for i in 0..n {
-            if p[i][i] <= 0.0 {
-                continue;
-            }
-            let s: f64 = (0..n)
-                .filter(|&j| j != i)
-                .map(|j| p[i][j] * (y[j] - x[j]))
-                .sum();
-            let yi = x[i] - s / p[i][i];
-            if yi.is_finite() {
-                let yi = yi.clamp(lo[i], hi[i]);
-                moved |= yi.to_bits() != y[i].to_bits();
-                y[i] = yi;
-            }
-        }
-        if !moved {
-            break;
-        }
-    }
 }

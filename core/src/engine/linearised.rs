@@ -23,11 +23,12 @@ use super::assemble::Piece;
 use super::first_order::exp_enclosure;
 use super::gaussian::{add, congruence, step_flow};
 use super::linalg::product_point;
-use super::{zonotope, Inputs, Run};
+use super::{Inputs, Run};
 use crate::chi2::chi2_quantile_upper;
 use crate::interval::Interval;
 use crate::model::Guarantee;
 use crate::prs::{DetSet, Span};
+use crate::sets::zonotope;
 
 /// Attempts per step to find an a-priori box for `W` that holds its own bound.
 const MAX_TRIES: usize = 12;

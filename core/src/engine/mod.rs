@@ -40,12 +40,10 @@ mod problem;
 mod r1;
 pub(crate) mod radius;
 mod rates;
-mod safety;
+pub(crate) mod safety;
 mod tighten;
-pub(crate) mod transform;
 mod uniform;
 pub(crate) mod union;
-pub(crate) mod zonotope;
 
 pub use contraction::MAX_BOX_STATES;
 pub use culprit::{Culprit, Detail, Setting};

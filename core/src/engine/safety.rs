@@ -9,11 +9,11 @@
 
 use super::linalg;
 use super::problem::{UnsafeSetError, UnsafeSetFault};
-use super::transform::Frame;
-use super::zonotope;
 use crate::interval::Interval;
 use crate::model::{UnsafeSet, UnsafeShape};
 use crate::prs::{DetSet, Span, UnsafeKind};
+use crate::sets::parallelotope::Frame;
+use crate::sets::zonotope;
 
 /// What the margins of box-shaped sets need besides the set.
 pub(crate) struct Context<'a> {

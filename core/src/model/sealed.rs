@@ -57,7 +57,7 @@ pub struct ConstantsParts {
     /// Where `P` comes from (given, or synthesised for which region).
     pub metric_region: MetricRegion,
     /// Contraction rate: `mu_P(D_x f) <= c` over the region, for all inputs and times (`inf`
-    /// for a [`Rate::Empirical`] analysis: the compiler does not bound it then).
+    /// for a [`Rate::Empirical`](super::Rate::Empirical) analysis: the compiler does not bound it then).
     pub c: f64,
     /// Noise level: `P^(1/2) G G' P^(1/2) <= sigma^2 I`.
     pub sigma: f64,
@@ -357,7 +357,7 @@ impl Constants {
     }
 
     /// Contraction rate: `mu_P(D_x f) <= c` over the region, for all inputs and times (`inf`
-    /// for a [`Rate::Empirical`] analysis: the compiler does not bound it then).
+    /// for a [`Rate::Empirical`](super::Rate::Empirical) analysis: the compiler does not bound it then).
     pub fn c(&self) -> f64 {
         self.c
     }

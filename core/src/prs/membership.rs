@@ -3,10 +3,9 @@
 //! interval), and the PRS's bounding box; for an intersection and for a union of pieces.
 
 use super::{DetSet, Prs, Step};
-use crate::engine::interval;
-use crate::engine::zonotope;
 use crate::interval::Interval;
 use crate::model::Bounds;
+use crate::sets::{boxes, parallelotope, zonotope};
 
 impl Prs {
     /// The index of the report time `t` (within `1e-9` relative to the horizon, so grid times
@@ -84,7 +83,7 @@ impl Prs {
             self.n(),
             "span_contains: x has the wrong dimension"
         );
-        interval::box_contains(
+        boxes::box_contains(
             &self.constants.metric,
             self.n(),
             x,
@@ -138,13 +137,13 @@ impl Prs {
         match &st.det {
             DetSet::Ball { center, .. } => within(p, x, center, st.prs_radius),
             DetSet::Box { lo, hi, .. } => {
-                interval::box_contains(p, n, x, lo, hi, st.r_t) || near_centre()
+                boxes::box_contains(p, n, x, lo, hi, st.r_t) || near_centre()
             }
             DetSet::Parallelotope { lo, hi, .. } => match &self.transform {
                 Some(tr) => {
                     let near = match test {
                         Some(Prepared::Parallelotope(test)) => test.contains(x, lo, hi, st.r_t),
-                        _ => interval::parallelotope_contains(p, tr, x, lo, hi, st.r_t),
+                        _ => parallelotope::parallelotope_contains(p, tr, x, lo, hi, st.r_t),
                     };
                     near || near_centre()
                 }
@@ -190,7 +189,7 @@ impl Prs {
                 .is_some_and(|tr| {
                     let t: Vec<Vec<f64>> =
                         tr.matrix.chunks(self.n()).map(<[f64]>::to_vec).collect();
-                    crate::engine::transform::inside(&t, center, lo, hi)
+                    parallelotope::inside(&t, center, lo, hi)
                 })
                 .then_some(st.r_t),
         }
@@ -288,7 +287,7 @@ impl Prs {
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Prepared<'a> {
     /// The test of a result's parallelotopes (its metric and transform).
-    Parallelotope(&'a interval::ParallelotopeTest),
+    Parallelotope(&'a parallelotope::ParallelotopeTest),
     /// The test of one step's zonotope (with the result's metric).
     Zonotope(&'a zonotope::ZonotopeTest),
 }

@@ -71,9 +71,12 @@ pub use shard::{Shard, ShardError};
 
 #[cfg(doc)]
 use crate::model::Guarantee;
+#[cfg(feature = "test-util")]
 use crate::model::ModelInfo;
 use crate::prs::Prs;
-use crate::system::{Model, System};
+use crate::system::Model;
+#[cfg(feature = "test-util")]
+use crate::system::System;
 use run::{part, whole};
 
 /// The version of reachc that simulates (recorded in parts: only parts of one version merge).

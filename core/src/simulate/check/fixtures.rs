@@ -2,10 +2,10 @@
 //! turned into parallelotopes and zonotopes.
 
 use crate::engine;
-use crate::engine::zonotope;
 use crate::interval::Interval;
 use crate::model::*;
 use crate::prs::{DetSet, Prs, TransformUsed};
+use crate::sets::zonotope;
 use crate::system::System;
 use crate::test_support::models::model;
 use crate::test_support::sets::zonotope_in_box;

@@ -1,10 +1,10 @@
 //! PRS membership at report times: the shortcuts per shape, then `Prs::contains_at`.
 
 use super::{lanes, members, Hulls, Metric};
-use crate::engine::interval::ParallelotopeTest;
-use crate::engine::zonotope::ZonotopeTest;
 use crate::lanes::X8;
 use crate::prs::{DetSet, Prepared, Prs};
+use crate::sets::parallelotope::ParallelotopeTest;
+use crate::sets::zonotope::ZonotopeTest;
 
 /// The PRS shapes the shortcuts know.
 #[derive(Clone, Debug)]

@@ -1,7 +1,7 @@
 use super::*;
-use crate::engine::zonotope;
 use crate::interval::Interval;
 use crate::model::Method;
+use crate::sets::zonotope;
 use crate::simulate::check::fixtures::{methods_and_metrics, parallelotope, result, zonotopes};
 use crate::simulate::check::quad_small;
 use crate::simulate::rng::PathRng;

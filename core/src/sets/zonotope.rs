@@ -3,7 +3,7 @@
 //! in the direction it is used (hulls and supports rounded outward, membership `true` only
 //! when certain). Generators are stored generator-major: `g_j = gens[j n..(j + 1) n]`.
 
-use super::transform::Frame;
+use super::parallelotope::Frame;
 use crate::interval::Interval;
 use crate::lanes::Real;
 use crate::model::{Transform, TransformSource};
@@ -74,7 +74,7 @@ pub(crate) fn contains(p: &[f64], x: &[f64], center: &[f64], gens: &[f64], r: f6
 ///   `|x - z|_P <= sum_s max(|xi_s| - 1, 0) |g_s|_P`: 0 inside `c + G_S [-1, 1]^n`, exact for
 ///   a point beyond one face. `xi` is computed in floating point with an approximate inverse
 ///   `M` of `G_S`, whose error `|G_S^-1 - M| <= e` entry-wise is enclosed as for a coordinate
-///   transform (interval residual `I - M G_S`, see `transform.rs`), every rounding bounded.
+///   transform (interval residual `I - M G_S`, see `parallelotope.rs`), every rounding bounded.
 /// - a point `z = c + G xi` of `Z` near `x` in the metric, the minimiser of the convex
 ///   quadratic `|x - c - G xi|_P^2` over the cube (primal active-set steps from the clamped
 ///   `M (x - c)` or 0, [`nearest_in_cube`]; projected coordinate descent where they stop short),
@@ -360,7 +360,7 @@ impl ZonotopeTest {
     /// `q + sum |P_ij| (|e_i| w_j + w_i |e_j| + w_i w_j)` plus the roundings of both sums,
     /// within `c2 sum |P_ij| (|e_i| + w_i)(|e_j| + w_j)`, `c2 = 16 (n^2 + 4) eps`; and
     /// `r^2 (1 - 4 eps)` lies below the exact `r^2` (the bound of `Frame::clearly_within` in
-    /// `transform.rs`, for a point of the zonotope instead of the parallelotope).
+    /// `parallelotope.rs`, for a point of the zonotope instead of the parallelotope).
     fn clearly_within(&self, x: &[f64], xi: &[f64], r: f64) -> (bool, f64) {
         let n = x.len();
         let (center, gens, p) = (&self.center, &self.gens, &self.p);
@@ -770,8 +770,8 @@ mod tests {
     /// rounded down by no more than rounding.
     #[test]
     fn margins_use_the_support_and_the_hull_with_both_balls() {
-        use super::super::linalg;
-        use super::super::safety::{Check, Context};
+        use crate::engine::linalg;
+        use crate::engine::safety::{Check, Context};
         use crate::model::{Bounds, UnsafeSet, UnsafeShape};
         use crate::prs::DetSet;
         let (c, g) = set();
