@@ -28,13 +28,13 @@ fn compare(name: &str) -> (f64, f64, f64) {
     let mut model = reachc_compiler::driver::load(&spec(name)).unwrap().model;
     let d = Derivatives::of(&mut model);
     let p = synthesize_metric(&model, &d).unwrap();
-    let c_default = constants(&model, &d, &p).unwrap().c;
+    let c_default = constants(&model, &d, &p).unwrap().c();
     let vertices = jacobian_vertices(&model, &d)
         .unwrap()
         .expect("few enough free atoms for vertices");
     let (c_sdp, p_sdp) = optimal_metric(&vertices).expect("SDP solved");
     // Never use the SDP's P unchecked: its rate is the certified one.
-    let c_sdp_certified = constants(&model, &d, &p_sdp).unwrap().c;
+    let c_sdp_certified = constants(&model, &d, &p_sdp).unwrap().c();
     (c_default, c_sdp, c_sdp_certified)
 }
 
