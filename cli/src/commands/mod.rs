@@ -105,10 +105,11 @@ pub enum Command {
     Plot(plot::PlotArgs),
 }
 
-/// Exit code for spec errors.
-pub const EXIT_SPEC: u8 = 1;
-/// Exit code for usage and I/O errors.
-pub const EXIT_USAGE: u8 = 2;
+/// Exit code for spec errors: the runtime's code for an analysis that cannot run
+/// ([`reachc_runtime::app::EXIT_FAILED`]), so one spec problem has one code at every stage.
+pub const EXIT_SPEC: u8 = reachc_runtime::app::EXIT_FAILED;
+/// Exit code for usage and I/O errors (the runtime's [`reachc_runtime::app::EXIT_USAGE`]).
+pub const EXIT_USAGE: u8 = reachc_runtime::app::EXIT_USAGE;
 
 /// Runs the CLI on the process arguments.
 pub fn main() -> ExitCode {
