@@ -16,6 +16,7 @@ use reachc_runtime::engine;
 use reachc_runtime::model::{Bounds, UnsafeShape};
 use reachc_runtime::report;
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::Paired;
 
 use common::{file_names, reachc, spec, text};
 
@@ -422,7 +423,8 @@ fn sample_paths_are_the_monte_carlo_paths() {
         seed: 5,
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&interp, &info, &result, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&interp, &info), &result, &opts, &mut |_, _| {}).unwrap();
     let paths = simulate::result_paths(&interp, &info, &result, &opts).unwrap();
     assert_eq!(paths.len(), 64);
     let p = &result.constants().metric;

@@ -8,6 +8,7 @@ use reachc_core::model::{
     ModelInfo, ModelParts, RadiusRule, Rate, Transform, TransformSource, UnsafeSet, UnsafeShape,
 };
 use reachc_core::prs::{BallBound, DetSet, Prs, Span, Unproved, UnsafeKind, Verdict};
+use reachc_core::system::Paired;
 use reachc_core::{InputPlan, Reach, System};
 
 use reachc_test_support::models::{model, pendulum_constants, pendulum_model, PENDULUM_METRIC};
@@ -807,7 +808,8 @@ fn reach_under_an_input_plan() {
     // A plan is not simulated with random inputs: the simulator refuses it.
     let opts = reachc_core::simulate::Options::default();
     assert!(
-        reachc_core::simulate::simulate_paired(&sys, &inf, &prs, &opts, &mut |_, _| {}).is_err()
+        reachc_core::simulate::simulate(&Paired::new(&sys, &inf), &prs, &opts, &mut |_, _| {})
+            .is_err()
     );
 }
 

@@ -11,6 +11,7 @@ use reachc_runtime::engine;
 use reachc_runtime::interval::Interval;
 use reachc_runtime::model::*;
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::Paired;
 use reachc_runtime::System;
 use reachc_runtime::X8;
 use reachc_test_support::models::model;
@@ -109,7 +110,7 @@ fn linear_100k_paths(bencher: divan::Bencher, threads: usize) {
         ..Options::default()
     };
     bencher.bench(|| {
-        simulate::simulate_paired(&Linear, &info, &result, &opts, &mut |_, _| {})
+        simulate::simulate(&Paired::new(&Linear, &info), &result, &opts, &mut |_, _| {})
             .unwrap()
             .horizon
             .outside_any

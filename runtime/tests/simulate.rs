@@ -10,6 +10,7 @@ use reachc_runtime::merge::merge_files;
 use reachc_runtime::model::*;
 use reachc_runtime::report::simulation::{summary, to_json};
 use reachc_runtime::simulate::{self, InputMode, Options, SimReport};
+use reachc_runtime::system::Paired;
 use reachc_runtime::Prs;
 use reachc_test_support::models::model;
 use reachc_test_support::systems::Linear;
@@ -82,7 +83,7 @@ fn run(sys: &Linear, info: &ModelInfo) -> Prs {
 }
 
 fn simulate(sys: &Linear, info: &ModelInfo, r: &Prs, opts: &Options) -> SimReport {
-    simulate::simulate_paired(sys, info, r, opts, &mut |_, _| {}).unwrap()
+    simulate::simulate(&Paired::new(sys, info), r, opts, &mut |_, _| {}).unwrap()
 }
 
 /// With X0 = 0, the Euler-Maruyama iterate is exactly Gaussian: per coordinate,

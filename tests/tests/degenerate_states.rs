@@ -22,6 +22,7 @@ use reachc_compiler::backend::{interp::Interpreter, prepare};
 use reachc_compiler::driver::check_source;
 use reachc_runtime::model::{Method, ModelInfo};
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::Paired;
 use reachc_runtime::{Prs, Reach, System};
 use reachc_test_support::flow::rk4_step;
 
@@ -223,8 +224,9 @@ fn point_starts_noise_free_states_inputs_and_couplings_in_every_combination() {
                     dt: Some(1e-3),
                     ..Options::default()
                 };
-                let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {})
-                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+                let report =
+                    simulate::simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {})
+                        .unwrap_or_else(|e| panic!("{name}: {e}"));
                 assert!(report.passed(), "{name}: Monte Carlo check failed");
             } else {
                 // Without noise there is no stochastic radius.

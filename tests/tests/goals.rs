@@ -162,7 +162,8 @@ fn misses_say_why() {
 /// unsharded report exactly, goal counts included.
 #[test]
 fn simulate_counts_goal_events_and_tests_their_bounds() {
-    use reachc_runtime::simulate::{self, merge, run_part_paired, Options, Shard};
+    use reachc_runtime::simulate::{self, merge, run_part, Options, Shard};
+    use reachc_runtime::system::Paired;
     let src = "model push\nstate x = 0\nnoise w\ndrift { x' = 1 }\ndiffusion { x: 0.01 * w }\n\
                unsafe wall halfspace { x >= 1 }\n\
                goal pass box { x in [0.2, 0.8] } within [0, 1]\n\
@@ -177,8 +178,9 @@ fn simulate_counts_goal_events_and_tests_their_bounds() {
         goal_bounds: bounds,
         ..Options::default()
     };
-    let run =
-        |o: &Options| simulate::simulate_paired(&sys, &info, &prs, o, &mut |_, _| {}).unwrap();
+    let run = |o: &Options| {
+        simulate::simulate(&Paired::new(&sys, &info), &prs, o, &mut |_, _| {}).unwrap()
+    };
     let report = run(&opts(vec![Some(0.99), Some(0.5), None, Some(0.05)]));
     let counts: Vec<u64> = report.goals.iter().map(|g| g.reached).collect();
     // `start`: in [-0.5, 0.5] from t = 0, but not to the horizon: no path.
@@ -191,7 +193,8 @@ fn simulate_counts_goal_events_and_tests_their_bounds() {
     let parts: Vec<(String, _)> = (0..3)
         .map(|i| {
             let shard = Shard::new(i, 3).unwrap();
-            let part = run_part_paired(&sys, &info, &prs, &o, shard, &mut |_, _| {}).unwrap();
+            let part =
+                run_part(&Paired::new(&sys, &info), &prs, &o, shard, &mut |_, _| {}).unwrap();
             (format!("part {i}"), part)
         })
         .collect();

@@ -12,6 +12,7 @@ use reachc_e2e::{
 use reachc_runtime::prs::{Hint, Proved, Role, Verdict};
 use reachc_runtime::report::simulation::summary;
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::Paired;
 use reachc_runtime::Reach;
 use reachc_test_support::flow::rk4;
 
@@ -313,7 +314,8 @@ fn the_linearised_set_alone_where_the_ball_cannot_be_bounded() {
         seed: 3,
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {}).unwrap();
     assert!(report.passed(), "{}", summary(&report));
     assert_eq!(report.tube.as_ref().map(|t| t.outside), Some(0));
 }

@@ -168,7 +168,8 @@ fn limits_and_refusals_are_reported() {
 #[test]
 fn simulate_checks_the_certified_bound_against_the_paths() {
     use reachc_runtime::report::simulation::{summary, to_json};
-    use reachc_runtime::simulate::{simulate_paired, Options};
+    use reachc_runtime::simulate::{simulate, Options};
+    use reachc_runtime::system::Paired;
     let (sys, info) = brownian(0.5);
     let reach = Reach::paired(&sys, &info, "a").unwrap();
     let bound = reach.safety_probability().unwrap().lower_bound().unwrap();
@@ -180,7 +181,7 @@ fn simulate_checks_the_certified_bound_against_the_paths() {
             safety_bound: Some(b),
             ..Options::default()
         };
-        simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap()
+        simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {}).unwrap()
     };
     let rep = check(bound);
     let s = rep.safety.clone().expect("a model with unsafe sets");

@@ -11,6 +11,7 @@ use reachc_runtime::report::result::{to_json, to_json_with, to_json_within};
 use reachc_runtime::report::schema::{ResultJson, ShapeJson, SimJson};
 use reachc_runtime::report::simulation;
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::Paired;
 use reachc_runtime::{Prs, Reach};
 
 /// `again`, `text` read and written again, is `text` (else the first line that differs).
@@ -173,7 +174,8 @@ fn monte_carlo_reports_round_trip() {
         seed: 1,
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {}).unwrap();
     report_round_trips("pendulum", &simulation::to_json(&report));
 
     let (sys, info) = inline(
@@ -190,7 +192,8 @@ fn monte_carlo_reports_round_trip() {
         goal_bounds: vec![Some(0.9)],
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {}).unwrap();
     let text = simulation::to_json(&report);
     assert!(text.contains("\"safety\": {") && text.contains("\"goals\""));
     report_round_trips("goals", &text);

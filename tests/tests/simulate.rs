@@ -8,6 +8,7 @@ use reachc_e2e::{relative, shipped_specs};
 use reachc_runtime::engine::RunError;
 use reachc_runtime::report::simulation::summary;
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::Paired;
 use reachc_runtime::Reach;
 
 #[test]
@@ -39,8 +40,9 @@ fn every_shipped_spec_passes_the_coverage_check() {
                 seed: 1,
                 ..Options::default()
             };
-            let report = simulate::simulate_paired(&interp, &info, &result, &opts, &mut |_, _| {})
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let report =
+                simulate::simulate(&Paired::new(&interp, &info), &result, &opts, &mut |_, _| {})
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(report.passed(), "{name}:\n{}", summary(&report));
             // Not vacuous: the quantile is a sizeable part of the PRS radius somewhere.
             let ratio = report

@@ -9,6 +9,7 @@ use reachc_runtime::probability::SafetyLimit;
 use reachc_runtime::prs::{DetSet, Prs, Verdict};
 use reachc_runtime::report::simulation::summary;
 use reachc_runtime::simulate::{self, Options};
+use reachc_runtime::system::Paired;
 use reachc_runtime::{Reach, System};
 
 /// A pendulum-like flow from a wide box, where the first-order sets lose the flow's shape
@@ -175,7 +176,8 @@ fn the_union_passes_the_monte_carlo_check() {
         seed: 3,
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&sys, &info, &union, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&sys, &info), &union, &opts, &mut |_, _| {}).unwrap();
     assert!(report.passed(), "{}", summary(&report));
     // Not vacuous: the paths' spread is a sizeable part of the union's set.
     let ratio = report

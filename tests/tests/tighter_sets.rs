@@ -9,6 +9,7 @@ use reachc_runtime::prs::{Proved, Role, UniformBound};
 use reachc_runtime::simulate::{
     self, clopper_pearson_lower as lower_bound, clopper_pearson_upper as upper_bound, Options,
 };
+use reachc_runtime::system::Paired;
 use reachc_runtime::{Prs, Reach};
 
 /// The sum of the logs of the PRS's bounding-box half-widths at the horizon.
@@ -67,7 +68,8 @@ fn linear_exact_sets_are_missed_at_the_nominal_rate() {
         dt: Some(0.001),
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {}).unwrap();
     for step in report.steps.iter().filter(|s| s.t > 0.2) {
         let (lo, hi) = (
             lower_bound(step.outside, paths, 1e-4),
@@ -116,7 +118,8 @@ fn the_mixture_bound_replaces_an_exploding_tube_and_holds() {
         dt: Some(0.002),
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {}).unwrap();
     let tube = report.tube.as_ref().expect("a uniform result");
     assert!(tube.cp_lower <= 0.1, "{} paths left the tube", tube.outside);
     // Not vacuous: some paths do leave it at delta = 0.1.
@@ -327,7 +330,8 @@ fn the_contraction_ball_is_cut_by_the_interval_box() {
         seed: 5,
         ..Options::default()
     };
-    let report = simulate::simulate_paired(&sys, &info, &prs, &opts, &mut |_, _| {}).unwrap();
+    let report =
+        simulate::simulate(&Paired::new(&sys, &info), &prs, &opts, &mut |_, _| {}).unwrap();
     for step in &report.steps {
         assert!(
             lower_bound(step.outside, paths, 1e-4) <= 0.1,

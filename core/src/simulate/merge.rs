@@ -382,10 +382,11 @@ fn report(run: &RunInfo, total: &PartStats, topk: &mut TopK, state_topk: &mut To
 mod tests {
     use super::super::part_file::FORMAT_VERSION;
     use super::super::tests::{info, narrow, sys};
-    use super::super::{run_part_paired, simulate_paired, Options};
+    use super::super::{run_part, simulate, Options};
     use super::*;
     use crate::engine;
     use crate::prs::Prs;
+    use crate::system::Paired;
     use crate::test_support::systems::Linear;
 
     /// The parts of `r` for `shards` shards, each through its file's bytes.
@@ -394,7 +395,8 @@ mod tests {
         (0..shards)
             .map(|i| {
                 let shard = Shard::new(i, shards).unwrap();
-                let part = run_part_paired(sys, &info, r, opts, shard, &mut |_, _| {}).unwrap();
+                let part =
+                    run_part(&Paired::new(sys, &info), r, opts, shard, &mut |_, _| {}).unwrap();
                 let bytes = part.to_bytes();
                 let read = Part::from_bytes(&bytes).unwrap();
                 assert_eq!(read, part);
@@ -422,7 +424,7 @@ mod tests {
                     dt: Some(0.005),
                     ..Options::default()
                 };
-                let whole = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+                let whole = simulate(&Paired::new(&sys, &info), &r, &opts, &mut |_, _| {}).unwrap();
                 assert_eq!(whole.quantile_rank, 51);
                 if r.guarantee == Guarantee::Uniform {
                     assert!(whole.tube.as_ref().unwrap().outside > 30);

@@ -71,13 +71,9 @@ pub use shard::{Shard, ShardError};
 
 #[cfg(doc)]
 use crate::model::Guarantee;
-#[cfg(feature = "test-util")]
-use crate::model::ModelInfo;
 use crate::prs::Prs;
 use crate::system::Model;
-#[cfg(feature = "test-util")]
-use crate::system::System;
-use run::{part, whole};
+use run::part;
 
 /// The version of reachc that simulates (recorded in parts: only parts of one version merge).
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -139,7 +135,8 @@ pub fn simulate<M: Model + ?Sized>(
     opts: &Options,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<SimReport, SimError> {
-    whole(model, model.info(), result, opts, progress)
+    let part = run_part(model, result, opts, Shard::WHOLE, progress)?;
+    merge([(String::new(), part)]).map_err(|e| SimError::Invalid(SimInvalid::Merge(e)))
 }
 
 /// Simulates the paths of `shard` (of `opts.paths`) of `model` and returns their exact
@@ -153,35 +150,6 @@ pub fn run_part<M: Model + ?Sized>(
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<Part, SimError> {
     part(model, model.info(), result, opts, shard, progress)
-}
-
-/// [`simulate`] of the system `sys` with the model data `info`: test support (feature
-/// `test-util`), for tests of hand-written systems and data.
-#[cfg(feature = "test-util")]
-#[doc(hidden)]
-pub fn simulate_paired<S: System + ?Sized>(
-    sys: &S,
-    info: &ModelInfo,
-    result: &Prs,
-    opts: &Options,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<SimReport, SimError> {
-    whole(sys, info, result, opts, progress)
-}
-
-/// [`run_part`] of the system `sys` with the model data `info`: test support (feature
-/// `test-util`).
-#[cfg(feature = "test-util")]
-#[doc(hidden)]
-pub fn run_part_paired<S: System + ?Sized>(
-    sys: &S,
-    info: &ModelInfo,
-    result: &Prs,
-    opts: &Options,
-    shard: Shard,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<Part, SimError> {
-    part(sys, info, result, opts, shard, progress)
 }
 
 #[cfg(test)]

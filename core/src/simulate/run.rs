@@ -4,8 +4,8 @@
 use super::paths::{ChunkStats, Plan, Thresholds};
 use super::plan::make_plan;
 use super::{
-    merge, part_file, topk, Options, Part, PartStats, RunInfo, Shard, SimError, SimInvalid,
-    SimReport, SimUsage, StepInfo, VERSION,
+    part_file, topk, Options, Part, PartStats, RunInfo, Shard, SimError, SimInvalid, SimUsage,
+    StepInfo, VERSION,
 };
 #[cfg(doc)]
 use super::{run_part, simulate};
@@ -25,18 +25,6 @@ const MAX_BATCH: u64 = 1 << 16;
 const BATCH_BYTES: u64 = 32 << 20;
 /// Memory limit of the quantile buffers, in bytes.
 pub(super) const QUANTILE_BYTES: u64 = 8 << 30;
-
-/// [`simulate`] of `sys` with its model data `info`.
-pub(super) fn whole<S: System + ?Sized>(
-    sys: &S,
-    info: &ModelInfo,
-    result: &Prs,
-    opts: &Options,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<SimReport, SimError> {
-    let part = part(sys, info, result, opts, Shard::WHOLE, progress)?;
-    merge([(String::new(), part)]).map_err(|e| SimError::Invalid(SimInvalid::Merge(e)))
-}
 
 /// [`run_part`] of `sys` with its model data `info`.
 pub(super) fn part<S: System + ?Sized>(

@@ -10,6 +10,7 @@ use super::*;
 use crate::engine;
 use crate::interval::Interval;
 use crate::model::*;
+use crate::system::{Paired, System};
 use crate::test_support::models::model;
 use crate::test_support::systems::Linear;
 

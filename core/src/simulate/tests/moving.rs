@@ -86,7 +86,7 @@ fn held(info: &ModelInfo) -> ModelInfo {
 /// The report of `opts.paths` paths of `sys` checked against `info`'s sets.
 fn simulate_sets(sys: &Brownian, info: &ModelInfo, opts: &Options) -> SimReport {
     let r = engine::run_paired(sys, info, &info.analyses[0]).unwrap();
-    simulate_paired(sys, info, &r, opts, &mut |_, _| {}).unwrap()
+    simulate(&Paired::new(sys, info), &r, opts, &mut |_, _| {}).unwrap()
 }
 
 /// The unsafe half-space `x >= offset` (at `t = 0`), its offset moving number `number`.
@@ -218,7 +218,14 @@ fn moving_goals_are_reached_as_in_their_frame() {
     let r = engine::run_paired(&moving, &info, &info.analyses[0]).unwrap();
     let parts = (0..3).map(|i| {
         let shard = Shard::new(i, 3).unwrap();
-        let part = run_part_paired(&moving, &info, &r, &opts, shard, &mut |_, _| {}).unwrap();
+        let part = run_part(
+            &Paired::new(&moving, &info),
+            &r,
+            &opts,
+            shard,
+            &mut |_, _| {},
+        )
+        .unwrap();
         (i.to_string(), Part::from_bytes(&part.to_bytes()).unwrap())
     });
     assert_eq!(merge(parts).unwrap(), rep);

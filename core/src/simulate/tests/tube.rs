@@ -69,7 +69,7 @@ fn a_path_leaving_the_tube_between_report_times_is_counted() {
     assert!(hand_made.span_contains(k, end));
     assert!((0..9).any(|j| !hand_made.span_contains(k, state(j))));
 
-    let simulate = |r: &Prs| simulate_paired(&sys, &info, r, &opts, &mut |_, _| {}).unwrap();
+    let simulate = |r: &Prs| simulate(&Paired::new(&sys, &info), r, &opts, &mut |_, _| {}).unwrap();
     let computed = simulate(&r);
     assert_eq!(computed.tube.as_ref().unwrap().outside, 0);
     let rep = simulate(&hand_made);
@@ -112,7 +112,7 @@ fn the_tube_count_is_a_recount_of_every_euler_state() {
                 hold: Some(0.05),
                 ..Options::default()
             };
-            let rep = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+            let rep = simulate(&Paired::new(&sys, &info), &r, &opts, &mut |_, _| {}).unwrap();
             let (left, between) = recount(&sys, &info, &r, &opts);
             let case = format!("b = {b}, metric {metric:?}, spans x {factor}");
             let counted: Vec<u64> = rep.steps.iter().map(|s| s.left_tube.unwrap()).collect();
@@ -150,7 +150,7 @@ fn the_uniform_verdict_is_decided_by_the_tube() {
             threads: Some(threads),
             ..Options::default()
         };
-        simulate_paired(&sys, &info, r, &opts, &mut |_, _| {}).unwrap()
+        simulate(&Paired::new(&sys, &info), r, &opts, &mut |_, _| {}).unwrap()
     };
     let computed = run(&r, 2);
     assert_eq!(computed, run(&r, 1));
@@ -223,7 +223,7 @@ fn a_zonotope_member_is_counted_as_contains_at_decides() {
             assert_eq!(detected, baseline, "{metric:?}, {threshold}");
             assert_eq!(avx2, baseline, "{metric:?}, {threshold}");
         }
-        let rep = simulate_paired(&sys, &info, &r, &opts, &mut |_, _| {}).unwrap();
+        let rep = simulate(&Paired::new(&sys, &info), &r, &opts, &mut |_, _| {}).unwrap();
         let paths = result_paths(&sys, &info, &r, &opts).unwrap();
         let outside: Vec<u64> = (0..r.steps.len())
             .map(|k| {
@@ -263,7 +263,7 @@ fn malformed_spans_are_refused() {
     ] {
         let mut bad = r.clone();
         change(&mut bad.steps[3].span);
-        match simulate_paired(&sys, &info, &bad, &opts, &mut |_, _| {}) {
+        match simulate(&Paired::new(&sys, &info), &bad, &opts, &mut |_, _| {}) {
             Err(SimError::Invalid(m @ SimInvalid::Span { step: 3, .. })) => {
                 assert!(m.to_string().contains(what), "{m}")
             }
