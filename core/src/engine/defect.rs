@@ -11,7 +11,7 @@
 //! `p([a, b])`, so `d(s) in p'(m) - f(p(m), u, [a, b]) + (p''([a, b]) - J p'([a, b])) [a - m, b - m]`:
 //! a small first term (the Hermite error), and a second that shrinks with the piece.
 
-use super::hermite::Cubic;
+use super::hermite::{Cubic, Piece, PIECES};
 use super::radius::BoxRadius;
 use super::{Culprit, Detail, Integrated, Problem, RunError, Setting};
 use crate::interval::Interval;
@@ -234,7 +234,9 @@ impl<'a> Nominal<'a> {
         let mut jac = vec![Interval::ZERO; self.pattern.len()];
         let mut f_mid = vec![Interval::ZERO; n];
         let mut slope = vec![Interval::ZERO; n];
-        for piece in cubic.pieces() {
+        let mut piece = Piece::new(n);
+        for k in 0..PIECES {
+            cubic.piece(k, &mut piece);
             for i in 0..n {
                 lo[i] = lo[i].min(piece.over.p[i].lo());
                 hi[i] = hi[i].max(piece.over.p[i].hi());

@@ -11,7 +11,7 @@
 //! size of the expressions, not to `n^2`.
 
 use super::defect::{StepBudget, MAX_STEPS, MAX_STEPS_PER_REPORT, MIN_STEP};
-use super::hermite::Cubic;
+use super::hermite::{Cubic, Piece, PIECES};
 use super::nominal::rk4_step;
 use super::{Detail, Integrated, Problem, RunError, Setting};
 use crate::interval::Interval;
@@ -374,7 +374,9 @@ impl<'a> Embedding<'a> {
         let mut hull = vec![Interval::ZERO; n];
         let mut rate = vec![Interval::ZERO; n];
         let mut slope = vec![Interval::ZERO; 2 * n];
-        for piece in cubic.pieces() {
+        let mut piece = Piece::new(2 * n);
+        for k in 0..PIECES {
+            cubic.piece(k, &mut piece);
             let (mid, over) = (&piece.mid, &piece.over);
             let s = &mut self.scratch;
             for j in 0..n {

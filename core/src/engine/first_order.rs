@@ -469,7 +469,10 @@ pub(super) fn exp_enclosure(a: &[f64], n: usize, tau: Interval) -> Option<Vec<In
     let mut s = vec![Interval::ZERO; n * n];
     eye(&mut s);
     for j in (1..=q).rev() {
-        let scaled: Vec<Interval> = at.iter().map(|&v| v / Interval::point(j as f64)).collect();
+        // `A tau / j` as `A tau` times an enclosure of `1 / j`: a product per entry, not a
+        // quotient.
+        let inv = Interval::ONE / Interval::point(j as f64);
+        let scaled: Vec<Interval> = at.iter().map(|&v| v * inv).collect();
         s = product(&scaled, &s, n, n, n);
         eye(&mut s);
     }

@@ -236,9 +236,11 @@ impl Linear {
         let mut tail = Interval::point(nu);
         loop {
             let kk = Interval::point(k as f64);
+            // `h / k` once per term: a product per entry, not a product and a quotient.
+            let scale = h / kk;
             term = product(&term, &sa, n, n, n)
                 .into_iter()
-                .map(|v| v * h / kk)
+                .map(|v| v * scale)
                 .collect();
             phi = add(&phi, &term);
             let ax = product(&sa, &x, n, n, n);

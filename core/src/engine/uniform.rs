@@ -22,6 +22,7 @@
 use super::radius::expm1_over;
 use crate::interval::Interval;
 use crate::kappa::{amgf_minimiser, log_inv_delta_upper, log_phi_lower};
+use std::cell::RefCell;
 
 /// The most epochs (the union bound's price grows with their number).
 const MAX_EPOCHS: usize = 64;
@@ -73,6 +74,35 @@ impl Scale {
 /// overflow and the radius infinite; epochs laid out for a larger `S` hold all the same (any
 /// thresholds covering the horizon's `S` do), and give a radius of about `sqrt(S_FLOOR)`.
 const S_FLOOR: f64 = 1e-200;
+
+/// Slots of [`recent_root`]'s cache.
+const ROOT_SLOTS: usize = 64;
+
+thread_local! {
+    /// Roots recently found on this thread, `(n, target's bits, root)` in a slot chosen by the
+    /// key (`n = 0`: empty).
+    static ROOTS: RefCell<[(usize, u64, f64); ROOT_SLOTS]> =
+        const { RefCell::new([(0, 0, 0.0); ROOT_SLOTS]) };
+}
+
+/// The root for `(n, target)` found by `search`, or the one it found before on this thread.
+/// A report time's root is asked for by its radius, by the radius over the step before it and
+/// by the local rates' region around it; the search is a pure function of `(n, target)`, so
+/// the cache changes no result.
+fn recent_root(n: usize, target: f64, search: impl FnOnce() -> f64) -> f64 {
+    let bits = target.to_bits();
+    let slot = ((bits ^ (bits >> 29) ^ n as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 58)
+        as usize
+        % ROOT_SLOTS;
+    if let Some(z) =
+        ROOTS.with_borrow(|r| (r[slot].0 == n && r[slot].1 == bits).then_some(r[slot].2))
+    {
+        return z;
+    }
+    let z = search();
+    ROOTS.with_borrow_mut(|r| r[slot] = (n, bits, z));
+    z
+}
 
 /// One epoch of the tube.
 #[derive(Clone, Copy, Debug)]
@@ -186,6 +216,11 @@ impl Tube {
         if target.is_nan() || target > 1e50 {
             return f64::INFINITY;
         }
+        recent_root(self.n, target, || self.search(target))
+    }
+
+    /// The root's upper bound for `target` (see [`Tube::root`]).
+    fn search(&self, target: f64) -> f64 {
         // Increasing in z; >= 0 at an upper bound of the root.
         let gap = |z: f64| log_phi_lower(self.n, z) - target;
         // ln Phi_n(0) = 0 < target, and ln Phi_n(z) <= z: the root is at least the target.
