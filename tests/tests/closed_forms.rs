@@ -5,7 +5,7 @@
 //! set and stay close to it.
 
 use reachc_e2e::{inline, linearised_member, reflection_factor};
-use reachc_runtime::prs::Role;
+use reachc_runtime::prs::{Proved, Role};
 use reachc_runtime::{Prs, Reach};
 
 /// The half-width of a one-state result's box at report step `k`, and its centre.
@@ -132,4 +132,59 @@ fn a_linear_time_varying_sde_gets_its_exact_image_and_variance() {
         }
     }
     assert!(worst <= 0.02, "largest relative excess {worst:e}");
+}
+
+/// The stiff reproducer of the fuzz findings (`tests/fuzz/findings/run-timeout.sde`: `x' = v`,
+/// `v' = -4 x - 1e5 v` from `[0.9, 1.1] x [-0.1, 0.1]`, no noise, horizon 5): with RK4 nodes
+/// alone its nominal took 179,546 validated steps (RK4 is stable below `h` of about 2.8e-5); with
+/// ROS2 nodes where RK4 is unstable (method.md 8.4) it takes a few hundred, and the exact flow
+/// `e^(A t) x0` (two real eigenvalues) from the box's corners and centre lies in every set, at
+/// report times and at 20 times inside every report interval.
+#[test]
+fn a_stiff_damper_keeps_long_steps_and_holds_its_exact_flow() {
+    let path = reachc_e2e::workspace().join("tests/fuzz/findings/run-timeout.sde");
+    let (interp, _) = inline(&std::fs::read_to_string(path).unwrap());
+    let prs = Reach::new(&interp, "contraction").unwrap().run().unwrap();
+    assert!(prs.internal_steps() < 1000, "{}", prs.internal_steps());
+    assert!(
+        prs.validation()
+            .rigorous
+            .iter()
+            .any(|p| matches!(p, Proved::ValidatedNominal { ros2, .. } if *ros2 > 0)),
+        "{:?}",
+        prs.validation().rigorous
+    );
+    // A = [[0, 1], [-k, -d]]: eigenvalues l1, l2 (without cancellation), e^(A t) from them.
+    let (k, d) = (4.0f64, 1e5f64);
+    let root = (d * d - 4.0 * k).sqrt();
+    let (l1, l2) = (-2.0 * k / (d + root), -(d + root) / 2.0);
+    let flow = |x0: f64, v0: f64, t: f64| {
+        // x = a e^(l1 t) + b e^(l2 t) with a + b = x0, l1 a + l2 b = v0.
+        let b = (v0 - l1 * x0) / (l2 - l1);
+        let a = x0 - b;
+        let (e1, e2) = ((l1 * t).exp(), (l2 * t).exp());
+        [a * e1 + b * e2, l1 * a * e1 + l2 * b * e2]
+    };
+    // The corners, 1e-9 inside (the closed form rounds: a corner itself may come out an ulp
+    // outside the box at t = 0), and the centre.
+    let e = 1e-9;
+    let starts = [
+        (0.9 + e, -0.1 + e),
+        (0.9 + e, 0.1 - e),
+        (1.1 - e, -0.1 + e),
+        (1.1 - e, 0.1 - e),
+        (1.0, 0.0),
+    ];
+    for (i, st) in prs.steps().iter().enumerate() {
+        for &(x0, v0) in &starts {
+            assert!(prs.contains_at(i, &flow(x0, v0, st.t)), "t = {}", st.t);
+            if i > 0 {
+                let t0 = prs.steps()[i - 1].t;
+                for j in 1..20 {
+                    let t = t0 + (st.t - t0) * f64::from(j) / 20.0;
+                    assert!(prs.span_contains(i, &flow(x0, v0, t)), "t = {t}");
+                }
+            }
+        }
+    }
 }

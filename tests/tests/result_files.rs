@@ -92,3 +92,34 @@ fn members_over_budget_are_written_as_their_bounding_boxes() {
         &boxed_text[..400]
     );
 }
+
+/// The budget is checked on an estimate of the members' size before anything is written: it
+/// must not fall below what the members take (it did, by a factor 4.5: a pendulum over 10^4
+/// report times wrote 77 MB with every member in full under a budget of 32 MiB), nor far above
+/// it. Measured here against the members' text in the full file without its white space (the
+/// file itself, arrays of numbers on one line, is about 1.4 times that): a budget of that size
+/// boxes them, one at 4 times it does not.
+#[test]
+fn the_budget_estimate_follows_the_members_written_size() {
+    let (sys, info) = shipped("pendulum.sde");
+    let prs = Reach::paired(&sys, &info, "contraction")
+        .unwrap()
+        .run()
+        .unwrap();
+    let full: Value =
+        serde_json::from_str(&to_json_within(&prs, Default::default(), usize::MAX)).unwrap();
+    let members: usize = full["also"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| serde_json::to_string(m).unwrap().len())
+        .sum();
+    let boxed = |budget: usize| {
+        let text = to_json_within(&prs, Default::default(), budget);
+        serde_json::from_str::<Value>(&text).unwrap()["also"][0]
+            .get("boxed")
+            .is_some()
+    };
+    assert!(boxed(members), "members of {members} bytes");
+    assert!(!boxed(members * 4), "members of {members} bytes");
+}

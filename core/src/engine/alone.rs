@@ -53,7 +53,10 @@ pub(super) fn run(run: &Run, failed: &RunError) -> Result<Option<Prs>, RunError>
         initial_center: x0,
         input_center: inputs.first().cloned().unwrap_or_default(),
         rigorous: vec![
-            Proved::ValidatedNominal { steps: steps.len() },
+            Proved::ValidatedNominal {
+                steps: steps.len(),
+                ros2: steps.iter().filter(|(s, _)| s.ros2).count(),
+            },
             Proved::LinearisedGaussian { epochs },
             Proved::Margins {
                 given: Method::Contraction,

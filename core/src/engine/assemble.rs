@@ -380,7 +380,7 @@ pub(super) fn constants_used(run: &Run, rho: f64) -> ConstantsUsed {
 }
 
 /// Upper bounds of `sqrt((P^-1)_ii)`: `B_P(r)` lies in the box `|d_i| <= r w_i`.
-fn spread(run: &Run) -> Vec<f64> {
+pub(super) fn spread(run: &Run) -> Vec<f64> {
     run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect()
 }
 

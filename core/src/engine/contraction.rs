@@ -30,8 +30,14 @@ const BOX_STEPS_PER_REPORT: usize = 256;
 /// The shortest step of that box that accuracy alone may ask for, as a fraction of the report
 /// step: a box of no width (a point start) keeps the accuracy target out of reach, and the
 /// analysis' own boxes then go down to `2^-12` of it (4096 steps per report interval, 110 s
-/// spent on `specs/unicycle_lookahead.sde` before the box was dropped for its budget).
-const BOX_ACCURACY_STEPS: usize = 64;
+/// spent on `specs/unicycle_lookahead.sde` before the box was dropped for its budget); so does
+/// a contracting model's box over a long horizon (it shrinks faster than validation's padding).
+const BOX_ACCURACY_STEPS: usize = 16;
+
+/// The fewest report intervals for which a run with local rates first certifies them on the
+/// first interval alone (the pilot costs one interval's nominal and rates again: at most a
+/// sixteenth of the run).
+const PILOT_INTERVALS: usize = 16;
 
 /// The contraction PRS of a run.
 pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
@@ -47,6 +53,17 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     let rho = if run.setup.p == 0 { 0.0 } else { consts.rho };
     let (kappa, radius_rule) = radius::stochastic_factor(n, spec);
 
+    // Local rates that cannot be certified on the first report interval stop the run there,
+    // before the nominal is integrated over the whole horizon (a stiff or blowing-up model
+    // spent seconds on it first): the first pass of `local::passes` on the first interval, the
+    // same steps and regions as the whole run's first pass begins with.
+    if spec.rate == Rate::Local && grid.len() > PILOT_INTERVALS {
+        let pilot = nominal_steps(run, &x0, r1, &grid[..2], &inputs[..1])?;
+        local::pilot(run, |stepper| {
+            local_pass(stepper, &pilot, &grid[..2], r1, r2)
+        })?;
+    }
+
     // The nominal on its internal steps, each with its report interval.
     let steps = nominal_steps(run, &x0, r1, &grid, &inputs)?;
     let validated = spec.integrator == Integrator::Validated;
@@ -55,18 +72,7 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     // constant, or estimated per report interval (empirical).
     let (pieces, local) = match spec.rate {
         Rate::Local => {
-            let local = local::passes(run, |stepper| {
-                let pieces = along(&steps, &grid, r1, r2, |step, _, t0, r| {
-                    let h = Interval::point(step.t1) - Interval::point(t0);
-                    let rates = stepper.step(&step.lo, &step.hi, (t0, step.t1), |q| {
-                        let next = advance(r, (q.c, q.rho), r2, step.defect, h);
-                        r.hi().max(next.hi())
-                    })?;
-                    Ok((rates.c, rates.sigma, rates.rho))
-                })?;
-                let first = pieces.iter().position(|p| p.end.is_some()).unwrap_or(0) + 1;
-                Ok((pieces, first))
-            })?;
+            let local = local::passes(run, |stepper| local_pass(stepper, &steps, &grid, r1, r2))?;
             let found = local::Found::of(&local);
             (local.result, Some(found))
         }
@@ -113,7 +119,10 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     }];
     let mut not_validated = Vec::new();
     if validated {
-        rigorous.push(Proved::ValidatedNominal { steps: internal });
+        rigorous.push(Proved::ValidatedNominal {
+            steps: internal,
+            ros2: steps.iter().filter(|(s, _)| s.ros2).count(),
+        });
     } else {
         not_validated.push(Unproved::Nominal {
             integrator: spec.integrator,
@@ -201,6 +210,27 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
 
 /// The pieces along the nominal's steps, `R` following `R' = c R + rho r2 + |d|_P` with the
 /// rates `rates(step, report interval, t0, R at t0)` gives for each step (`c`, `sigma`, `rho`).
+/// One pass of the local rates along the nominal's `steps` (see [`local::passes`]): the pieces
+/// and the index of the first report time.
+fn local_pass(
+    stepper: &mut local::Stepper,
+    steps: &[(NominalStep, usize)],
+    grid: &[f64],
+    r1: f64,
+    r2: f64,
+) -> Result<(Vec<Piece>, usize), RunError> {
+    let pieces = along(steps, grid, r1, r2, |step, _, t0, r| {
+        let h = Interval::point(step.t1) - Interval::point(t0);
+        let rates = stepper.step(&step.lo, &step.hi, (t0, step.t1), |q| {
+            let next = advance(r, (q.c, q.rho), r2, step.defect, h);
+            r.hi().max(next.hi())
+        })?;
+        Ok((rates.c, rates.sigma, rates.rho))
+    })?;
+    let first = pieces.iter().position(|p| p.end.is_some()).unwrap_or(0) + 1;
+    Ok((pieces, first))
+}
+
 fn along(
     steps: &[(NominalStep, usize)],
     grid: &[f64],
@@ -301,6 +331,7 @@ pub(super) fn nominal_steps(
                     t1: grid[k + 1],
                     x1: w[1].clone(),
                     defect: 0.0,
+                    ros2: false,
                     lo,
                     hi,
                 },

@@ -13,6 +13,7 @@
 
 use super::hermite::{Cubic, Piece, PIECES};
 use super::radius::BoxRadius;
+use super::rosenbrock;
 use super::{Culprit, Detail, Integrated, Problem, RunError, Setting};
 use crate::interval::Interval;
 use crate::system::System;
@@ -99,12 +100,34 @@ impl StepBudget {
 /// of creeping towards it.
 pub(crate) const MIN_STEP: f64 = 1e-6;
 
+/// Accepted steps without ROS2 tries after a ROS2 node was refused.
+const ROS2_REST: u32 = 16;
+
+/// What the nominal has seen of the model's stiffness along the way.
+#[derive(Default)]
+struct Stiffness {
+    /// The last accepted step ended on a ROS2 node.
+    last_ros2: bool,
+    /// Accepted steps to go before ROS2 is tried again after it was refused.
+    rest: u32,
+}
+
+/// Which integrator gives a step's end node (the cubic and its defect bound are the same).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Nodes {
+    Rk4,
+    /// The linearly implicit step of `rosenbrock.rs`, for stiff models.
+    Ros2,
+}
+
 /// One validated step `[t0, t1]` of the nominal.
 pub(super) struct NominalStep {
     /// Its end.
     pub(super) t1: f64,
-    /// The nominal at `t1` (the RK4 node).
+    /// The nominal at `t1` (the RK4 or ROS2 node).
     pub(super) x1: Vec<f64>,
+    /// Whether that node came from ROS2.
+    pub(super) ros2: bool,
     /// An upper bound of `|d(s)|_P` over the step.
     pub(super) defect: f64,
     /// The interval hull of `p([t0, t1])`.
@@ -156,12 +179,13 @@ impl<'a> Nominal<'a> {
         let mut t = 0.0;
         let mut h = grid.get(1).copied().unwrap_or(0.0);
         let mut budget = StepBudget::new(Integrated::Nominal);
+        let mut stiff = Stiffness::default();
         for (k, w) in grid.windows(2).enumerate() {
             let end = w[1];
             budget.next_interval();
             while t < end {
                 budget.take(t, w)?;
-                let (step, used) = self.step(&x, &inputs[k], t, h.min(end - t), w)?;
+                let (step, used) = self.step(&x, &inputs[k], t, h.min(end - t), w, &mut stiff)?;
                 // Land exactly on the report time when the step reaches it.
                 h = (2.0 * used).min(w[1] - w[0]);
                 x = step.x1.clone();
@@ -173,7 +197,11 @@ impl<'a> Nominal<'a> {
     }
 
     /// One accepted step from `(x, t)` in the report interval `window`: tries `h`, halving it
-    /// until the defect is below the tolerance; returns the step and the length used.
+    /// until the defect is below the tolerance; returns the step and the length used. The nodes
+    /// come from RK4, or where RK4 is unstable at the length tried (`|J| h` above
+    /// [`rosenbrock::RK4_LIMIT`], a stiff model) from ROS2 as well: first if the previous step
+    /// used it, else after RK4 failed, and not for [`ROS2_REST`] steps after ROS2 failed (a
+    /// fast mode that oscillates, which ROS2 damps instead of following).
     fn step(
         &self,
         x: &[f64],
@@ -181,9 +209,15 @@ impl<'a> Nominal<'a> {
         t: f64,
         mut h: f64,
         window: &[f64],
+        stiff: &mut Stiffness,
     ) -> Result<(NominalStep, f64), RunError> {
         let end = window[1];
         let min_h = MIN_STEP * (end - window[0]);
+        let norm = if x.len() <= rosenbrock::MAX_STATES {
+            rosenbrock::jacobian_norm(self.sys, x, u, t)
+        } else {
+            0.0
+        };
         loop {
             // The last step of an interval ends exactly on its report time.
             let t1 = if t + h >= end * (1.0 - 1e-15) || end - (t + h) < min_h {
@@ -192,9 +226,26 @@ impl<'a> Nominal<'a> {
                 t + h
             };
             let h_used = t1 - t;
-            if let Some(step) = self.try_step(x, u, t, t1)? {
-                if step.defect <= self.tolerance {
-                    return Ok((step, h_used));
+            let nodes: &[Nodes] = if norm * h_used <= rosenbrock::RK4_LIMIT {
+                &[Nodes::Rk4]
+            } else if stiff.last_ros2 {
+                &[Nodes::Ros2, Nodes::Rk4]
+            } else if stiff.rest > 0 {
+                &[Nodes::Rk4]
+            } else {
+                &[Nodes::Rk4, Nodes::Ros2]
+            };
+            for &by in nodes {
+                if let Some(step) = self.try_step(x, u, t, t1, by)? {
+                    if step.defect <= self.tolerance {
+                        stiff.last_ros2 = by == Nodes::Ros2;
+                        stiff.rest = stiff.rest.saturating_sub(1);
+                        return Ok((step, h_used));
+                    }
+                }
+                if by == Nodes::Ros2 {
+                    stiff.last_ros2 = false;
+                    stiff.rest = ROS2_REST;
                 }
             }
             h = 0.5 * h_used;
@@ -207,21 +258,28 @@ impl<'a> Nominal<'a> {
         }
     }
 
-    /// An RK4 step `[t, t1]` and its defect bound; `None` if a value is not finite (a smaller
-    /// step may help); an error if the nominal leaves the domain.
+    /// A step `[t, t1]` with its end node from `by`, and its defect bound; `None` if a value is
+    /// not finite (a smaller step may help); an error if the nominal leaves the domain.
     fn try_step(
         &self,
         x: &[f64],
         u: &[f64],
         t: f64,
         t1: f64,
+        by: Nodes,
     ) -> Result<Option<NominalStep>, RunError> {
         let sys = self.sys;
         let n = x.len();
         let h = t1 - t;
         let mut f0 = vec![0.0; n];
         sys.drift(x, u, t, &mut f0);
-        let x1 = super::nominal::rk4(sys, x, u, t, h);
+        let x1 = match by {
+            Nodes::Rk4 => super::nominal::rk4(sys, x, u, t, h),
+            Nodes::Ros2 => match rosenbrock::ros2(sys, x, u, t, h) {
+                Some(x1) => x1,
+                None => return Ok(None),
+            },
+        };
         let mut f1 = vec![0.0; n];
         sys.drift(&x1, u, t1, &mut f1);
         if x1.iter().chain(&f0).chain(&f1).any(|v| !v.is_finite()) {
@@ -267,6 +325,7 @@ impl<'a> Nominal<'a> {
             t1,
             defect: self.metric.bound(&defect_half),
             x1,
+            ros2: by == Nodes::Ros2,
             lo,
             hi,
         }))

@@ -20,7 +20,7 @@
 //! floating-point midpoint `M_(k+1)`; the jump `(exp(A h) M_k - M_(k+1)) xi` is added to the
 //! remainder there.
 
-use super::assemble::{assemble_with, Deterministic, Header, Piece, Radii};
+use super::assemble::{assemble_with, spread, Deterministic, Header, Piece, Radii};
 use super::defect::NominalStep;
 use super::linalg::{product, product_point};
 use super::linearised::{sliced_jacobian, StepData, Tracker};
@@ -164,7 +164,7 @@ pub(super) fn deterministic(
     let metric = &run.setup.consts.metric;
     let cert = Certifier::new(run).ok()?;
     let norm = BoxRadius::new(metric, n);
-    let w: Vec<f64> = run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect();
+    let w = spread(run);
     // Generator j of the initial box: h_j e_j, h_j >= |x - x0_j| over the box.
     let bounds = run.initial.bounding_box().ok()?;
     let h: Vec<f64> = bounds

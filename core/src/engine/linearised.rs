@@ -19,7 +19,7 @@
 //! linear flow itself (a zonotope), not by a contraction rate: a remainder in a fast direction is
 //! damped as fast as the flow damps it.
 
-use super::assemble::Piece;
+use super::assemble::{spread, Piece};
 use super::first_order::exp_enclosure;
 use super::gaussian::{add, congruence, step_flow};
 use super::linalg::product_point;
@@ -141,7 +141,7 @@ impl<'r> Tracker<'r> {
             sigma: vec![Interval::ZERO; n * n],
             quantile,
             gens: Vec::new(),
-            w: run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect(),
+            w: spread(run),
             grew: vec![0.0; n],
             epochs,
             pinned,

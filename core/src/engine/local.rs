@@ -17,6 +17,7 @@
 //! scaled by the input box's half-widths. Where the compiler's global constants hold on the
 //! region (no domain, or the region inside it), the smaller of the two is used.
 
+use super::assemble::spread;
 use super::linalg::{self, lambda_max, product, symmetric_part};
 use super::uniform::{Scale, Tube};
 use super::{Detail, JacobianEntry, Problem, Run, RunError, Setting};
@@ -611,6 +612,18 @@ impl Found {
     }
 }
 
+/// The first pass of [`passes`] (no tube yet) alone, for its error: a run whose first report
+/// interval's rates cannot be certified stops there with the error the whole run's first pass
+/// would give, the regions and steps being the same up to that point.
+pub(super) fn pilot<T>(
+    run: &Run,
+    mut pass: impl FnMut(&mut Stepper) -> Result<(T, usize), RunError>,
+) -> Result<(), RunError> {
+    let cert = Certifier::new(run)?;
+    let w = spread(run);
+    pass(&mut Stepper::new(&cert, None, &w)).map(|_| ())
+}
+
 /// Runs `pass` (one sweep of the horizon with a [`Stepper`]; returns its result and the index
 /// into the scale of the first report time) until the tube's epochs fit the scale: the first
 /// pass without a tube, then with the epochs of the previous pass's scale.
@@ -619,7 +632,7 @@ pub(super) fn passes<T>(
     mut pass: impl FnMut(&mut Stepper) -> Result<(T, usize), RunError>,
 ) -> Result<Local<T>, RunError> {
     let cert = Certifier::new(run)?;
-    let w: Vec<f64> = run.setup.p_inv_diag.iter().map(|d| d.sqrt().hi()).collect();
+    let w = spread(run);
     let (n, delta) = (run.setup.n, run.spec.delta);
     let mut stepper = Stepper::new(&cert, None, &w);
     let (_, first) = pass(&mut stepper)?;

@@ -40,6 +40,7 @@ mod problem;
 mod r1;
 pub(crate) mod radius;
 mod rates;
+mod rosenbrock;
 pub(crate) mod safety;
 mod tighten;
 mod uniform;

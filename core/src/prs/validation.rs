@@ -53,6 +53,9 @@ pub enum Proved {
     ValidatedNominal {
         /// The number of internal steps.
         steps: usize,
+        /// How many of them end on a ROS2 node instead of an RK4 one (a stiff model, method.md
+        /// 8.4).
+        ros2: usize,
     },
     /// The embedding system enclosed on validated steps (the comparison principle on each
     /// step's hull; interval method).

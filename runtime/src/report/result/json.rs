@@ -52,20 +52,28 @@ pub fn to_json_within(prs: &Prs, probabilities: Probabilities<'_>, budget: usize
         }
         json.to_text()
     };
-    // The members' sets dominate such a file: each number in it takes about 20 bytes (the
-    // budget is checked on that count before anything is written, rather than on a text of
-    // hundreds of megabytes).
-    let numbers: usize = prs
+    // The members' steps dominate such a file (the budget is checked on an estimate before
+    // anything is written, rather than on a text of hundreds of megabytes): per step, the set
+    // (centre, generators, hull) and the step's other arrays (nominal, spans, hulls: about 8
+    // numbers per state), and its scalar fields.
+    let bytes: usize = prs
         .also()
         .iter()
         .flat_map(|m| m.steps())
-        .map(|st| (st.det.generators().len() + 4) * st.det.center().len())
+        .map(|st| {
+            let numbers = (st.det.generators().len() + 12) * st.det.center().len();
+            numbers * BYTES_PER_NUMBER + BYTES_PER_STEP
+        })
         .sum();
-    write(numbers.saturating_mul(BYTES_PER_NUMBER) > budget)
+    write(bytes > budget)
 }
 
-/// About what one number takes in a result file (17 significant digits, a separator).
+/// About what one number of an array takes in a result file (17 significant digits, a
+/// separator).
 const BYTES_PER_NUMBER: usize = 20;
+
+/// About what a step's scalar fields take (one line each, with their keys and indentation).
+const BYTES_PER_STEP: usize = 640;
 
 impl ResultJson {
     /// The result file of `prs`, its members written in full.

@@ -156,10 +156,14 @@ pub(super) fn proved(p: &Proved) -> String {
              rounding), the initial box in y = T x (interval hull of T X0) and the map back to x \
              (T^-1 enclosed entry-wise within {inverse_error:.1e} of the floating-point inverse)"
         ),
-        Proved::ValidatedNominal { steps } => format!(
-            "nominal trajectory on {steps} validated steps (a cubic through RK4 nodes, its \
+        Proved::ValidatedNominal { steps, ros2 } => format!(
+            "nominal trajectory on {steps} validated steps (a cubic through RK4 nodes{}, its \
              defect bounded in interval arithmetic on each step and added to R_t through the \
-             contraction rate): the sets hold over whole steps, not only at report times"
+             contraction rate): the sets hold over whole steps, not only at report times",
+            match ros2 {
+                0 => String::new(),
+                k => format!(", ROS2 nodes on {k} steps where the model is stiff"),
+            }
         ),
         Proved::ValidatedEmbedding { steps } => format!(
             "embedding system on {} (the comparison principle on each \
