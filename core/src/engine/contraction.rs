@@ -208,8 +208,6 @@ pub(super) fn run(run: &Run) -> Result<Prs, RunError> {
     Ok(prs)
 }
 
-/// The pieces along the nominal's steps, `R` following `R' = c R + rho r2 + |d|_P` with the
-/// rates `rates(step, report interval, t0, R at t0)` gives for each step (`c`, `sigma`, `rho`).
 /// One pass of the local rates along the nominal's `steps` (see [`local::passes`]): the pieces
 /// and the index of the first report time.
 fn local_pass(
@@ -231,6 +229,8 @@ fn local_pass(
     Ok((pieces, first))
 }
 
+/// The pieces along the nominal's steps, `R` following `R' = c R + rho r2 + |d|_P` with the
+/// rates `rates(step, report interval, t0, R at t0)` gives for each step (`c`, `sigma`, `rho`).
 fn along(
     steps: &[(NominalStep, usize)],
     grid: &[f64],

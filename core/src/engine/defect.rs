@@ -213,10 +213,18 @@ impl<'a> Nominal<'a> {
     ) -> Result<(NominalStep, f64), RunError> {
         let end = window[1];
         let min_h = MIN_STEP * (end - window[0]);
-        let norm = if x.len() <= rosenbrock::MAX_STATES {
-            rosenbrock::jacobian_norm(self.sys, x, u, t)
-        } else {
-            0.0
+        // `|J(x)|_inf`, evaluated only where an RK4 step failed or ROS2 is to go first (off the
+        // path of a model that is not stiff); 0 above `rosenbrock::MAX_STATES` (never ROS2).
+        let mut norm = None;
+        let mut stiff_at = |h: f64| {
+            let norm = *norm.get_or_insert_with(|| {
+                if x.len() <= rosenbrock::MAX_STATES {
+                    rosenbrock::jacobian_norm(self.sys, x, u, t)
+                } else {
+                    0.0
+                }
+            });
+            norm * h > rosenbrock::RK4_LIMIT
         };
         loop {
             // The last step of an interval ends exactly on its report time.
@@ -226,16 +234,17 @@ impl<'a> Nominal<'a> {
                 t + h
             };
             let h_used = t1 - t;
-            let nodes: &[Nodes] = if norm * h_used <= rosenbrock::RK4_LIMIT {
-                &[Nodes::Rk4]
-            } else if stiff.last_ros2 {
-                &[Nodes::Ros2, Nodes::Rk4]
-            } else if stiff.rest > 0 {
-                &[Nodes::Rk4]
+            let ros2_first = stiff.last_ros2 && stiff_at(h_used);
+            let order = if ros2_first {
+                [Nodes::Ros2, Nodes::Rk4]
             } else {
-                &[Nodes::Rk4, Nodes::Ros2]
+                [Nodes::Rk4, Nodes::Ros2]
             };
-            for &by in nodes {
+            for by in order {
+                // ROS2 after a failed RK4 only where RK4 is unstable, and not while resting.
+                if by == Nodes::Ros2 && !ros2_first && (stiff.rest > 0 || !stiff_at(h_used)) {
+                    continue;
+                }
                 if let Some(step) = self.try_step(x, u, t, t1, by)? {
                     if step.defect <= self.tolerance {
                         stiff.last_ros2 = by == Nodes::Ros2;

@@ -238,11 +238,22 @@ pub(crate) fn lambda_max_upper(a: &[Interval], k: usize) -> f64 {
     if k == 1 {
         return a[0].hi();
     }
-    let gersh = gershgorin_upper(a, k);
-    let mid: Vec<f64> = a.iter().map(|x| x.mid()).collect();
-    let est = jacobi_eigenvalues(&mid, k)
+    let centre: Vec<f64> = a.iter().map(|x| x.mid()).collect();
+    verified_above(a, k, top_eigenvalue(&centre, k))
+}
+
+/// The largest eigenvalue of the symmetric `k x k` matrix `m`, estimated (Jacobi, floats).
+fn top_eigenvalue(m: &[f64], k: usize) -> f64 {
+    jacobi_eigenvalues(m, k)
         .into_iter()
-        .fold(f64::NEG_INFINITY, f64::max);
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// [`lambda_max_upper`] for `k >= 2` from the estimate `est`: the first `est + margin` the
+/// interval Cholesky factorisation certifies, margins from `1e-13` of the matrix's scale up by
+/// tens, capped by Gershgorin's bound.
+fn verified_above(a: &[Interval], k: usize, est: f64) -> f64 {
+    let gersh = gershgorin_upper(a, k);
     if !est.is_finite() {
         return gersh;
     }
@@ -374,7 +385,9 @@ pub(crate) fn lambda_max(s: &[Interval], n: usize) -> f64 {
     if n <= 1 {
         return lambda_max_upper(s, n);
     }
-    let mid: Vec<Interval> = s.iter().map(|v| Interval::point(v.mid())).collect();
+    let centre: Vec<f64> = s.iter().map(|v| v.mid()).collect();
+    let mid: Vec<Interval> = centre.iter().map(|&c| Interval::point(c)).collect();
+    let est = top_eigenvalue(&centre, n);
     let mut spread = 0.0f64;
     for i in 0..n {
         let mut row = Interval::ZERO;
@@ -388,12 +401,8 @@ pub(crate) fn lambda_max(s: &[Interval], n: usize) -> f64 {
         }
         spread = spread.max(row.hi());
     }
-    let split = (Interval::point(lambda_max_upper(&mid, n)) + Interval::point(spread)).hi();
+    let split = (Interval::point(verified_above(&mid, n, est)) + Interval::point(spread)).hi();
     let mut best = split.min(gershgorin_upper(s, n));
-    let centre: Vec<f64> = mid.iter().map(|x| x.lo()).collect();
-    let est = jacobi_eigenvalues(&centre, n)
-        .into_iter()
-        .fold(f64::NEG_INFINITY, f64::max);
     let scale = s
         .iter()
         .map(|x| x.mag())
