@@ -116,6 +116,40 @@ fn pendulum_inspect_json_has_the_papers_vertex_matrices() {
     assert_eq!(j["unbounded"], serde_json::json!([]));
 }
 
+/// A discrete-time model: its time and period, the map printed as next values (`x = ..`).
+#[test]
+fn inspect_shows_a_discrete_time_model() {
+    let path = temp_spec(
+        "chain.sde",
+        "model chain\ndiscrete { period = 0.1 }\nstate x1 in [-1, 1]\nstate x2 = 0\n\
+         input u in [-0.1, 0.1]\nnoise w1\n\
+         update { x1 = x1 + 0.1 * x2  x2 = 0.9 * x2 - 0.1 * x1 + u }\n\
+         diffusion { x2: 0.05 * w1 }\nanalysis a { horizon = 0.3 }\n",
+    );
+    let path = path.to_str().unwrap();
+    let out = reachc(&["inspect", "--json", path]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["time"], serde_json::json!({"discrete": {"period": 0.1}}));
+    assert_eq!(
+        j["drift"],
+        serde_json::json!(["x1 + 0.1*x2", "0.9*x2 - 0.1*x1 + u"])
+    );
+    assert_eq!(j["analyses"][0]["horizon"], 3.0 * 0.1);
+    assert_eq!(j["analyses"][0]["step"], 0.1);
+    let text = reachc(&["inspect", path]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("discrete time: one step every period 0.1"),
+        "{text}"
+    );
+    assert!(
+        text.contains("update (simplified):\n  x1 = x1 + 0.1*x2\n"),
+        "{text}"
+    );
+    assert_eq!(inspect_json("pendulum.sde")["time"], "continuous");
+}
+
 #[test]
 fn unbounded_entries_are_reported() {
     // Van der Pol's Jacobian is polynomial: bounded only because the spec gives a domain.

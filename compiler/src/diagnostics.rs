@@ -139,3 +139,14 @@ pub fn render(diags: &[Diagnostic], path: &str, src: &str, color: bool) -> Strin
     }
     String::from_utf8_lossy(&out).into_owned()
 }
+
+/// The byte span of the `n`th (0-based) occurrence of `needle` in `src` (for tests of spans).
+#[cfg(test)]
+pub(crate) fn span_of(src: &str, needle: &str, n: usize) -> Span {
+    let start = src
+        .match_indices(needle)
+        .nth(n)
+        .unwrap_or_else(|| panic!("{needle:?} not in {src:?}"))
+        .0;
+    start..start + needle.len()
+}

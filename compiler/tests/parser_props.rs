@@ -55,6 +55,8 @@ const VOCAB: &[&str] = &[
     "drift",
     "diffusion",
     "domain",
+    "discrete",
+    "update",
     "initial",
     "unsafe",
     "analysis",

@@ -80,6 +80,8 @@ pub struct ModelInfo {
     /// the noise of the linearisation along the nominal cancels the model's exactly and the
     /// first-order sets get a Gaussian part (method.md 8.10).
     pub(crate) constant_diffusion: bool,
+    /// Continuous time (an SDE) or discrete time (a map stepped at a fixed period).
+    pub(crate) time: Time,
     /// Unsafe sets.
     pub(crate) unsafe_sets: Vec<UnsafeSet>,
     /// Goal sets (reach-avoid and reach-and-stay questions, method.md 8.13).
@@ -329,6 +331,32 @@ impl Integrator {
             Integrator::Validated => "validated",
             Integrator::Rk4 => "rk4",
             Integrator::Euler => "euler",
+        }
+    }
+}
+
+/// Whether a model is a stochastic differential equation or a stochastic map.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Time {
+    /// `dX = f(X, u, t) dt + G(X, t) dW`: [`System::drift`](crate::System::drift) is `f`.
+    #[default]
+    Continuous,
+    /// `X_(k+1) = f(X_k, u_k, t_k) + G(X_k, t_k) w_k` at the times `t_k = k period`, the `w_k`
+    /// independent standard normal vectors: [`System::drift`](crate::System::drift) is the map
+    /// `f` (the next state, not a rate) and [`System::diffusion`](crate::System::diffusion) the
+    /// noise's gain `G` per step (method.md 8.16).
+    Discrete {
+        /// The sampling period: the time between two steps, `> 0`.
+        period: f64,
+    },
+}
+
+impl Time {
+    /// The period of a discrete-time model, `None` for continuous time.
+    pub fn period(self) -> Option<f64> {
+        match self {
+            Time::Continuous => None,
+            Time::Discrete { period } => Some(period),
         }
     }
 }
@@ -665,6 +693,10 @@ pub enum MetricRegion {
     /// smaller PRS at the horizon than the metric synthesised over the initial set (the engine
     /// ran both, see [`Constants::alternatives`]).
     IdentityAtRun,
+    /// A discrete-time model's `metric = auto` (method.md 8.16): the inverse of the deviation's
+    /// covariance at the horizon for an affine map with additive noise, else the solution of
+    /// `A' P A - P = -I` for the map's Jacobian `A` at the initial set's centre.
+    Map,
 }
 
 /// The states, inputs and times over which [`Constants`] were certified. A run whose model
@@ -694,6 +726,10 @@ pub enum Provenance {
     },
     /// Given by hand (a hand-written system, a test): not certified by reachc.
     Given,
+    /// A discrete-time model: the compiler bounds nothing (`c`, `sigma`, `rho` are infinite);
+    /// the engine bounds the map's factor, the noise level and the input gain on each step's
+    /// region at run time (method.md 8.16).
+    Map,
     /// The compiler could not bound them over the domain (`c`, `sigma`, `rho` are infinite):
     /// only an analysis with [`Rate::Local`] can run, bounding them on the tube at run time.
     Unbounded {

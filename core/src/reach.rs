@@ -8,7 +8,7 @@ use crate::engine::{
 use crate::interval::Interval;
 use crate::model::{
     Analysis, AnalysisSpec, Bounds, Constants, Guarantee, Inclusion, InitialSet, Method, ModelInfo,
-    Rate, Split,
+    Rate, Split, Time,
 };
 use crate::prs::{Prs, Role, Verdict};
 use crate::system::{Model, System};
@@ -92,6 +92,12 @@ impl<'a> Reach<'a> {
     ) -> Result<Reach<'a>, RunError> {
         let spec = &analysis.spec;
         let needs = match (spec.method, spec.rate) {
+            // A discrete-time model's factors are bounded at run time, for either guarantee.
+            _ if info.time() != Time::Continuous => Needs {
+                c: false,
+                sigma: false,
+                rho: false,
+            },
             (_, Rate::Local) if spec.guarantee != Guarantee::Uniform => {
                 return Err(RunError::Unsupported(
                     Detail::from(Problem::LocalPointwise).at_setting(Setting::Rate),

@@ -18,6 +18,14 @@ use crate::simulate::{
 use std::fmt::{self, Display, Formatter};
 
 /// Writes `items` separated by `", "`.
+/// A region's ranges, `s in [lo, hi], ...`, and the closing parenthesis.
+fn region_list(f: &mut Formatter<'_>, region: &[(String, crate::Interval)]) -> fmt::Result {
+    list(f, region, |f, (s, v)| {
+        write!(f, "{s} in [{:.4e}, {:.4e}]", v.lo(), v.hi())
+    })?;
+    f.write_str(")")
+}
+
 fn list<T>(
     f: &mut Formatter<'_>,
     items: &[T],
@@ -347,10 +355,7 @@ impl Display for Problem {
                      holds the tube its own rates give (last region tried: ",
                     time(*t)
                 )?;
-                list(f, region, |f, (s, v)| {
-                    write!(f, "{s} in [{:.4e}, {:.4e}]", v.lo(), v.hi())
-                })?;
-                f.write_str(")")?;
+                region_list(f, region)?;
                 if let Some(e) = entry {
                     write!(
                         f,
@@ -363,6 +368,47 @@ impl Display for Problem {
                 }
                 f.write_str(". A shorter horizon, a smaller initial set or less noise may help")
             }
+            Problem::DiscreteSetting(setting) => write!(
+                f,
+                "`{}` as given does not apply to a discrete-time model",
+                setting.key()
+            ),
+            Problem::NotWholePeriods {
+                setting,
+                value,
+                period,
+            } => write!(
+                f,
+                "{} = {value} is not a whole number of periods (period {period})",
+                setting.key()
+            ),
+            Problem::MapFactor {
+                t,
+                region,
+                pointwise,
+            } => {
+                write!(
+                    f,
+                    "the map's factor or noise level cannot be bounded on the step from t = {} \
+                     (region: ",
+                    time(*t)
+                )?;
+                region_list(f, region)?;
+                if *pointwise {
+                    f.write_str(
+                        ": a pointwise guarantee bounds them over the whole domain; \
+                         `guarantee = uniform` bounds them on the tube, or give a `domain`",
+                    )
+                } else {
+                    f.write_str(". A shorter horizon, a smaller initial set or less noise may help")
+                }
+            }
+            Problem::MapNotFinite { t } => write!(
+                f,
+                "the interval method's box of the map is not finite at t = {}: the contraction \
+                 method or a shorter horizon may help",
+                time(*t)
+            ),
             Problem::EmpiricalSampling(e) => {
                 write!(f, "sampling paths for the empirical rate: {e}")
             }
@@ -531,6 +577,11 @@ impl Display for SimUsage {
                 write!(f, "at most {max} paths can be recorded, not {paths}")
             }
             SimUsage::Dt(dt) => write!(f, "dt = {dt} must be positive and finite"),
+            SimUsage::DtDiscrete(dt) => write!(
+                f,
+                "dt = {dt}: a discrete-time model is simulated one step of its map at a time, \
+                 exactly; leave out --dt"
+            ),
             SimUsage::DtSteps(dt) => write!(f, "dt = {dt} gives too many Euler steps"),
             SimUsage::Hold(hold) => {
                 write!(f, "the hold time {hold} must be positive and finite")
@@ -849,6 +900,11 @@ impl Display for MetricRegion {
             MetricRegion::InitialSet => {
                 "synthesised for the Jacobian over the initial set during the first report step"
             }
+            MetricRegion::Map => {
+                "chosen for the map at the initial set's centre (the inverse of the deviation's \
+                 covariance at the horizon for an affine map with additive noise, else the \
+                 solution of A' P A - P = -I)"
+            }
             MetricRegion::IdentityAtRun => {
                 "the identity: a smaller PRS at the horizon than the metric synthesised over the \
                  initial set (both were run)"
@@ -905,13 +961,18 @@ impl Display for InputGain {
 
 impl Display for Provenance {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
-        let (c, sigma, rho) = match self {
-            Provenance::Certified { c, sigma, rho } => (c, sigma, rho),
-            Provenance::Given => return f.write_str("given by hand, not certified by reachc"),
-            Provenance::Unbounded { why } => {
-                return write!(f, "not bounded over the domain ({why})");
-            }
-        };
+        let (c, sigma, rho) =
+            match self {
+                Provenance::Certified { c, sigma, rho } => (c, sigma, rho),
+                Provenance::Given => return f.write_str("given by hand, not certified by reachc"),
+                Provenance::Map => return f.write_str(
+                    "a discrete-time model: the map's factors are bounded on each step's region \
+                     at run time",
+                ),
+                Provenance::Unbounded { why } => {
+                    return write!(f, "not bounded over the domain ({why})");
+                }
+            };
         match c {
             Some(c) => write!(f, "c: {c}; ")?,
             None => f.write_str("c: not bounded by the compiler; ")?,

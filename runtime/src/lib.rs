@@ -32,7 +32,7 @@
 //! #     let parts = ModelParts {
 //! #         name: "decay".into(), states: vec!["x".into()], inputs: vec![], noises: vec!["w".into()],
 //! #         input_box: vec![], initial: InitialSet::from_box(&[Bounds::new(0.9, 1.1)]),
-//! #         domain: vec![Bounds::ENTIRE], has_domain: false, affine: false, constant_diffusion: false, unsafe_sets: vec![], goals: vec![], analyses: vec![],
+//! #         domain: vec![Bounds::ENTIRE], has_domain: false, affine: false, constant_diffusion: false, time: Default::default(), unsafe_sets: vec![], goals: vec![], analyses: vec![],
 //! #     };
 //! #     let constants = Constants::given(&ModelInfo::from_parts(parts.clone()), vec![1.0], -1.0, 0.5, 0.0);
 //! #     let spec = AnalysisSpec { name: "contraction".into(), horizon: 2.0, ..AnalysisSpec::default() };

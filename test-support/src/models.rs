@@ -24,6 +24,7 @@ pub fn model(name: &str, states: &[&str], noises: &[&str], initial: &[(f64, f64)
         has_domain: false,
         affine: false,
         constant_diffusion: false,
+        time: Default::default(),
         unsafe_sets: vec![],
         goals: vec![],
         analyses: vec![],

@@ -99,6 +99,11 @@ pub fn benchmark_specs() -> Vec<PathBuf> {
     specs_in("specs/arch")
 }
 
+/// The discrete-time specs, `specs/discrete/` (method.md 8.16), sorted by name.
+pub fn discrete_specs() -> Vec<PathBuf> {
+    specs_in("specs/discrete")
+}
+
 /// The `.sde` files of the workspace folder `dir`, sorted by name.
 fn specs_in(dir: &str) -> Vec<PathBuf> {
     reachc_test_support::files::with_extension(&workspace().join(dir), "sde")

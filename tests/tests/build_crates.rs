@@ -22,7 +22,7 @@ use reachc_compiler::package::{
     compile_crate_in, install_runtime, write_crate, BuildError, Cache, CrateOptions,
     InstalledRuntime, Profile, RuntimeDep, WrittenCrate,
 };
-use reachc_e2e::{relative, shipped_specs, workspace};
+use reachc_e2e::{discrete_specs, relative, shipped_specs, workspace};
 use reachc_runtime::{Interval, System};
 use reachc_test_support::files::{with_extension, Scratch};
 use reachc_test_support::rng::Rng;
@@ -689,14 +689,17 @@ fn generated_code_agrees_with_the_interpreter() {
         "unicycle_lookahead",
         "vanderpol",
         "vanderpol_feedback",
+        "discrete/building_automation",
+        "discrete/integrator_chain",
     ];
     let keywords = workspace().join("tests/good/rust_keywords.sde");
     // Every shipped spec that gets `drift_x8` is probed.
-    for path in shipped_specs() {
+    for path in shipped_specs().into_iter().chain(discrete_specs()) {
         let model = load(&path).unwrap().model;
-        let stem = path.file_stem().unwrap().to_string_lossy();
+        let stem = relative(&path);
+        let stem = stem.trim_start_matches("specs/").trim_end_matches(".sde");
         let lanes = model.states.len() <= codegen::LANES_MAX_STATES;
-        assert!(!lanes || shipped.contains(&&*stem), "{stem} is not probed");
+        assert!(!lanes || shipped.contains(&stem), "{stem} is not probed");
     }
     // Specs with at most four states (generated with `drift_x8`) that the shipped ones do not
     // cover: every function of values in lanes and of `t` alone, entries of

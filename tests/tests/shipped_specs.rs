@@ -8,7 +8,7 @@ use reachc_compiler::analysis::Derivatives;
 use reachc_compiler::driver::{check_source, load};
 use reachc_compiler::ir::{ExprId, Names, VarValues};
 use reachc_compiler::model::Model;
-use reachc_e2e::{benchmark_specs, relative, shipped_specs};
+use reachc_e2e::{benchmark_specs, discrete_specs, relative, shipped_specs};
 use reachc_test_support::rng::Rng;
 
 /// A random point: states in the domain (or within 3 of the initial set where unbounded),
@@ -84,7 +84,8 @@ fn central(model: &Model, exprs: &[ExprId], p: &Point, j: usize, input: bool) ->
 
 #[test]
 fn derivatives_match_finite_differences() {
-    for path in shipped_specs().into_iter().chain(benchmark_specs()) {
+    let all = shipped_specs().into_iter().chain(benchmark_specs());
+    for path in all.chain(discrete_specs()) {
         let mut model = load(&path)
             .unwrap_or_else(|e| panic!("{}:\n{e}", relative(&path)))
             .model;

@@ -18,7 +18,7 @@ use reachc_compiler::analysis::{
     bound_matrix, eval_box, split_atoms, time_range, AtomSplit, Derivatives, GradEntry,
 };
 use reachc_compiler::ir::{ExprId, Names};
-use reachc_compiler::model::{Bounds, Model, Moving, Slot, UnsafeShape, Variable};
+use reachc_compiler::model::{Bounds, Model, Moving, Slot, Time, UnsafeShape, Variable};
 
 /// A dense matrix of expressions with its interval bounds.
 struct Matrix {
@@ -188,6 +188,7 @@ struct Doc<'a> {
     noise: Vec<&'a str>,
     initial_balls: Vec<Value>,
     domain_given: bool,
+    time: Value,
     time_range: [f64; 2],
     lets: Vec<LetDoc<'a>>,
     drift: Vec<&'a str>,
@@ -272,6 +273,10 @@ pub fn json(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             })
             .collect(),
         domain_given: model.has_domain,
+        time: match model.time {
+            Time::Continuous => json!("continuous"),
+            Time::Discrete { period } => json!({"discrete": {"period": period}}),
+        },
         time_range: ends(r.time),
         lets: r.lets.iter().map(|(name, expr)| LetDoc { name, expr }).collect(),
         drift: model.drift.iter().map(|&e| r.sde(e)).collect(),
@@ -403,6 +408,12 @@ pub fn text(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
     for line in model.doc.iter().flat_map(|d| d.lines()) {
         let _ = writeln!(o, "  /// {line}");
     }
+    if let Time::Discrete { period } = model.time {
+        let _ = writeln!(
+            o,
+            "  discrete time: one step every period {period} (t = k * {period})"
+        );
+    }
     let _ = writeln!(o, "\nstates (initial set; domain):");
     for ((s, d), b) in model
         .states
@@ -448,9 +459,13 @@ pub fn text(model: &mut Model, out: &mut dyn Write) -> std::io::Result<()> {
             let _ = writeln!(o, "  let {name} = {e}");
         }
     }
-    let _ = writeln!(o, "\ndrift (simplified):");
+    let (block, prime) = match model.time {
+        Time::Continuous => ("drift", "'"),
+        Time::Discrete { .. } => ("update", ""),
+    };
+    let _ = writeln!(o, "\n{block} (simplified):");
     for (s, &f) in model.states.iter().zip(&model.drift) {
-        let _ = writeln!(o, "  {}' = {}", s.name, r.sde(f));
+        let _ = writeln!(o, "  {}{prime} = {}", s.name, r.sde(f));
     }
     let _ = writeln!(
         o,

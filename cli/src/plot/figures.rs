@@ -387,8 +387,9 @@ impl Draw for SetsScene {
             entries.push((
                 Mark::Line(PATHS.mix(0.6), 1),
                 format!(
-                    "{} (Euler-Maruyama)",
-                    count(self.paths.len() as u64, "sample path")
+                    "{} ({})",
+                    count(self.paths.len() as u64, "sample path"),
+                    self.paths_by
                 ),
             ));
         }

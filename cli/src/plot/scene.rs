@@ -33,6 +33,9 @@ pub struct SetsScene {
     pub nominal_label: String,
     /// Sample paths, at every report time.
     pub paths: Vec<Vec<Point>>,
+    /// How the paths were drawn, for the legend: `Euler-Maruyama`, or a discrete-time model's
+    /// `exact map steps`.
+    pub paths_by: &'static str,
     /// Unsafe sets by name.
     pub regions: Vec<(String, Region)>,
     /// Goal sets by name: the projections of their parts (the goal's projection lies in
@@ -308,6 +311,14 @@ pub fn envelope(result: &ResultJson, plane: &Plane) -> Vec<Vec<Point>> {
         .collect()
 }
 
+/// How sample paths are drawn for a model of this period (`None`: continuous time).
+fn paths_by(period: Option<f64>) -> &'static str {
+    match period {
+        Some(_) => "exact map steps",
+        None => "Euler-Maruyama",
+    }
+}
+
 /// The sets figure of a result: the sets at report steps `picked`, the nominal, the sample
 /// paths (flat states at every report time of the result) and the unsafe regions.
 pub fn sets_scene(
@@ -419,6 +430,7 @@ pub fn sets_scene(
         } else {
             "centre of the deterministic set".into()
         },
+        paths_by: paths_by(result.period),
         paths,
         regions,
         goals: Vec::new(),
@@ -535,6 +547,7 @@ pub fn paths_scene(
         reference: None,
         nominal: Vec::new(),
         nominal_label: String::new(),
+        paths_by: paths_by(info.time().period()),
         paths,
         regions,
         goals: Vec::new(),

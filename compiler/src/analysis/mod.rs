@@ -12,6 +12,7 @@ mod objective;
 mod psd;
 #[cfg(feature = "sdp")]
 pub mod sdp;
+mod stein;
 mod transform;
 
 pub use atoms::{split_atoms, Atom, AtomSplit};
@@ -25,4 +26,5 @@ pub use contraction::{
 pub use derivatives::{Derivatives, GradEntry};
 pub use metric::{synthesize_metric, synthesize_metric_over, FULL_METRIC_MAX_DIM};
 pub use objective::{metric_for_result, Objective};
+pub use stein::{map_metric, stein, MAX_KRONECKER_STATES};
 pub use transform::Frame;

@@ -50,7 +50,7 @@ use quote::{format_ident, quote};
 use super::{mangle, Prepared};
 use crate::analysis::Derivatives;
 use crate::ir::{ExprId, Names, Pool};
-use crate::model::{Model, Variable};
+use crate::model::{Model, Time, Variable};
 
 mod bake;
 mod chunk;
@@ -164,7 +164,7 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
         &model.pool,
         &mut tables,
         &name,
-        (&model.drift, &model.diffusion),
+        (&model.drift, &model.diffusion, model.time),
         (&prepared.derivatives, &names),
         (options, lanes),
     );
@@ -209,7 +209,7 @@ pub fn generate_with(model: &Model, prepared: &Prepared, options: &Options) -> S
             &model.pool,
             &mut tables,
             &frame_name,
-            (&frame.drift, &frame.diffusion),
+            (&frame.drift, &frame.diffusion, model.time),
             (&frame.derivatives, &frame_names),
             (options, lanes),
         );
@@ -330,19 +330,20 @@ pub fn generated_header(comment: &str) -> String {
     )
 }
 
-/// The `System` methods (f64 and interval) of a drift, diffusion and their Jacobians, and the
-/// modules of helper functions of those split into chunks (see [`chunk::chunked_method`]); with
-/// `lanes`, also `drift_x8` and `diffusion_x8` (unless they would be chunked).
+/// The `System` methods (f64 and interval) of a drift (a discrete-time model's map), diffusion
+/// and their Jacobians, and the modules of helper functions of those split into chunks (see
+/// [`chunk::chunked_method`]); with `lanes`, also `drift_x8` and `diffusion_x8` (unless they
+/// would be chunked).
 fn system_bodies(
     pool: &Pool,
     tables: &mut Tables,
     owner: &Ident,
-    (drift, diffusion): (&[ExprId], &[Vec<ExprId>]),
+    (drift, diffusion, time): (&[ExprId], &[Vec<ExprId>], Time),
     (d, names): (&Derivatives, &Names<'_>),
     (options, lanes): (&Options, bool),
 ) -> (TokenStream, TokenStream) {
     let nonzeros = d.jac_x_dependencies(pool, drift);
-    let docs = SystemDocs::new(pool, names, (drift, diffusion), d, &nonzeros);
+    let docs = SystemDocs::new(pool, names, (drift, diffusion, time), d, &nonzeros);
     let flat = |m: &[Vec<ExprId>]| -> Vec<ExprId> { m.iter().flatten().copied().collect() };
     let (jac_x, jac_u, diffusion) = (flat(&d.jac_x), flat(&d.jac_u), flat(diffusion));
     let methods = [

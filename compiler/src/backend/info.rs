@@ -4,7 +4,7 @@
 use reachc_core::model::{Analysis, ModelInfo, ModelParts};
 
 use crate::analysis::{
-    constants, constants_without_rate, metric_for_result, synthesize_metric,
+    constants, constants_without_rate, map_metric, metric_for_result, synthesize_metric,
     synthesize_metric_over, time_range, ConstantsError, Derivatives, Frame, Objective,
 };
 use crate::diagnostics::Diagnostic;
@@ -87,6 +87,7 @@ pub fn prepare(model: &mut Model) -> Prepared {
             .iter()
             .flatten()
             .all(|e| model.pool.vars_of(*e).is_empty()),
+        time: model.time,
         unsafe_sets: model.unsafe_sets.clone(),
         goals: model.goals.clone(),
         analyses,
@@ -100,7 +101,8 @@ pub fn prepare(model: &mut Model) -> Prepared {
 }
 
 /// Whether `D_x f` and `G` are constant expressions (no state, input, time or table in them):
-/// the model is affine in the state with additive noise (method.md section 8.1).
+/// the model is affine in the state with additive noise (method.md section 8.1); for a
+/// discrete-time model, an affine map with additive noise.
 fn is_affine(model: &Model, d: &Derivatives) -> bool {
     let constant = |e: &crate::ir::ExprId| model.pool.vars_of(*e).is_empty();
     d.jac_x.iter().flatten().all(constant) && model.diffusion.iter().flatten().all(constant)
@@ -108,12 +110,16 @@ fn is_affine(model: &Model, d: &Derivatives) -> bool {
 
 /// The constants of an analysis: for its metric, or with `metric = auto(states = [..])` one
 /// metric per named state, each chosen for that state's extent at `delta / K`, the first's
-/// constants holding the others' in [`Constants::also`].
+/// constants holding the others' in [`Constants::also`]. A discrete-time model's are
+/// [`map_constants`].
 fn analysis_constants(
     model: &Model,
     d: &Derivatives,
     spec: &AnalysisSpec,
 ) -> Result<Constants, ConstantsError> {
+    if model.time.period().is_some() {
+        return Ok(map_constants(model, d, spec));
+    }
     let MetricChoice::PerState(states) = &spec.metric else {
         return one_metric(model, d, spec, Objective::Volume);
     };
@@ -251,6 +257,45 @@ fn initial_metric(model: &Model, d: &Derivatives, step: f64) -> Vec<f64> {
     synthesize_metric_over(&at_start, d, Interval::new(0.0, step)).unwrap_or_else(|_| identity(n))
 }
 
+/// The constants of an analysis of a discrete-time model: its metric only, nothing certified
+/// (a logarithmic norm of a map's Jacobian bounds nothing; the engine bounds the map's factors
+/// on each step's region at run time), over the domain, the input box and `[0, horizon]`. The
+/// metric is given (`identity`, a matrix) or, for `auto`, the Stein solution for the map's
+/// Jacobian at the initial set's centre ([`map_metric`]; the identity when there is none).
+fn map_constants(model: &Model, d: &Derivatives, spec: &AnalysisSpec) -> Constants {
+    let n = model.states.len();
+    let (metric, metric_region) = match given_metric(spec, n) {
+        Some(p) => (p, MetricRegion::Given),
+        None => map_metric(model, d, map_steps(model, spec)).map_or_else(
+            || (identity(n), MetricRegion::Given),
+            |p| (p, MetricRegion::Map),
+        ),
+    };
+    Constants::from_parts(ConstantsParts {
+        metric,
+        metric_region,
+        c: f64::INFINITY,
+        sigma: f64::INFINITY,
+        rho: f64::INFINITY,
+        provenance: Provenance::Map,
+        region: reachc_core::model::Region {
+            domain: model.domain.clone(),
+            input_box: model.input_box.clone(),
+            time: reachc_core::model::Bounds::new(0.0, spec.horizon),
+        },
+        also: Vec::new(),
+        alternatives: Vec::new(),
+    })
+}
+
+/// The number of steps of a discrete-time analysis (its horizon in periods).
+fn map_steps(model: &Model, spec: &AnalysisSpec) -> usize {
+    model
+        .time
+        .period()
+        .map_or(0, |period| (spec.horizon / period).round() as usize)
+}
+
 /// The metric the spec gives (`identity` or a matrix); `None` for the compiler to choose.
 fn given_metric(spec: &AnalysisSpec, n: usize) -> Option<Vec<f64>> {
     match &spec.metric {
@@ -342,3 +387,6 @@ fn explain(model: &Model, d: &Derivatives, e: &ConstantsError) -> (NoConstants, 
     };
     (why, help)
 }
+
+#[cfg(test)]
+mod tests;

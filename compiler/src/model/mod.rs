@@ -4,10 +4,13 @@
 mod check;
 
 pub use check::check;
+/// A metric scaled by a power of two to a largest entry in `[1, 2)` (as given metrics are).
+pub(crate) use check::normalised as normalised_metric;
 
 use crate::diagnostics::Span;
 use crate::ir::{ExprId, Pool, Table};
 use reachc_core::engine::Setting;
+pub use reachc_core::model::Time;
 
 // The sets and analyses are the core's data model: the checker lowers straight into it and the
 // backends hand it on unchanged.
@@ -34,7 +37,9 @@ pub struct Model {
     pub input_box: Vec<Bounds>,
     /// Noise channels (independent Wiener processes).
     pub noises: Vec<Variable>,
-    /// `f_i(x, u, t)`, one per state.
+    /// Continuous time (`drift`) or discrete time (`discrete { period = .. }` and `update`).
+    pub time: Time,
+    /// `f_i(x, u, t)`, one per state: the drift, or in discrete time the map (the next state).
     pub drift: Vec<ExprId>,
     /// `G[i][k](x, t)`: row per state, column per noise channel (the constant 0 where absent).
     pub diffusion: Vec<Vec<ExprId>>,

@@ -56,11 +56,31 @@ pub enum Item {
     /// A top-level `let` or `for` (definitions for intermediate quantities).
     Stmt(Stmt),
     /// `drift { ... }`: equations `x' = EXPR`, lets, for loops.
-    Drift(Block),
+    Drift {
+        /// The statements.
+        body: Block,
+        /// The whole item, from the keyword.
+        span: Span,
+    },
     /// `diffusion { ... }`: rows `x: EXPR` (linear in the noise names), lets, for loops.
     Diffusion(Block),
     /// `domain { ... }`: memberships `x in [lo, hi]`, for loops.
     Domain(Block),
+    /// `discrete { period = EXPR }`: the model is discrete time, stepped every `period`.
+    Discrete {
+        /// Its fields (`period`).
+        body: Block,
+        /// The whole item, from the keyword.
+        span: Span,
+    },
+    /// `update { ... }`: the next state of a discrete-time model: update equations `x = EXPR`,
+    /// lets, for loops.
+    Update {
+        /// The statements.
+        body: Block,
+        /// The whole item, from the keyword.
+        span: Span,
+    },
     /// `initial KIND { ... }` (KIND is `ball`): fields `over = [..]`, `center`, `radius`, `metric`.
     Initial {
         /// The kind of set (`ball`).
@@ -176,6 +196,15 @@ pub enum Stmt {
         /// The state.
         target: Target,
         /// Right-hand side.
+        rhs: Expr,
+        /// The whole statement.
+        span: Span,
+    },
+    /// `x = EXPR` (update equation of a discrete-time model: the next value of `x`).
+    Update {
+        /// The state.
+        target: Target,
+        /// Right-hand side (at step `k`).
         rhs: Expr,
         /// The whole statement.
         span: Span,

@@ -149,6 +149,33 @@ impl Radii {
         }
     }
 
+    /// The radii of a discrete-time run (method.md 8.16): `at[k]` is `(Psi, r)` at the end of
+    /// `pieces[k]` (a map step), a report interval's radius the largest of its steps'; with
+    /// `union`, the union bound over that many steps made them hold at once.
+    pub(super) fn discrete(
+        pieces: &[Piece],
+        at: &[(f64, f64)],
+        union: Option<usize>,
+        gaussian: Option<GaussianUsed>,
+    ) -> Radii {
+        let (mut pointwise, mut guaranteed) = (Vec::new(), Vec::new());
+        let mut over = 0.0f64;
+        for (p, &(psi, r)) in pieces.iter().zip(at) {
+            over = over.max(r);
+            if p.end.is_some() {
+                pointwise.push((psi, r));
+                guaranteed.push((r, over));
+                over = 0.0;
+            }
+        }
+        Radii {
+            pointwise,
+            guaranteed,
+            uniform: union.map(|steps| (UniformBound::UnionOverSteps, steps)),
+            gaussian,
+        }
+    }
+
     /// No stochastic radius: for sets that hold the stochastic part themselves (method.md
     /// 8.10), at `reports` report times after 0.
     pub(super) fn inside(reports: usize) -> Radii {
@@ -294,6 +321,9 @@ pub(super) fn assemble_with(
     match radii.uniform {
         Some((UniformBound::AmgfTube, epochs)) => rigorous.push(Proved::UniformTube { epochs }),
         Some((UniformBound::Mixture, epochs)) => rigorous.push(Proved::GaussianMixture { epochs }),
+        Some((UniformBound::UnionOverSteps, steps)) => {
+            rigorous.push(Proved::UnionOverSteps { steps })
+        }
         None => {}
     }
     let radius_rule = RuleUsed {
@@ -309,6 +339,7 @@ pub(super) fn assemble_with(
         horizon: run.spec.horizon,
         step: run.spec.step,
         integrator: run.spec.integrator,
+        period: run.info.time.period(),
         guarantee: run.spec.guarantee,
         internal_steps,
         states: run.info.states.clone(),

@@ -373,7 +373,7 @@ fn noise_scale(run: &Run, x0: &[f64]) -> f64 {
 /// `Rbar_0`: the initial set itself where it is a box (inside the ball `B_P(x0, r1)`, which
 /// is all the contraction method propagates), else that ball. Every over-approximation of the
 /// deterministic set is sound, so the smaller one is reported and checked at `t = 0`.
-fn initial_set(run: &Run, x0: &[f64], r1: f64) -> DetSet {
+pub(super) fn initial_set(run: &Run, x0: &[f64], r1: f64) -> DetSet {
     match run.initial.bounding_box() {
         Ok(b) if run.initial.balls.is_empty() => DetSet::Box {
             lo: b.iter().map(|x| x.lo).collect(),

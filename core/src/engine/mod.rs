@@ -22,6 +22,7 @@ mod assemble;
 mod contraction;
 mod culprit;
 mod defect;
+mod discrete;
 mod embedding;
 mod finite;
 mod first_order;
@@ -63,7 +64,7 @@ pub use tighten::{tighten, Constraint, TightStep, TightenError, Tightening};
 use crate::interval::Interval;
 use crate::model::{
     AnalysisSpec, Bounds, Constants, InitialSet, Method, ModelInfo, NoConstants, RadiusRule, Split,
-    MAX_PIECES,
+    Time, MAX_PIECES,
 };
 use crate::prs::Prs;
 use crate::reach::InputPlan;
@@ -340,9 +341,10 @@ pub(crate) use safety::deterministic_limit;
 /// Runs the engine of the analysis' method; a result with a number that is not finite is a
 /// [`RunError::NonFinite`].
 pub(crate) fn run_engine(run: &Run) -> Result<Prs, RunError> {
-    let prs = match run.spec.method {
-        Method::Contraction => contraction::run(run),
-        Method::Interval => interval::run(run, run.spec.inclusion),
+    let prs = match (run.info.time, run.spec.method) {
+        (Time::Discrete { period }, _) => discrete::run(run, period),
+        (Time::Continuous, Method::Contraction) => contraction::run(run),
+        (Time::Continuous, Method::Interval) => interval::run(run, run.spec.inclusion),
     }?;
     finite::check(&prs)?;
     Ok(prs)

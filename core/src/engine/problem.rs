@@ -2,6 +2,7 @@
 //! variant's [`Detail`](super::Detail), with the numbers, times, states and names it is about.
 //! The words live in one place, `core/src/words.rs`.
 
+use super::Setting;
 use crate::interval::Interval;
 use crate::model::{Bounds, Inclusion, Integrator, NoConstants, Rate};
 
@@ -531,6 +532,33 @@ pub enum Problem {
         t: f64,
         /// Which number.
         what: NonFiniteQuantity,
+    },
+    /// A setting that does not apply to discrete-time models (`RunError::Unsupported`).
+    DiscreteSetting(Setting),
+    /// A discrete-time analysis' horizon or report step is not a whole number of periods
+    /// (`RunError::Invalid`).
+    NotWholePeriods {
+        /// `horizon` or `step`.
+        setting: Setting,
+        /// Its value.
+        value: f64,
+        /// The model's period.
+        period: f64,
+    },
+    /// The factor or the noise level of a discrete-time model's map cannot be bounded on the
+    /// region of the step starting at `t` (an unbounded Jacobian or diffusion entry there).
+    MapFactor {
+        /// The step's start.
+        t: f64,
+        /// The region, per state.
+        region: Vec<(String, Interval)>,
+        /// The region is the domain (a pointwise guarantee).
+        pointwise: bool,
+    },
+    /// The box of a discrete-time model's interval method is not finite at `t`.
+    MapNotFinite {
+        /// Where.
+        t: f64,
     },
     /// The worker threads could not be started (`RunError::Invalid`).
     Threads(ThreadsError),

@@ -7,7 +7,7 @@
 
 use super::{
     Analysis, Bounds, Constants, GoalSet, InitialSet, MetricRegion, ModelInfo, Provenance, Region,
-    UnsafeSet,
+    Time, UnsafeSet,
 };
 
 /// The fields of a [`ModelInfo`], for the compiler and generated code only (not part of the
@@ -39,6 +39,8 @@ pub struct ModelParts {
     /// the noise of the linearisation along the nominal cancels the model's exactly and the
     /// first-order sets get a Gaussian part (method.md 8.10).
     pub constant_diffusion: bool,
+    /// Continuous time (an SDE) or discrete time (a map stepped at a fixed period).
+    pub time: Time,
     /// Unsafe sets.
     pub unsafe_sets: Vec<UnsafeSet>,
     /// Goal sets (reach-avoid and reach-and-stay questions, method.md 8.13).
@@ -94,6 +96,7 @@ impl ModelInfo {
             has_domain,
             affine,
             constant_diffusion,
+            time,
             unsafe_sets,
             goals,
             analyses,
@@ -109,6 +112,7 @@ impl ModelInfo {
             has_domain,
             affine,
             constant_diffusion,
+            time,
             unsafe_sets,
             goals,
             analyses,
@@ -129,6 +133,7 @@ impl ModelInfo {
             has_domain,
             affine,
             constant_diffusion,
+            time,
             unsafe_sets,
             goals,
             analyses,
@@ -144,6 +149,7 @@ impl ModelInfo {
             has_domain,
             affine,
             constant_diffusion,
+            time,
             unsafe_sets,
             goals,
             analyses,
@@ -195,6 +201,11 @@ impl ModelInfo {
     /// part from its covariance.
     pub fn affine(&self) -> bool {
         self.affine
+    }
+
+    /// Continuous time (an SDE) or discrete time (a map stepped at a fixed period).
+    pub fn time(&self) -> Time {
+        self.time
     }
 
     /// Whether `G` is constant (no state, input, time or table in it: additive noise). Then

@@ -117,6 +117,8 @@ pub enum UniformBound {
     AmgfTube,
     /// The method-of-mixtures bound for Gaussian martingales (method.md section 8.1).
     Mixture,
+    /// A discrete-time model's steps, each at `delta / K` (method.md section 8.16).
+    UnionOverSteps,
 }
 
 /// How `r1` was bounded (method.md section 6).

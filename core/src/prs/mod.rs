@@ -66,6 +66,9 @@ pub struct Prs {
     pub(crate) step: f64,
     /// Integrator of the nominal trajectory or of the embedding system.
     pub(crate) integrator: Integrator,
+    /// The sampling period of a discrete-time model (method.md 8.16): its sets are at the steps
+    /// `t_k = k period`, the map enclosed exactly; `None` for continuous time.
+    pub(crate) period: Option<f64>,
     /// What the probability level is about: all times at once, or each time separately.
     pub(crate) guarantee: Guarantee,
     /// The number of internal steps of the deterministic part (the engine chooses them; the
@@ -220,6 +223,12 @@ impl Prs {
     /// Integrator of the nominal trajectory or of the embedding system.
     pub fn integrator(&self) -> Integrator {
         self.integrator
+    }
+
+    /// The sampling period of a discrete-time model (its sets are at the steps `k period`, and
+    /// a report interval's span holds the sets of its steps); `None` for continuous time.
+    pub fn period(&self) -> Option<f64> {
+        self.period
     }
 
     /// What the probability level is about: all times at once, or each time separately.

@@ -76,6 +76,22 @@ pub enum Proved {
         /// The number of epochs.
         epochs: usize,
     },
+    /// A discrete-time model's map (method.md 8.16): each step's image enclosed in interval
+    /// arithmetic, and the map's factor `|R J R^-1|_2` and noise level bounded on each step's
+    /// region (verified eigenvalue bounds).
+    MapFactors {
+        /// The number of steps.
+        steps: usize,
+        /// Where the metric was chosen.
+        metric: MetricRegion,
+        /// The regions are the model's domain (a pointwise guarantee), not the tube's boxes.
+        over_domain: bool,
+    },
+    /// The union bound over a discrete-time model's `steps` steps, at `delta / steps` each.
+    UnionOverSteps {
+        /// The number of steps.
+        steps: usize,
+    },
     /// The stochastic part of an affine system from its exact Gaussian covariance (enclosed in
     /// interval arithmetic), with a rigorous chi-square quantile.
     ExactGaussian,

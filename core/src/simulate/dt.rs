@@ -33,6 +33,8 @@ pub enum DtSource {
     Rule,
     /// The `--dt` option.
     Option,
+    /// A discrete-time model: one step per step of its map, exact.
+    Map,
 }
 
 impl DtSource {
@@ -41,6 +43,7 @@ impl DtSource {
         match self {
             DtSource::Rule => "rule",
             DtSource::Option => "option",
+            DtSource::Map => "map",
         }
     }
 }
@@ -261,6 +264,29 @@ fn bound_on<S: System + ?Sized>(
 /// The number of Euler-Maruyama steps of each report interval of `times` and how they compare
 /// with the rule: equal steps of at most `dt_option` when given, the rule's otherwise. An error
 /// (a usage error: the step, given or the rule's) when it gives more than `1e9` steps in one
+/// The steps of a discrete-time model with sampling period `period` over `times` (whole
+/// numbers of periods apart): one per step of its map.
+fn map_steps(times: &[f64], period: f64) -> (Vec<u32>, DtUsed) {
+    let steps = times
+        .windows(2)
+        .map(|w| {
+            ((w[1] - w[0]) / period)
+                .round()
+                .clamp(1.0, f64::from(u32::MAX)) as u32
+        })
+        .collect();
+    let used = DtUsed {
+        source: DtSource::Map,
+        min: period,
+        max: period,
+        rule_min: period,
+        hl_max: 0.0,
+        bias_max: 0.0,
+        coarse: 0,
+    };
+    (steps, used)
+}
+
 /// interval.
 pub(crate) fn choose<S: System + ?Sized>(
     sys: &S,
@@ -269,6 +295,9 @@ pub(crate) fn choose<S: System + ?Sized>(
     times: &[f64],
     dt_option: Option<f64>,
 ) -> Result<(Vec<u32>, DtUsed), f64> {
+    if let Some(period) = info.time().period() {
+        return Ok(map_steps(times, period));
+    }
     let mut used = DtUsed {
         source: dt_option.map_or(DtSource::Rule, |_| DtSource::Option),
         min: f64::INFINITY,

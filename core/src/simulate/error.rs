@@ -34,6 +34,8 @@ pub enum SimUsage {
     },
     /// A time step `dt` that is not positive and finite.
     Dt(f64),
+    /// A time step `dt` given for a discrete-time model (its steps are its map's).
+    DtDiscrete(f64),
     /// A time step `dt` (given or chosen) giving too many Euler steps.
     DtSteps(f64),
     /// A hold time that is not positive and finite.

@@ -34,6 +34,7 @@ mod binomial;
 mod check;
 mod dt;
 mod error;
+mod increments;
 mod initial;
 mod inputs;
 mod merge;
@@ -73,6 +74,7 @@ pub use shard::{Shard, ShardError};
 use crate::model::Guarantee;
 use crate::prs::Prs;
 use crate::system::Model;
+use increments::Increments;
 use run::part;
 
 /// The version of reachc that simulates (recorded in parts: only parts of one version merge).
@@ -149,7 +151,12 @@ pub fn run_part<M: Model + ?Sized>(
     shard: Shard,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<Part, SimError> {
-    part(model, model.info(), result, opts, shard, progress)
+    let info = model.info();
+    match info.time().period() {
+        // The loops step a map as its increments.
+        Some(_) => part(&Increments(model), info, result, opts, shard, progress),
+        None => part(model, info, result, opts, shard, progress),
+    }
 }
 
 #[cfg(test)]

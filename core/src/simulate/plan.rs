@@ -28,6 +28,10 @@ pub(super) fn make_plan<'a, S: System + ?Sized>(
     if let Some(dt) = opts.dt.filter(|dt| !(*dt > 0.0 && dt.is_finite())) {
         return usage(SimUsage::Dt(dt));
     }
+    let map = info.time().period().is_some();
+    if let (true, Some(dt)) = (map, opts.dt) {
+        return usage(SimUsage::DtDiscrete(dt));
+    }
     let hold = opts.hold.unwrap_or(result.step);
     if !(hold > 0.0 && hold.is_finite()) {
         return usage(SimUsage::Hold(hold));
@@ -82,7 +86,10 @@ pub(super) fn make_plan<'a, S: System + ?Sized>(
     let spans: Vec<Span> = times
         .windows(2)
         .zip(steps)
-        .map(|(w, s)| Span::new(w[0], w[1], s))
+        .map(|(w, s)| match map {
+            true => Span::map(w[0], w[1], s),
+            false => Span::new(w[0], w[1], s),
+        })
         .collect();
     let per_path: u64 = spans.iter().map(|s| u64::from(s.steps)).sum();
     // Draws per Euler step: m normals (about 1% need a second draw), p inputs at most.

@@ -26,7 +26,8 @@ const BATCH_BYTES: u64 = 32 << 20;
 /// Memory limit of the quantile buffers, in bytes.
 pub(super) const QUANTILE_BYTES: u64 = 8 << 30;
 
-/// [`run_part`] of `sys` with its model data `info`.
+/// [`run_part`] of `sys` with its model data `info` (for a discrete-time model, `sys` is its
+/// map's [`Increments`](super::increments::Increments)).
 pub(super) fn part<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,

@@ -3,6 +3,7 @@
 //! kept at every report time ([`result_paths`]; [`sample_paths`] without a result) or after
 //! every Euler-Maruyama step ([`result_substeps`]) instead of being reduced to statistics.
 
+use super::increments::Increments;
 use super::initial::InitialSampler;
 use super::inputs::InputSchedule;
 use super::noise::Noise;
@@ -55,12 +56,21 @@ pub fn sample_paths<S: System + ?Sized>(
     if times.len() > 1 && !(dt > 0.0 && dt.is_finite()) {
         return Err(SimError::Usage(SimUsage::Dt(dt)));
     }
+    // (A discrete-time model takes one step per step of its map.)
+    let dt = info.time().period().unwrap_or(dt);
     let substeps = times
         .windows(2)
         .map(|w| ((w[1] - w[0]) / dt * (1.0 - 1e-12)).ceil().max(1.0))
         .map(|s| if s <= 1e9 { s as u32 } else { u32::MAX })
         .collect();
-    record(sys, info, times, center, opts, substeps, false).map(|s| s.paths)
+    let what = Recording {
+        times,
+        center,
+        opts,
+        substeps,
+        every_step: false,
+    };
+    record(sys, info, what).map(|s| s.paths)
 }
 
 /// Path `p` of [`simulate`](super::simulate) of `result` with the same options, recorded at
@@ -102,7 +112,14 @@ fn of_result<S: System + ?Sized>(
     let (substeps, _) = dt::choose(sys, info, result, &times, opts.dt)
         .map_err(|dt| SimError::Usage(SimUsage::DtSteps(dt)))?;
     let center = Some(&result.initial_center[..]);
-    record(sys, info, &times, center, opts, substeps, every_step)
+    let what = Recording {
+        times: &times,
+        center,
+        opts,
+        substeps,
+        every_step,
+    };
+    record(sys, info, what)
 }
 
 /// Report times start at 0 and increase.
@@ -117,17 +134,44 @@ fn check_times(times: &[f64]) -> Result<(), SimError> {
     Ok(())
 }
 
-/// The paths over `times`, report interval `k` split into `substeps[k]` equal Euler-Maruyama
-/// steps, with the states of every step (`every_step`) or of the report times.
+/// What to record: the paths over `times`, report interval `k` split into `substeps[k]` equal
+/// steps, with the states of every step (`every_step`) or of the report times, the constant
+/// diffusion evaluated at `center`.
+struct Recording<'a> {
+    times: &'a [f64],
+    center: Option<&'a [f64]>,
+    opts: &'a Options,
+    substeps: Vec<u32>,
+    every_step: bool,
+}
+
+/// The paths of `what` (Euler-Maruyama steps; a discrete-time model's map stepped as its
+/// increments with `h = 1`).
 fn record<S: System + ?Sized>(
     sys: &S,
     info: &ModelInfo,
-    times: &[f64],
-    center: Option<&[f64]>,
-    opts: &Options,
-    substeps: Vec<u32>,
-    every_step: bool,
+    what: Recording,
 ) -> Result<Substeps, SimError> {
+    match info.time().period() {
+        Some(_) => record_in(&Increments(sys), info, what, true),
+        None => record_in(sys, info, what, false),
+    }
+}
+
+/// [`record`] with the system the loop steps (`map`: a discrete-time model's increments).
+fn record_in<S: System + ?Sized>(
+    sys: &S,
+    info: &ModelInfo,
+    what: Recording,
+    map: bool,
+) -> Result<Substeps, SimError> {
+    let Recording {
+        times,
+        center,
+        opts,
+        substeps,
+        every_step,
+    } = what;
     let usage = |m: SimUsage| Err(SimError::Usage(m));
     let (n, p, m) = (sys.n(), sys.p(), sys.m());
     if opts.paths > MAX_SAMPLE_PATHS.min(MAX_PATHS) {
@@ -189,10 +233,10 @@ fn record<S: System + ?Sized>(
         let mut interval = None;
         for (k, &nsub) in substeps.iter().enumerate() {
             let (t0, t1) = (times[k], times[k + 1]);
-            let h = (t1 - t0) / f64::from(nsub);
-            let sqrt_h = h.sqrt();
+            let dt = (t1 - t0) / f64::from(nsub);
+            let (h, sqrt_h) = if map { (1.0, 1.0) } else { (dt, dt.sqrt()) };
             for i in 0..nsub {
-                let t = t0 + f64::from(i) * h;
+                let t = t0 + f64::from(i) * dt;
                 // The draws in `simulate`'s order: inputs, then the normals in channel order.
                 if p > 0 {
                     inputs.update(t, &mut interval, &mut rng, &mut u);

@@ -156,12 +156,23 @@ impl SimJson {
     }
 }
 
+/// What one step of the paths is: an Euler-Maruyama step, or a step of a discrete-time
+/// model's map.
+fn step_name(r: &SimReport) -> &'static str {
+    match r.dt.source {
+        DtSource::Map => "step of the map",
+        DtSource::Rule | DtSource::Option => "Euler-Maruyama step",
+    }
+}
+
 /// Met, capped or coarser.
 fn dt_status(dt: &DtUsed) -> DtStatus {
     match (dt.meets_rule(), dt.source) {
         (true, _) => DtStatus::Met,
         (false, DtSource::Rule) => DtStatus::Capped,
         (false, DtSource::Option) => DtStatus::Coarser,
+        // (A map's steps are exact: they always meet the rules.)
+        (false, DtSource::Map) => DtStatus::Met,
     }
 }
 
@@ -195,7 +206,7 @@ pub fn dt_warning(dt: &DtUsed) -> Option<String> {
     };
     let rules = format!("the rules h L <= {DT_RULE} and bias <= {DT_ACCURACY} of the half-width");
     match (dt.meets_rule(), dt.source) {
-        (true, _) => None,
+        (true, _) | (_, DtSource::Map) => None,
         (false, DtSource::Rule) => Some(format!(
             "the Euler-Maruyama step is capped at {MAX_STEPS} steps per report interval on {}, \
              coarser than {rules} ask ({hl}, {bias}): Euler-Maruyama's own error may show as \
@@ -314,20 +325,31 @@ pub fn summary(r: &SimReport) -> String {
         r.guarantee.name()
     );
     // dt is a quotient (step / substeps): show it without its last-digit noise.
-    let _ = writeln!(
-        s,
-        "  {} (seed {}), Euler-Maruyama with {} ({} per path; {})",
-        count(r.paths, "path"),
-        r.seed,
-        dt_range(&r.dt),
-        count(r.steps_per_path, "step"),
-        match r.dt.source {
-            DtSource::Rule => format!(
-                "chosen by the rules h L <= {DT_RULE} and bias <= {DT_ACCURACY} of the half-width"
-            ),
-            DtSource::Option => "--dt".to_string(),
-        }
-    );
+    let how = match r.dt.source {
+        DtSource::Rule => Some(format!(
+            "chosen by the rules h L <= {DT_RULE} and bias <= {DT_ACCURACY} of the half-width"
+        )),
+        DtSource::Option => Some("--dt".to_string()),
+        DtSource::Map => None,
+    };
+    let _ = match how {
+        Some(how) => writeln!(
+            s,
+            "  {} (seed {}), Euler-Maruyama with {} ({} per path; {how})",
+            count(r.paths, "path"),
+            r.seed,
+            dt_range(&r.dt),
+            count(r.steps_per_path, "step"),
+        ),
+        None => writeln!(
+            s,
+            "  {} (seed {}), the map's exact recursion, period {} ({} per path)",
+            count(r.paths, "path"),
+            r.seed,
+            time(r.dt.max),
+            count(r.steps_per_path, "step"),
+        ),
+    };
     if let Some(w) = dt_warning(&r.dt) {
         let _ = writeln!(s, "  warning: {w}");
     }
@@ -377,7 +399,7 @@ pub fn summary(r: &SimReport) -> String {
         let _ = writeln!(
             s,
             "  tube, all times at once: {} ({:.3e}) left it at some time (Clopper-Pearson \
-             bounds [{:.3e}, {:.3e}] at confidence {}); checked at every Euler-Maruyama step ({} \
+             bounds [{:.3e}, {:.3e}] at confidence {}); checked at every {} ({} \
              states per path) against the PRS over its report interval, and at each report time \
              against that time's PRS",
             count(t.outside, "path"),
@@ -385,6 +407,7 @@ pub fn summary(r: &SimReport) -> String {
             t.cp_lower,
             t.cp_upper,
             r.confidence,
+            step_name(r),
             t.checks_per_path
         );
     }
@@ -403,13 +426,17 @@ pub fn summary(r: &SimReport) -> String {
     }
     if let Some(c) = &r.safety {
         let check = (c.safe, c.fraction, c.cp_upper, c.certified, c.passed);
-        let what = "entered no unsafe set at any Euler-Maruyama step";
-        s.push_str(&check_line(r, "probability of safety", what, check));
+        let what = format!("entered no unsafe set at any {}", step_name(r));
+        s.push_str(&check_line(r, "probability of safety", &what, check));
     }
     for g in &r.goals {
         let check = (g.reached, g.fraction, g.cp_upper, g.certified, g.passed);
-        let what = "reached it as the goal set asks, at the Euler-Maruyama steps";
-        s.push_str(&check_line(r, &format!("goal `{}`", g.name), what, check));
+        let steps = match r.dt.source {
+            DtSource::Map => "steps of the map",
+            DtSource::Rule | DtSource::Option => "Euler-Maruyama steps",
+        };
+        let what = format!("reached it as the goal set asks, at the {steps}");
+        s.push_str(&check_line(r, &format!("goal `{}`", g.name), &what, check));
     }
     if let Some(left) = r.left_domain {
         let _ = writeln!(

@@ -11,7 +11,7 @@
 
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
-use reachc_core::model::{ModelInfo, Rate};
+use reachc_core::model::{ModelInfo, Rate, Time};
 
 use super::emit::Kind;
 use crate::analysis::Derivatives;
@@ -73,7 +73,7 @@ impl SystemDocs {
     pub(super) fn new(
         pool: &Pool,
         names: &Names<'_>,
-        (drift, diffusion): (&[ExprId], &[Vec<ExprId>]),
+        (drift, diffusion, time): (&[ExprId], &[Vec<ExprId>], Time),
         d: &Derivatives,
         pattern: &[(usize, usize, ExprId)],
     ) -> SystemDocs {
@@ -85,13 +85,20 @@ impl SystemDocs {
         let diffusion = p.nonzero(diffusion);
         let doc = |what, equations| MethodDoc { what, equations };
         SystemDocs {
-            drift: doc(
-                "The drift `f(x, u, t)`: `out[i]` is the right-hand side of the equation of \
-                 state `i`",
-                block(drift.len(), |i| {
-                    p.equation(format!("{}'", states[i]), drift[i])
-                }),
-            ),
+            drift: match time {
+                Time::Continuous => doc(
+                    "The drift `f(x, u, t)`: `out[i]` is the right-hand side of the equation of \
+                     state `i`",
+                    block(drift.len(), |i| {
+                        p.equation(format!("{}'", states[i]), drift[i])
+                    }),
+                ),
+                Time::Discrete { .. } => doc(
+                    "The map `f(x, u, t)` of a discrete-time model: `out[i]` is the next value \
+                     of state `i` (its update equation)",
+                    block(drift.len(), |i| p.equation(states[i].to_string(), drift[i])),
+                ),
+            },
             jac_x: doc(
                 "The Jacobian `D_x f`, row-major: `out[i * n + j] = d f[i] / d x[j]`, 0 where \
                  `f[i]` does not depend on `x[j]`",

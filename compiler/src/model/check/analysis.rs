@@ -58,7 +58,11 @@ impl Checker<'_> {
         if self.defined_twice("analysis", name, first.map(|a| a.span.clone())) {
             return;
         }
-        let f = self.fields(body, KEYS, "an analysis");
+        let mut f = self.fields(body, KEYS, "an analysis");
+        // A discrete-time model: its settings of continuous time are refused (and dropped, so
+        // that the rest is checked with the defaults); its times are whole numbers of periods.
+        let discrete = self.discrete.as_ref().map(|d| d.period);
+        let refused = discrete.is_some() && self.refuse_continuous(&mut f);
         let n = self.states.len();
         let method = self.choice(
             &f,
@@ -104,33 +108,12 @@ impl Checker<'_> {
                 .then_some(())
                 .ok_or("delta must be in (0, 1)")
         });
-        let horizon = match f.get("horizon") {
-            Some(_) => self.number(&f, "horizon", 0.0, |h| {
-                (h > 0.0)
-                    .then_some(())
-                    .ok_or("the horizon must be positive")
-            }),
-            None => self.fail(
-                Diagnostic::error(
-                    format!("analysis `{}` has no horizon", name.name),
-                    name.span.clone(),
-                    "needs `horizon = ...`",
-                )
-                .with_help("add e.g. `horizon = 4` (the final time)"),
-            ),
+        let (horizon, step) = match discrete {
+            None => self.continuous_times(&f, name),
+            Some(Some(period)) => self.discrete_times(&f, name, period),
+            // The period had errors (reported): no times to check against it.
+            Some(None) => (None, None),
         };
-        let step = horizon.and_then(|h| {
-            self.number(&f, "step", h / 100.0, |s| {
-                if s <= 0.0 {
-                    Err("the step must be positive")
-                } else if s > h {
-                    Err("the step is larger than the horizon")
-                } else {
-                    Ok(())
-                }
-            })
-        });
-        let step = step.and_then(|s| self.report_steps(&f, horizon?, s).then_some(s));
         let metric = match f.get("metric") {
             None => Some(Metric::Identity),
             Some((e, _)) => match &e.kind {
@@ -195,6 +178,16 @@ impl Checker<'_> {
         ) = (metric, radius, rate, transform, outputs, first_order, split)
         else {
             return;
+        };
+        if refused {
+            return;
+        }
+        // A discrete-time analysis: the settings of continuous time are fixed (the engine
+        // bounds the map's factors per step, locally).
+        let (rate, integrator, first_order) = if discrete.is_some() {
+            (Rate::Local, Integrator::default(), false)
+        } else {
+            (rate, integrator, first_order)
         };
         if let (Rate::Local, Guarantee::Pointwise, Some((e, _))) = (rate, guarantee, f.get("rate"))
         {
@@ -308,6 +301,44 @@ impl Checker<'_> {
         });
     }
 
+    /// The horizon and report step of a continuous-time analysis: the step in
+    /// `(0, horizon]`, `horizon / 100` by default.
+    fn continuous_times(&mut self, f: &Fields, name: &Ident) -> (Option<f64>, Option<f64>) {
+        let horizon = self.horizon(f, name);
+        let step = horizon.and_then(|h| {
+            self.number(f, "step", h / 100.0, |s| {
+                if s <= 0.0 {
+                    Err("the step must be positive")
+                } else if s > h {
+                    Err("the step is larger than the horizon")
+                } else {
+                    Ok(())
+                }
+            })
+        });
+        let step = step.and_then(|s| self.report_steps(f, horizon?, s).then_some(s));
+        (horizon, step)
+    }
+
+    /// The horizon: required, positive.
+    pub(super) fn horizon(&mut self, f: &Fields, name: &Ident) -> Option<f64> {
+        match f.get("horizon") {
+            Some(_) => self.number(f, "horizon", 0.0, |h| {
+                (h > 0.0)
+                    .then_some(())
+                    .ok_or("the horizon must be positive")
+            }),
+            None => self.fail(
+                Diagnostic::error(
+                    format!("analysis `{}` has no horizon", name.name),
+                    name.span.clone(),
+                    "needs `horizon = ...`",
+                )
+                .with_help("add e.g. `horizon = 4` (the final time)"),
+            ),
+        }
+    }
+
     /// A keyword value from `options`, or `default` if the key is absent.
     fn choice<T: Copy>(
         &mut self,
@@ -342,7 +373,7 @@ impl Checker<'_> {
     }
 
     /// A constant field checked by `valid`, or `default` if absent.
-    fn number(
+    pub(super) fn number(
         &mut self,
         f: &Fields,
         key: &str,
@@ -366,7 +397,7 @@ impl Checker<'_> {
     /// Whether `horizon / step` is within [`MAX_REPORT_STEPS`] (reported at `step`, or at
     /// `horizon` when the step is the default): every report step is kept in the result.
     /// Also whether the step is at least [`MIN_REPORT_STEP`].
-    fn report_steps(&mut self, f: &Fields, horizon: f64, step: f64) -> bool {
+    pub(super) fn report_steps(&mut self, f: &Fields, horizon: f64, step: f64) -> bool {
         let steps = horizon / step;
         let (message, label, help) = if step < MIN_REPORT_STEP {
             (

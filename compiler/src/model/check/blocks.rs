@@ -1,4 +1,5 @@
-//! The second pass: lets, `for` unrolling, drift equations, diffusion rows and the domain.
+//! The second pass: lets, `for` unrolling, drift (or update) equations, diffusion rows and the
+//! domain.
 
 use super::lower::{Allow, LoopEnv};
 use super::scope::{Symbol, VarKind};
@@ -31,11 +32,17 @@ impl<'a> Checker<'a> {
                         )
                     },
                 ),
-                Item::Drift(b) => {
-                    self.walk(&b.stmts, "in drift", true, &mut budget, &mut |c, s, env| {
-                        c.drift_stmt(s, env)
-                    })
+                Item::Drift { body, span } if self.is_discrete() => {
+                    self.drift_in_discrete(body, span, &mut budget)
                 }
+                Item::Drift { body, .. } => self.walk(
+                    &body.stmts,
+                    "in drift",
+                    true,
+                    &mut budget,
+                    &mut |c, s, env| c.drift_stmt(s, env),
+                ),
+                Item::Update { body, span } => self.update_block(body, span, &mut budget),
                 Item::Diffusion(b) => self.walk(
                     &b.stmts,
                     "in diffusion",
@@ -72,7 +79,8 @@ impl<'a> Checker<'a> {
                 | Item::State(_)
                 | Item::Input(_)
                 | Item::Noise(_)
-                | Item::Table { .. } => {}
+                | Item::Table { .. }
+                | Item::Discrete { .. } => {}
             }
         }
     }
@@ -208,6 +216,7 @@ impl<'a> Checker<'a> {
     pub(super) fn unexpected(&mut self, s: &Stmt, place: &str, help: &str) {
         let what = match s {
             Stmt::Equation { .. } => "a drift equation",
+            Stmt::Update { .. } => "an update equation",
             Stmt::Row { .. } => "a diffusion row",
             Stmt::Member { .. } => "a membership `x in [..]`",
             Stmt::Field { .. } => "a field `key = value`",
@@ -360,6 +369,12 @@ impl<'a> Checker<'a> {
                 "drift holds equations like `x' = -x`, `let` and `for`",
             );
         };
+        self.equation(target, rhs, span, env);
+    }
+
+    /// A state's equation: its drift, or in a discrete-time model its next value (`span`: the
+    /// statement); one per state.
+    pub(super) fn equation(&mut self, target: &Target, rhs: &Expr, span: &Span, env: &LoopEnv) {
         let i = self.target(target, VarKind::State, env);
         let e = self.lower(rhs, Allow::Model, env);
         let Some(i) = i else { return };
@@ -372,7 +387,11 @@ impl<'a> Checker<'a> {
             let first = first.clone();
             self.diags.push(
                 Diagnostic::error(
-                    format!("state `{}` has two drift equations", self.states[i].name),
+                    format!(
+                        "state `{}` has two {} equations",
+                        self.states[i].name,
+                        self.equation_word()
+                    ),
                     span.clone(),
                     "second equation",
                 )
@@ -508,6 +527,7 @@ fn head_span(s: &Stmt) -> Span {
 pub(super) fn stmt_span(s: &Stmt) -> crate::diagnostics::Span {
     match s {
         Stmt::Equation { span, .. }
+        | Stmt::Update { span, .. }
         | Stmt::Row { span, .. }
         | Stmt::Member { span, .. }
         | Stmt::Field { span, .. }

@@ -72,7 +72,7 @@ fn max_abs(m: &[Vec<f64>]) -> f64 {
 /// `[1, 2)` in absolute value. An analysis metric's rates and sets do not change when it is
 /// scaled, but its factorisations overflow near 1e300 (and underflow near 1e-300): both the
 /// compiler and the run factorise the metric the checker returns, so this is the one place.
-pub(super) fn normalised(mut m: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+pub(crate) fn normalised(mut m: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
     let max = max_abs(&m);
     if !(max.is_finite() && max > 0.0) {
         return m; // rejected by the checks that follow

@@ -1,14 +1,15 @@
 //! The checker: syntax tree to [`Model`], reporting every problem it can find in one run.
 //!
-//! Passes, in order: constants and declarations (so names can be used before the line that
-//! declares them, except constants and lets, which are ordered); then lets, equations and
-//! blocks in source order; then completeness checks (every state has a drift equation and an
-//! initial set); then, on a model without errors, the `transform = auto` choices (they need the
+//! Passes, in order: constants, declarations and the `discrete` item (so names can be used
+//! before the line that declares them, except constants and lets, which are ordered); then
+//! lets, equations and blocks in source order; then completeness checks (every state has a
+//! drift or update equation and an initial set); then, on a model without errors, the `transform = auto` choices (they need the
 //! whole drift), and the transforms' frames.
 
 mod analysis;
 mod blocks;
 mod csv;
+mod discrete;
 mod lower;
 mod matrix;
 mod scope;
@@ -16,6 +17,7 @@ mod sets;
 
 use std::path::Path;
 
+pub(crate) use matrix::normalised;
 use scope::{Scope, Symbol, VarKind};
 
 use super::{Ball, Bounds, GoalSet, InitialSet, Model, UnsafeSet, Variable};
@@ -51,6 +53,9 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
         analyses: Vec::new(),
         auto_transforms: Vec::new(),
         constants: Vec::new(),
+        discrete: None,
+        has_update: false,
+        mixed: false,
     };
     c.declarations(spec);
     c.bodies(spec);
@@ -74,6 +79,7 @@ pub fn check(spec: &Spec, spec_dir: &Path) -> (Option<Model>, Vec<Diagnostic>) {
             .as_ref()
             .map_or_else(String::new, |m| m.name.clone()),
         doc: spec.doc.clone(),
+        time: c.time(),
         drift: c
             .drift
             .iter()
@@ -145,6 +151,13 @@ struct Checker<'a> {
     /// Analyses with `transform = auto` (index, span of `auto`), chosen after the checks.
     auto_transforms: Vec<(usize, Span)>,
     constants: Vec<(String, f64)>,
+    /// The `discrete` item (the first, if given twice): the model is discrete time.
+    discrete: Option<discrete::Discrete>,
+    /// Whether the spec has an `update` block.
+    has_update: bool,
+    /// A continuous-time construct in a discrete-time model or the reverse was reported (so
+    /// states are not also reported without equation).
+    mixed: bool,
 }
 
 impl Checker<'_> {
@@ -218,6 +231,7 @@ impl Checker<'_> {
                 Item::State(d) => self.declare(d, VarKind::State),
                 Item::Input(d) => self.declare(d, VarKind::Input),
                 Item::Noise(d) => self.declare(d, VarKind::Noise),
+                Item::Discrete { body, span } => self.discrete_item(body, span),
                 Item::Table {
                     name,
                     path,
@@ -377,11 +391,17 @@ impl Checker<'_> {
         }
     }
 
-    /// Third pass: every state has a drift equation and an initial set.
+    /// Third pass: every state has a drift (or update) equation and an initial set.
     fn completeness(&mut self, spec: &Spec) {
         if spec.model.is_none() {
             return; // the parser already reported it; the rest would be noise
         }
+        let equations = self.discrete_complete() && !self.mixed;
+        let (word, example) = if self.is_discrete() {
+            ("update", "")
+        } else {
+            ("drift", "'")
+        };
         let mut in_ball = vec![false; self.states.len()];
         for (b, _) in &self.balls {
             for &s in &b.states {
@@ -389,14 +409,17 @@ impl Checker<'_> {
             }
         }
         for (i, s) in self.states.iter().enumerate() {
-            if self.drift[i].is_none() && !self.drift_failed[i] {
+            if equations && self.drift[i].is_none() && !self.drift_failed[i] {
                 self.diags.push(
                     Diagnostic::error(
-                        format!("state `{}` has no drift equation", s.name),
+                        format!("state `{}` has no {word} equation", s.name),
                         s.span.clone(),
                         "declared here",
                     )
-                    .with_help(format!("add `{}' = ...` to the drift block", s.name)),
+                    .with_help(format!(
+                        "add `{}{example} = ...` to the {word} block",
+                        s.name
+                    )),
                 );
             }
             if self.boxes[i].is_none() && !in_ball[i] && !self.init_failed.contains(&i) {

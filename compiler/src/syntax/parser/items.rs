@@ -63,12 +63,13 @@ impl<'s> Parser<'s> {
                 _ => {
                     let mut help = "items start with a keyword: `model`, `const`, `state`, `input`, \
                                     `noise`, `table`, `let`, `for`, `drift`, `diffusion`, `domain`, \
-                                    `initial`, `unsafe`, `goal` or `analysis`";
+                                    `discrete`, `update`, `initial`, `unsafe`, `goal` or \
+                                    `analysis`";
                     if self.at(&Tok::Ident)
                         && matches!(self.peek(), Tok::Prime | Tok::Colon | Tok::Kw(Kw::In))
                     {
                         help = "equations, rows and bounds go inside `drift { ... }`, \
-                                `diffusion { ... }` or `domain { ... }`";
+                                `update { ... }`, `diffusion { ... }` or `domain { ... }`";
                     }
                     let _ = self.expected("an item", Some(help));
                     self.recover_item();
@@ -127,7 +128,11 @@ impl<'s> Parser<'s> {
             Kw::For => Item::Stmt(self.for_stmt(Ctx::TopFor)?),
             Kw::Drift => {
                 self.advance();
-                Item::Drift(self.block(Ctx::Drift, "`drift`")?)
+                let body = self.block(Ctx::Drift, "`drift`")?;
+                Item::Drift {
+                    body,
+                    span: start..self.prev_end,
+                }
             }
             Kw::Diffusion => {
                 self.advance();
@@ -136,6 +141,22 @@ impl<'s> Parser<'s> {
             Kw::Domain => {
                 self.advance();
                 Item::Domain(self.block(Ctx::Domain, "`domain`")?)
+            }
+            Kw::Discrete => {
+                self.advance();
+                let body = self.block(Ctx::Fields, "`discrete`")?;
+                Item::Discrete {
+                    body,
+                    span: start..self.prev_end,
+                }
+            }
+            Kw::Update => {
+                self.advance();
+                let body = self.block(Ctx::Update, "`update`")?;
+                Item::Update {
+                    body,
+                    span: start..self.prev_end,
+                }
             }
             Kw::Initial => {
                 self.advance();

@@ -1,5 +1,5 @@
-//! Blocks and statements: what each block may contain ([`Ctx`]), equations, rows, memberships,
-//! fields, constraints, lets and fors, with recovery at the statement level.
+//! Blocks and statements: what each block may contain ([`Ctx`]), equations, update equations,
+//! rows, memberships, fields, constraints, lets and fors, with recovery at the statement level.
 
 use super::{Fail, HExpr, Parser, P};
 use crate::diagnostics::{Diagnostic, Span};
@@ -13,6 +13,9 @@ pub(super) enum Ctx {
     /// A top-level `for`: lets and nested fors.
     TopFor,
     Drift,
+    /// A discrete-time model's `update`: update equations `x = ..` (and drift equations
+    /// `x' = ..`, which the checker refuses with a hint), lets and fors.
+    Update,
     Diffusion,
     Domain,
     /// `key = value` fields (analysis, initial ball, unsafe ball).
@@ -28,6 +31,7 @@ pub(super) enum Ctx {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
     Equation,
+    Update,
     Row,
     Member,
     Field,
@@ -42,6 +46,7 @@ impl Ctx {
         match self {
             Ctx::TopFor => matches!(k, Let | For),
             Ctx::Drift => matches!(k, Equation | Let | For),
+            Ctx::Update => matches!(k, Update | Equation | Let | For),
             Ctx::Diffusion => matches!(k, Row | Let | For),
             Ctx::Domain => matches!(k, Member | For),
             Ctx::Fields => k == Field,
@@ -56,6 +61,7 @@ impl Ctx {
         match self {
             Ctx::TopFor => "a top-level `for`",
             Ctx::Drift => "a `drift` block",
+            Ctx::Update => "an `update` block",
             Ctx::Diffusion => "a `diffusion` block",
             Ctx::Domain => "a `domain` block",
             Ctx::Fields => "this block",
@@ -70,6 +76,7 @@ impl Ctx {
         match self {
             Ctx::TopFor => "`let` or `for`",
             Ctx::Drift => "an equation `x' = ...`, `let` or `for`",
+            Ctx::Update => "an update `x = ...`, `let` or `for`",
             Ctx::Diffusion => "a row `x: ...`, `let` or `for`",
             Ctx::Domain => "a bound `x in [lo, hi]` or `for`",
             Ctx::Fields => "a field `key = value`",
@@ -85,7 +92,7 @@ impl Ctx {
             Ctx::Drift => "`'`",
             Ctx::Diffusion => "`:`",
             Ctx::Domain | Ctx::Box => "`in`",
-            Ctx::Fields => "`=`",
+            Ctx::Fields | Ctx::Update => "`=`",
             Ctx::Halfspace => "`<=` or `>=`",
             Ctx::TopFor | Ctx::Any => "`'`, `:`, `in` or `=`",
         }
@@ -98,6 +105,7 @@ impl Ctx {
                  `drift { ... }`"
             }
             Ctx::Drift => "a drift equation looks like `x' = -x`",
+            Ctx::Update => "an update equation (the next value) looks like `x = 0.9 * x`",
             Ctx::Diffusion => "a diffusion row looks like `x: 0.1 * w`",
             Ctx::Domain => "a domain bound looks like `x in [-1, 1]`",
             Ctx::Fields => "a field looks like `key = value`",
@@ -216,7 +224,7 @@ impl<'s> Parser<'s> {
         }
     }
 
-    /// A statement starting with a name: equation, row, member, field or constraint.
+    /// A statement starting with a name: equation, update, row, member, field or constraint.
     fn name_stmt(&mut self, ctx: Ctx) -> P<Option<Stmt>> {
         if ctx == Ctx::TopFor {
             return Err(self.expected(ctx.expected_stmt(), Some(ctx.help())));
@@ -232,6 +240,7 @@ impl<'s> Parser<'s> {
             Tok::Prime => Kind::Equation,
             Tok::Colon => Kind::Row,
             Tok::Kw(Kw::In) => Kind::Member,
+            Tok::Eq if ctx == Ctx::Update => Kind::Update,
             Tok::Eq if index.is_none() => Kind::Field,
             _ => Kind::Constraint,
         };
@@ -293,6 +302,11 @@ impl<'s> Parser<'s> {
                     span: start..self.prev_end,
                 }
             }
+            Kind::Update => Stmt::Update {
+                target,
+                rhs: self.expr()?,
+                span: start..self.prev_end,
+            },
             Kind::Row => Stmt::Row {
                 target,
                 rhs: self.expr()?,

@@ -1,7 +1,7 @@
 //! Parser unit tests: real syntax trees, precedence, every item and statement kind, error
 //! messages and spans, recovery and limits.
 
-use crate::diagnostics::{Diagnostic, Span};
+use crate::diagnostics::{span_of, Diagnostic, Span};
 use crate::syntax::ast::*;
 use crate::syntax::{parse, MAX_DIAGNOSTICS, MAX_SOURCE_LEN};
 
@@ -56,16 +56,6 @@ fn one_err(src: &str) -> Diagnostic {
         "expected one diagnostic for {src:?}: {diags:#?}"
     );
     diags.into_iter().next().unwrap()
-}
-
-/// The byte span of the `n`th (0-based) occurrence of `needle` in `src`.
-fn span_of(src: &str, needle: &str, n: usize) -> Span {
-    let start = src
-        .match_indices(needle)
-        .nth(n)
-        .unwrap_or_else(|| panic!("{needle:?} not in {src:?}"))
-        .0;
-    start..start + needle.len()
 }
 
 /// The value of `const c = SRC`.
@@ -130,6 +120,7 @@ fn sx_target(t: &Target) -> String {
 fn sx_stmt(s: &Stmt) -> String {
     match s {
         Stmt::Equation { target, rhs, .. } => format!("{}' = {}", sx_target(target), sx(rhs)),
+        Stmt::Update { target, rhs, .. } => format!("{} := {}", sx_target(target), sx(rhs)),
         Stmt::Row { target, rhs, .. } => format!("{}: {}", sx_target(target), sx(rhs)),
         Stmt::Member { target, set, .. } => format!("{} in {}", sx_target(target), sx(set)),
         Stmt::Field { key, value, .. } => format!("{} = {}", key.name, sx(value)),
@@ -176,9 +167,11 @@ fn sx_item(i: &Item) -> String {
         Item::Noise(d) => sx_decl("noise", d),
         Item::Table { name, path, .. } => format!("table {} = csv({path:?})", name.name),
         Item::Stmt(s) => sx_stmt(s),
-        Item::Drift(b) => format!("drift {}", sx_block(b)),
+        Item::Drift { body, .. } => format!("drift {}", sx_block(body)),
         Item::Diffusion(b) => format!("diffusion {}", sx_block(b)),
         Item::Domain(b) => format!("domain {}", sx_block(b)),
+        Item::Discrete { body, .. } => format!("discrete {}", sx_block(body)),
+        Item::Update { body, .. } => format!("update {}", sx_block(body)),
         Item::Initial { kind, body, .. } => format!("initial {} {}", kind.name, sx_block(body)),
         Item::Unsafe {
             name, kind, body, ..
@@ -399,7 +392,7 @@ fn pendulum() {
         span_of(PENDULUM, "state theta in [-pi/10, pi/10]", 0)
     );
     assert_eq!(theta.family, None);
-    let Item::Drift(block) = &spec.items[5] else {
+    let Item::Drift { body: block, .. } = &spec.items[5] else {
         panic!()
     };
     assert_eq!(block.span.start, span_of(PENDULUM, "{", 0).start);
@@ -538,7 +531,7 @@ fn lets_and_fors() {
         ]
     );
     let src = "model m\ndrift { for i in 2..N { x[i]' = x[i-1] } }";
-    let Item::Drift(b) = &ok(src).items[0] else {
+    let Item::Drift { body: b, .. } = &ok(src).items[0] else {
         panic!()
     };
     let Stmt::For {
@@ -1099,3 +1092,5 @@ fn goals() {
         ]
     );
 }
+
+mod discrete;

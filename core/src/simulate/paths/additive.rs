@@ -137,7 +137,7 @@ impl<S: System + ?Sized> Plan<'_, S> {
                 None => (&[][..], &[][..], f64::INFINITY),
             };
             for step in 0..span.steps {
-                let t = span.t0 + f64::from(step) * h;
+                let t = span.t0 + f64::from(step) * span.dt;
                 self.sys.drift_x8(&group.states()[..n], &[], t, &mut f[..n]);
                 group.step(n, &f, h, &ds, self.zig, live);
                 if pending != 0 {

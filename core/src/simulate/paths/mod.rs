@@ -55,12 +55,16 @@ use crate::system::System;
 use sets::GoalPath;
 use std::ops::Range;
 
-/// The Euler steps between two report times `t0 < t1`: `steps` equal steps of size `h`.
+/// The Euler steps between two report times `t0 < t1`: `steps` equal steps of length `dt`,
+/// each `x += h f + sqrt(h) G z` (`h = dt`; `h = 1` for the steps of a map, [`Span::map`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Span {
     pub(crate) t0: f64,
     pub(crate) t1: f64,
     pub(crate) steps: u32,
+    /// The time a step takes.
+    pub(crate) dt: f64,
+    /// The drift's factor in the update.
     pub(crate) h: f64,
     /// `sqrt(h)`, once per span rather than per step.
     pub(crate) sqrt_h: f64,
@@ -74,21 +78,35 @@ impl Span {
             t0,
             t1,
             steps,
+            dt: h,
             h,
             sqrt_h: h.sqrt(),
+        }
+    }
+
+    /// `[t0, t1]` in `steps` steps of a discrete-time model's map, simulated as its increments
+    /// ([`Increments`](super::increments::Increments)): `h = sqrt(h) = 1`.
+    pub(crate) fn map(t0: f64, t1: f64, steps: u32) -> Self {
+        Span {
+            t0,
+            t1,
+            steps,
+            dt: (t1 - t0) / f64::from(steps),
+            h: 1.0,
+            sqrt_h: 1.0,
         }
     }
 
     /// The start and end of Euler step `i` (the last one ends at `t1` exactly).
     #[inline(always)]
     pub(crate) fn step_times(&self, i: u32) -> (f64, f64) {
-        let t = self.t0 + f64::from(i) * self.h;
+        let t = self.t0 + f64::from(i) * self.dt;
         (
             t,
             if i + 1 == self.steps {
                 self.t1
             } else {
-                t + self.h
+                t + self.dt
             },
         )
     }

@@ -54,6 +54,7 @@ fn brownian(unsafe_sets: Vec<UnsafeSet>, goals: Vec<GoalSet>) -> ModelInfo {
         goals,
         affine: true,
         constant_diffusion: true,
+        time: Default::default(),
         unsafe_sets,
         ..model("brownian", &["x"], &["w"], &[(0.0, 0.0)])
     };

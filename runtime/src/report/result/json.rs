@@ -109,6 +109,7 @@ impl ResultJson {
             horizon: prs.horizon(),
             step: prs.step(),
             integrator: prs.integrator().into(),
+            period: prs.period(),
             guarantee: prs.guarantee().into(),
             internal_steps: prs.internal_steps(),
             states: prs.states().to_vec(),

@@ -110,6 +110,16 @@ pub fn summary(prs: &Prs) -> String {
                 k.c, k.sigma, k.rho, k.provenance
             );
         }
+        Rate::Local if prs.period().is_some() => {
+            let _ = writeln!(
+                s,
+                "  discrete time, period {}: map factors L_k in [{}, {}] ({})",
+                time(prs.period().unwrap_or(0.0)),
+                num(prs.rate().min_c),
+                num(prs.rate().max_c),
+                k.provenance
+            );
+        }
         Rate::Local => {
             // (A split result's regions are its pieces'.)
             let sigma = std::iter::once(prs)
@@ -149,7 +159,7 @@ pub fn summary(prs: &Prs) -> String {
             );
         }
     }
-    if prs.rate().rate != Rate::Global && !alone {
+    if prs.rate().rate != Rate::Global && !alone && prs.period().is_none() {
         let _ = writeln!(s, "  rate: {}", rate_note(prs.rate().rate));
     }
     let _ = writeln!(
@@ -166,6 +176,7 @@ pub fn summary(prs: &Prs) -> String {
             match g.uniform {
                 Some(UniformBound::Mixture) => ", time-uniform by the Gaussian mixture bound",
                 Some(UniformBound::AmgfTube) => ", time-uniform by the amgf tube (tighter here)",
+                Some(UniformBound::UnionOverSteps) => ", at once over the steps by the union bound",
                 None => "",
             },
         ),

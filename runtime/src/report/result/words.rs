@@ -176,6 +176,26 @@ pub(super) fn proved(p: &Proved) -> String {
              leaves them on the tube's event (metric {metric})",
             count(*regions as u64, "region")
         ),
+        Proved::MapFactors {
+            steps,
+            metric,
+            over_domain,
+        } => format!(
+            "discrete time: the map's image enclosed in interval arithmetic on each of {}, its \
+             factor |R J R^-1|_2 and noise level bounded by verified eigenvalues on {} \
+             (metric {metric})",
+            count(*steps as u64, "step"),
+            if *over_domain {
+                "the domain (every state)"
+            } else {
+                "each step's box holding the tube, so the process never leaves them on the \
+                 tube's event"
+            }
+        ),
+        Proved::UnionOverSteps { steps } => format!(
+            "at once over the steps: the union bound over {steps} steps at delta / {steps} \
+             each: one event, of probability at least 1 - delta, for every step in [0, horizon]"
+        ),
         Proved::UniformTube { epochs } => format!(
             "time-uniform tube: Ville's inequality on the averaged-MGF supermartingale over \
              {epochs} epochs at delta / {epochs} each: one event, of probability at least \

@@ -73,6 +73,8 @@ pub enum UniformBound {
     AmgfTube,
     /// The method-of-mixtures bound.
     GaussianMixture,
+    /// The union bound over a discrete-time model's steps.
+    UnionOverSteps,
 }
 
 /// Where a coordinate transform comes from.
@@ -132,6 +134,8 @@ pub enum DtSource {
     Rule,
     /// The `--dt` option.
     Option,
+    /// A discrete-time model's map, one step per step.
+    Map,
 }
 
 /// How the Euler-Maruyama steps compare with the rule.
@@ -269,6 +273,7 @@ from! {
     prs::UniformBound => UniformBound {
         prs::UniformBound::AmgfTube => AmgfTube,
         prs::UniformBound::Mixture => GaussianMixture,
+        prs::UniformBound::UnionOverSteps => UnionOverSteps,
     }
     model::TransformSource => TransformSource {
         model::TransformSource::Given => Given,
@@ -295,6 +300,7 @@ from! {
     simulate::DtSource => DtSource {
         simulate::DtSource::Rule => Rule,
         simulate::DtSource::Option => Option,
+        simulate::DtSource::Map => Map,
     }
     simulate::InputMode => InputMode {
         simulate::InputMode::Random => Random,
@@ -358,7 +364,7 @@ mod tests {
             prs::UnsafeKind::Ball,
         ];
         written_as::<_, UnsafeKind>(&kinds, crate::report::result::unsafe_kind);
-        written_as::<_, DtSource>(&[D::Rule, D::Option], D::name);
+        written_as::<_, DtSource>(&[D::Rule, D::Option, D::Map], D::name);
         written_as::<_, InputMode>(&[M::Random, M::Corners, M::Centre], M::name);
         assert_eq!(
             to_value(MetricRef::Constants).unwrap(),

@@ -31,6 +31,9 @@ pub struct ResultJson {
     pub step: f64,
     /// How the deterministic part is integrated.
     pub integrator: Integrator,
+    /// The sampling period of a discrete-time model (absent for continuous time).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
     /// What `delta` is about: all times at once, or each time separately.
     #[serde(default)]
     pub guarantee: Guarantee,

@@ -39,7 +39,7 @@ bake_unit_enum! {
     Inclusion { Natural, Jacobian, Mixed }
     Integrator { Validated, Rk4, Euler }
     Guarantee { Uniform, Pointwise }
-    MetricRegion { Given, Domain, InitialSet, IdentityAtRun }
+    MetricRegion { Given, Domain, InitialSet, IdentityAtRun, Map }
 }
 
 /// `MetricChoice::Identity`, `MetricChoice::Matrix(..)`, ...
@@ -177,7 +177,7 @@ impl Bake for Region {
     }
 }
 
-/// `Provenance::Certified { c, sigma, rho }`, `Provenance::Given` or
+/// `Provenance::Certified { c, sigma, rho }`, `Provenance::Given`, `Provenance::Map` or
 /// `Provenance::Unbounded { why }`.
 impl Bake for Provenance {
     fn bake(&self, baker: &mut Baker<'_>) -> TokenStream {
@@ -186,6 +186,7 @@ impl Bake for Provenance {
                 bake_fields!(baker, Provenance::Certified { c, sigma, rho })
             }
             Provenance::Given => quote!(Provenance::Given),
+            Provenance::Map => quote!(Provenance::Map),
             Provenance::Unbounded { why } => bake_fields!(baker, Provenance::Unbounded { why }),
         }
     }

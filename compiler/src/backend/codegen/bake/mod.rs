@@ -208,6 +208,7 @@ impl Bake for ModelInfo {
             has_domain,
             affine,
             constant_diffusion,
+            time,
             unsafe_sets,
             goals,
             analyses,
@@ -224,6 +225,7 @@ impl Bake for ModelInfo {
         let has_domain = has_domain.bake(baker);
         let affine = affine.bake(baker);
         let constant_diffusion = constant_diffusion.bake(baker);
+        let time = time.bake(baker);
         let unsafe_sets = unsafe_sets.bake(baker);
         let goals = goals.bake(baker);
         let analyses = analyses.bake(baker);
@@ -244,6 +246,7 @@ impl Bake for ModelInfo {
                 has_domain: #has_domain,
                 affine: #affine,
                 constant_diffusion: #constant_diffusion,
+                time: #time,
                 unsafe_sets: #unsafe_sets,
                 goals: #goals,
                 analyses: #analyses,

@@ -1,9 +1,9 @@
 //! [`Bake`] for the sets of a model: its initial set, its unsafe and goal sets, their shapes and
-//! the numbers of them that move with time (method.md 8.15).
+//! the numbers of them that move with time (method.md 8.15); and its [`Time`].
 
 use proc_macro2::TokenStream;
 use quote::quote;
-use reachc_core::model::{Ball, GoalSet, InitialSet, Moving, Slot, UnsafeSet, UnsafeShape};
+use reachc_core::model::{Ball, GoalSet, InitialSet, Moving, Slot, Time, UnsafeSet, UnsafeShape};
 
 use super::{variant, Bake, Baker};
 
@@ -48,6 +48,16 @@ impl Bake for Slot {
             Slot::Hi(k) => variant(quote!(Slot::Hi), k, baker),
             Slot::Center(k) => variant(quote!(Slot::Center), k, baker),
             Slot::Radius => quote!(Slot::Radius),
+        }
+    }
+}
+
+/// `Time::Continuous` or `Time::Discrete { period }`.
+impl Bake for Time {
+    fn bake(&self, baker: &mut Baker<'_>) -> TokenStream {
+        match self {
+            Time::Continuous => quote!(Time::Continuous),
+            Time::Discrete { period } => bake_fields!(baker, Time::Discrete { period }),
         }
     }
 }
