@@ -270,3 +270,68 @@ fn nonlinear_factors_bound_sampled_jacobians() {
         );
     }
 }
+
+/// `x_(k+1) = exp(x_k)` from `[0, 1]`, noise `0.01`: its factor is unbounded within a few steps.
+struct Exp;
+
+impl System for Exp {
+    fn n(&self) -> usize {
+        1
+    }
+    fn p(&self) -> usize {
+        0
+    }
+    fn m(&self) -> usize {
+        1
+    }
+    fn drift(&self, x: &[f64], _: &[f64], _: f64, out: &mut [f64]) {
+        out[0] = x[0].exp();
+    }
+    fn drift_interval(&self, x: &[Interval], _: &[Interval], _: Interval, out: &mut [Interval]) {
+        out[0] = x[0].exp();
+    }
+    fn jac_x(&self, x: &[f64], _: &[f64], _: f64, out: &mut [f64]) {
+        out[0] = x[0].exp();
+    }
+    fn jac_x_interval(&self, x: &[Interval], _: &[Interval], _: Interval, out: &mut [Interval]) {
+        out[0] = x[0].exp();
+    }
+    fn jac_u(&self, _: &[f64], _: &[f64], _: f64, _: &mut [f64]) {}
+    fn jac_u_interval(&self, _: &[Interval], _: &[Interval], _: Interval, _: &mut [Interval]) {}
+    fn diffusion(&self, _: &[f64], _: f64, out: &mut [f64]) {
+        out[0] = 0.01;
+    }
+    fn diffusion_interval(&self, _: &[Interval], _: Interval, out: &mut [Interval]) {
+        out[0] = Interval::point(0.01);
+    }
+}
+
+/// A map whose factor becomes unbounded (`exp` of `exp` ...) stops with the map's own
+/// diagnostic, naming the step and its region, even when its analysis asks for first-order
+/// sets and its noise is additive (no continuous-time set stands in for it).
+#[test]
+fn a_blowing_up_map_stops_with_its_diagnostic() {
+    let info = discrete(
+        &["x"],
+        &[(0.0, 1.0)],
+        false,
+        AnalysisSpec {
+            first_order: true,
+            ..spec(Method::Contraction, Guarantee::Uniform, 1e-2, 10.0)
+        },
+    );
+    let info = ModelInfo::from_parts(ModelParts {
+        constant_diffusion: true,
+        ..info.into_parts()
+    });
+    let err = Reach::paired(&Exp, &info, "main")
+        .unwrap()
+        .run()
+        .unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("the map's factor or noise level cannot be bounded on the step from t = "),
+        "{text}"
+    );
+    assert!(text.contains("region: x in ["), "{text}");
+}

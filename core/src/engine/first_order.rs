@@ -28,7 +28,7 @@ use super::local::Certifier;
 use super::radius::{expm1_over, BoxRadius};
 use super::Run;
 use crate::interval::Interval;
-use crate::model::{AnalysisSpec, Guarantee, InitialSet, Integrator, ModelInfo};
+use crate::model::{AnalysisSpec, Guarantee, InitialSet, Integrator, ModelInfo, Time};
 use crate::prs::{DetSet, Proved, Prs, Role, Span};
 use crate::sets::zonotope;
 
@@ -62,14 +62,19 @@ fn wanted_for(spec: &AnalysisSpec, initial: &InitialSet, n: usize) -> bool {
 }
 
 /// Whether a run of `spec` from `initial` may get the linearised Gaussian sets (method.md
-/// 8.10): first-order sets [`wanted`], constant noise and a time-uniform guarantee.
+/// 8.10): first-order sets [`wanted`], constant noise, a time-uniform guarantee and continuous
+/// time (a map has no linearised flow: its runs never take the Gaussian share of delta nor
+/// fall back on the set alone of 8.12).
 pub(crate) fn gaussian_wanted(
     info: &ModelInfo,
     spec: &AnalysisSpec,
     initial: &InitialSet,
     n: usize,
 ) -> bool {
-    wanted_for(spec, initial, n) && info.constant_diffusion && spec.guarantee == Guarantee::Uniform
+    wanted_for(spec, initial, n)
+        && info.constant_diffusion
+        && spec.guarantee == Guarantee::Uniform
+        && info.time == Time::Continuous
 }
 
 /// The first-order sets of a run, and with `gaussian = Some(delta')` (additive noise, a
@@ -486,6 +491,34 @@ pub(super) fn exp_enclosure(a: &[f64], n: usize, tau: Interval) -> Option<Vec<In
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The linearised Gaussian sets are wanted for a continuous model with additive noise, a
+    /// uniform guarantee and first-order sets, and never for a map with the same data.
+    #[test]
+    fn maps_want_no_linearised_sets() {
+        let base = crate::test_support::models::model("m", &["x"], &["w"], &[(0.0, 1.0)]);
+        let spec = AnalysisSpec {
+            first_order: true,
+            guarantee: Guarantee::Uniform,
+            ..AnalysisSpec::default()
+        };
+        for (time, wanted) in [
+            (Time::Continuous, true),
+            (Time::Discrete { period: 0.1 }, false),
+        ] {
+            let info = ModelInfo::from_parts(crate::model::ModelParts {
+                constant_diffusion: true,
+                time,
+                ..base.clone().into_parts()
+            });
+            let initial = info.initial.clone();
+            assert_eq!(
+                gaussian_wanted(&info, &spec, &initial, 1),
+                wanted,
+                "{time:?}"
+            );
+        }
+    }
 
     #[test]
     fn exp_enclosure_holds_the_closed_form() {
