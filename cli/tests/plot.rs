@@ -724,3 +724,30 @@ fn moving_sets_are_read_and_drawn_where_they_are() {
     assert!(!sets.contains(">\nwall\n<"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A discrete-time model's figures say what its numbers are: the sample paths are the map's
+/// exact steps, and the rates figure shows the map's factor `L_k` (not a contraction rate).
+#[test]
+fn plots_of_a_map_name_its_steps_and_factors() {
+    let dir = temp_dir("map");
+    let (out, plots) = (dir.join("out"), dir.join("plots"));
+    let o = reachc(&[
+        "run",
+        &spec("discrete/integrator_chain.sde"),
+        "--backend",
+        "interp",
+        "-o",
+        out.to_str().unwrap(),
+        "--plot",
+        plots.to_str().unwrap(),
+        "--plot-paths",
+        "5",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o));
+    let sets = svg(&plots.join("interval_sets.svg"));
+    assert!(sets.contains("5 sample paths (exact map steps)"), "{sets}");
+    let rates = svg(&plots.join("interval_rates.svg"));
+    assert!(rates.contains("map factor") && rates.contains("L_k"));
+    assert!(rates.contains("where L_k &gt; 1 the tube grows") || rates.contains("where L_k > 1"));
+    assert!(!rates.contains("c_t"));
+}

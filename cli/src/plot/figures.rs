@@ -714,7 +714,7 @@ impl Draw for RatesScene {
         let y_span = hi - lo;
         let x_fmt = |v: &f64| tick(*v, right);
         let y_fmt = |v: &f64| tick(*v, y_span.max(v.abs()));
-        mesh(&mut chart, s, ["t", "c_t"], [&x_fmt, &y_fmt])?;
+        mesh(&mut chart, s, ["t", self.label], [&x_fmt, &y_fmt])?;
         // Zero: contraction below, growth above.
         chart
             .draw_series(LineSeries::new(
@@ -743,7 +743,7 @@ impl Draw for RatesScene {
         chart
             .draw_series(LineSeries::new(run, colour.stroke_width(2 * s)))
             .map_err(err)?;
-        let entries = [(Mark::Line(colour.to_rgba(), 2), "c_t".to_string())];
+        let entries = [(Mark::Line(colour.to_rgba(), 2), self.label.to_string())];
         legend(&legend_area, s, &entries, &self.notes)
     }
 }

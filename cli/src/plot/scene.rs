@@ -179,6 +179,8 @@ pub struct RatesScene {
     pub times: Vec<f64>,
     /// `c_t`, the largest over each report interval (`None`: not finite).
     pub c: Vec<Option<f64>>,
+    /// The rate's name on the axis and in the legend: `c_t`, or a map's factor `L_k`.
+    pub label: &'static str,
     /// Lines for the legend panel.
     pub notes: Vec<String>,
 }
@@ -194,15 +196,25 @@ pub fn rates_scene(result: &ResultJson) -> Option<RatesScene> {
     let (lo, hi) = sigma.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
         (a.min(v), b.max(v))
     });
-    let mut notes = vec![format!(
-        "{} rates: c_t is the largest contraction rate (mu_P of the Jacobian) over each report \
-         interval",
-        rate.kind.name()
-    )];
+    let map = result.period.is_some();
+    let mut notes = vec![if map {
+        "discrete time: L_k is the map's factor |R J R^-1|_2 (the largest over each report \
+         interval)"
+            .to_string()
+    } else {
+        format!(
+            "{} rates: c_t is the largest contraction rate (mu_P of the Jacobian) over each \
+             report interval",
+            rate.kind.name()
+        )
+    }];
     if lo <= hi {
         notes.push(format!("noise level sigma_t in [{lo:.4}, {hi:.4}]"));
     }
     match rate.kind {
+        RateSource::Local if map => notes.push(
+            "bounded on boxes holding the tube at each step: where L_k > 1 the tube grows".into(),
+        ),
         RateSource::Local => notes.push(
             "certified on boxes holding the tube over each internal step: where c_t > 0 the \
              tube grows"
@@ -216,7 +228,17 @@ pub fn rates_scene(result: &ResultJson) -> Option<RatesScene> {
         ));
     }
     Some(RatesScene {
-        title: format!("{} / {}: contraction rate", result.model, result.analysis),
+        title: format!(
+            "{} / {}: {}",
+            result.model,
+            result.analysis,
+            if map {
+                "map factor"
+            } else {
+                "contraction rate"
+            }
+        ),
+        label: if map { "L_k" } else { "c_t" },
         times: steps.iter().map(|s| s.t).collect(),
         c: steps
             .iter()
