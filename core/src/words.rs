@@ -382,6 +382,11 @@ impl Display for Problem {
                 "{} = {value} is not a whole number of periods (period {period})",
                 setting.key()
             ),
+            Problem::TooManyMapSteps { steps, max } => write!(
+                f,
+                "the horizon is {steps} steps of the map, more than the {max} a run may take: a \
+                 shorter horizon or a longer period may help"
+            ),
             Problem::MapFactor {
                 t,
                 region,

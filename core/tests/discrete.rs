@@ -335,3 +335,30 @@ fn a_blowing_up_map_stops_with_its_diagnostic() {
     );
     assert!(text.contains("region: x in ["), "{text}");
 }
+
+/// A horizon of more map steps than a run may take (each step keeps its sets) is refused at
+/// the horizon before any step is taken, not run out of memory.
+#[test]
+fn too_many_map_steps_are_refused_at_the_horizon() {
+    let info = discrete(
+        &["x1", "x2"],
+        &[(0.0, 0.0); 2],
+        true,
+        spec(Method::Contraction, Guarantee::Pointwise, 0.1, 3e6),
+    );
+    let err = Reach::paired(&AR, &info, "main")
+        .unwrap()
+        .run()
+        .unwrap_err();
+    assert_eq!(
+        err.culprit(),
+        Some(reachc_core::engine::Culprit::Setting(
+            reachc_core::engine::Setting::Horizon
+        ))
+    );
+    assert!(
+        err.to_string()
+            .contains("the horizon is 3000000 steps of the map, more than the 2000000"),
+        "{err}"
+    );
+}

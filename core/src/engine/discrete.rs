@@ -22,6 +22,7 @@ use super::assemble::{
     assemble_with, constants_used, rate_used, span_of, spread, Deterministic, Header, Piece, Radii,
 };
 use super::contraction::initial_set;
+use super::defect::MAX_STEPS;
 use super::linalg::{self, lambda_max, product};
 use super::radius::{self, BoxRadius};
 use super::{r1, Culprit, Detail, Inputs, Problem, Run, RunError, Setting};
@@ -42,6 +43,16 @@ pub(super) fn run(run: &Run, period: f64) -> Result<Prs, RunError> {
     let spec = run.spec;
     let n = run.setup.n;
     let steps = whole_periods(spec.horizon, period, Setting::Horizon)?;
+    // (Each step keeps its sets: as many as a continuous run's internal steps at most.)
+    if steps > MAX_STEPS {
+        return Err(RunError::Invalid(
+            Detail::from(Problem::TooManyMapSteps {
+                steps,
+                max: MAX_STEPS,
+            })
+            .at_setting(Setting::Horizon),
+        ));
+    }
     let stride = whole_periods(spec.step, period, Setting::Step)?;
     let uniform = spec.guarantee == Guarantee::Uniform;
     if spec.radius != RadiusRule::Amgf {
@@ -72,6 +83,10 @@ pub(super) fn run(run: &Run, period: f64) -> Result<Prs, RunError> {
         r: 0.0,
         w: spread(run),
         gaussian,
+        box_inputs: (
+            super::input_intervals(run.info),
+            run.nominal_inputs(&[0.0]).0.remove(0),
+        ),
     };
     let (start, r1, r1_bound, pieces) = match spec.method {
         Method::Contraction => {
@@ -123,10 +138,7 @@ pub(super) fn run(run: &Run, period: f64) -> Result<Prs, RunError> {
         },
         Proved::Margins { given: spec.method },
     ]);
-    let input_center = match run.inputs {
-        Inputs::Box => run.nominal_inputs(&[0.0]).0.remove(0),
-        Inputs::Plan(plan) => plan.at(0.0).to_vec(),
-    };
+    let input_center = stepper.inputs(0).1;
     let header = Header {
         method: spec.method,
         inclusion: (spec.method == Method::Interval).then_some(spec.inclusion),
@@ -372,6 +384,9 @@ struct Stepper<'a> {
     /// Upper bounds of `sqrt((P^-1)_ii)`.
     w: Vec<f64>,
     gaussian: Option<Gaussian>,
+    /// The input box as intervals and its centre (the nominal's input), for inputs anywhere in
+    /// the box.
+    box_inputs: (Vec<Interval>, Vec<f64>),
 }
 
 /// A step's piece and the stochastic radius at its end with `Psi` there.
@@ -386,20 +401,18 @@ impl Stepper<'_> {
     /// The inputs over step `k`: the box (or the plan's value), and the nominal's.
     fn inputs(&self, k: usize) -> (Vec<Interval>, Vec<f64>) {
         match self.run.inputs {
-            Inputs::Box => (
-                super::input_intervals(self.run.info),
-                self.run.nominal_inputs(&[0.0]).0.remove(0),
-            ),
+            Inputs::Box => self.box_inputs.clone(),
             Inputs::Plan(plan) => {
-                let u = plan.at(self.time(k).mid()).to_vec();
+                // (At the step's time as the report prints it.)
+                let u = plan.at(k as f64 * self.period).to_vec();
                 (u.iter().map(|&v| Interval::point(v)).collect(), u)
             }
         }
     }
 
-    /// The region of step `k`: the box `[lo, hi]` widened by the stochastic radius (uniform),
-    /// or the domain (pointwise).
-    fn region(&self, lo: &[Interval]) -> Vec<Interval> {
+    /// The region of a step whose deterministic set lies in the box `set`: the box widened by
+    /// the stochastic radius (uniform), or the domain (pointwise).
+    fn region(&self, set: &[Interval]) -> Vec<Interval> {
         if self.run.spec.guarantee == Guarantee::Pointwise {
             return self
                 .run
@@ -409,7 +422,7 @@ impl Stepper<'_> {
                 .map(|b| Interval::new(b.lo, b.hi))
                 .collect();
         }
-        lo.iter()
+        set.iter()
             .zip(&self.w)
             .map(|(v, &w)| {
                 let d = Interval::point(self.r) * Interval::point(w);

@@ -545,6 +545,14 @@ pub enum Problem {
         /// The model's period.
         period: f64,
     },
+    /// A discrete-time analysis' horizon is more steps of the map than a run may take
+    /// (`RunError::Invalid`).
+    TooManyMapSteps {
+        /// The horizon in periods.
+        steps: usize,
+        /// The most steps.
+        max: usize,
+    },
     /// The factor or the noise level of a discrete-time model's map cannot be bounded on the
     /// region of the step starting at `t` (an unbounded Jacobian or diffusion entry there).
     MapFactor {
